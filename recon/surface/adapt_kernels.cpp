@@ -1,0 +1,68 @@
+#include "recon/surface/adapt_kernels.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace bodyscan {
+
+std::vector<float> density_sigma(const NeighborGraph& graph, size_t k) {
+  const size_t n = graph.k ? graph.indices.size() / graph.k : 0;
+  k = std::min(k, graph.k);
+  std::vector<float> sigma(n, 0.f);
+  if (k == 0) return sigma;
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    const float* d = graph.row_distances(i);
+    double sum = 0.0;
+    for (size_t j = 0; j < k; ++j) sum += d[j];
+    sigma[i] = static_cast<float>(sum / static_cast<double>(k));
+  });
+  return sigma;
+}
+
+std::vector<Kernel> adapt_kernels(const std::vector<Vec3f>& points, const LocalFrames& frames,
+                                  const std::vector<float>& sigma_density,
+                                  const CurvatureResult* curvature,
+                                  const std::vector<float>& mean_curvature,
+                                  const std::vector<float>& confidence,
+                                  const AdaptKernelsOptions& options) {
+  const size_t n = points.size();
+  std::vector<Kernel> kernels(n);
+  std::vector<uint8_t> keep(n, 1);
+  const bool sharpen = options.sharpening != 0.f && curvature != nullptr;
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    Kernel& k = kernels[i];
+    const float sd = sigma_density[i];
+    const float w = confidence.empty() ? 1.f : confidence[i];
+    if (!(w > 0.f) || !(sd > 0.f)) {
+      keep[i] = 0;
+      return;
+    }
+    k.center = points[i];
+    k.t1 = frames.tangent1[i];
+    k.t2 = frames.tangent2[i];
+    k.n = frames.normals[i];
+    const float base = sd * options.sigma_user;
+    const float floor = options.min_sigma_fraction * base;
+    k.sigma_t1 = base;
+    k.sigma_t2 = base;
+    if (sharpen) {
+      const Eigen::Vector2f& c = curvature->curvature[i];
+      k.sigma_t1 = std::max(floor, sd * (options.sigma_user - options.sharpening * c[0] * sd));
+      k.sigma_t2 = std::max(floor, sd * (options.sigma_user - options.sharpening * c[1] * sd));
+    }
+    k.sigma_n = options.normal_scale * sd;
+    if (options.curvature_compensation && !mean_curvature.empty()) {
+      const float limit = options.max_bend / std::max(k.sigma_t1, k.sigma_t2);
+      k.bend = std::clamp(mean_curvature[i], -limit, limit);
+    }
+    k.weight = std::min(w, 1.f);
+  });
+  size_t out = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (keep[i]) kernels[out++] = kernels[i];
+  kernels.resize(out);
+  return kernels;
+}
+
+}  // namespace bodyscan

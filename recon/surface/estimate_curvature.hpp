@@ -1,0 +1,84 @@
+// Normal-section curvature along each principal tangent direction (thesis §3.2.2.4).
+//
+// For a point p with frame (t1, t2, n) and direction t_a (a = 1, 2), the neighbours
+// lying near the plane spanned by t_a and n are projected into it and a circle is
+// fitted to them by Levenberg-Marquardt on the geometric distance (thesis ref. [15]).
+// The fit is checked against the stable normal-angle estimate (eq. 3.22-3.23),
+// c = mean over neighbours of 2 sin(theta/2) / dist: where the circle is unstable
+// (no convergence, too few points, or a curvature far above the angle estimate) the
+// angle estimate is used, as the thesis does.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "recon/geometry/point_cloud.hpp"
+#include "recon/spatial/knn_index.hpp"
+#include "recon/surface/estimate_normals.hpp"
+
+namespace bodyscan {
+
+struct EstimateCurvatureOptions {
+  size_t k = 20;  // neighbours considered (the graph must have at least this many)
+  // A neighbour belongs to the (t_a, n) plane when its direction is within this
+  // angle of the plane, radians.
+  float plane_angle = 0.5236f;  // 30 degrees
+  // The circle is unstable when its curvature exceeds `instability_ratio` times the
+  // angle estimate plus one over (instability_ratio x neighbourhood radius).
+  float instability_ratio = 2.5f;
+  int max_iterations = 4;
+};
+
+struct CurvatureResult {
+  // |curvature| (1 / length unit) of the normal section along tangent1 and tangent2.
+  std::vector<Eigen::Vector2f> curvature;
+  size_t circle_fits_used = 0;   // sections where the circle fit was kept
+  size_t angle_fallbacks = 0;    // sections where the angle estimate replaced it
+};
+
+// Circle fit for one section. u: positions along the tangent, h: heights along the
+// normal, both relative to the point, which is included by the caller if wanted.
+// Returns the signed curvature (positive when the circle's centre is on -n, i.e. the
+// surface bends away from the normal, as on a sphere with outward normals), or NaN
+// when the fit is not determined.
+float fit_circle_curvature(const float* u, const float* h, size_t count, int max_iterations);
+
+// The normal-angle curvature estimate (eq. 3.23 divided by the distances, i.e. the
+// mean of eq. 3.22 over the neighbours given), unsigned.
+float angle_curvature(const Vec3f& p, const Vec3f& n, const std::vector<Vec3f>& points,
+                      const std::vector<Vec3f>& normals, const uint32_t* neighbours,
+                      size_t count);
+
+// A quadric height field h = a u^2 + b uv + c v^2 + d u + e v + f fitted by least
+// squares to a point (at the origin) and its neighbours in its frame (u along
+// tangent1, v along tangent2, h along the normal).
+struct LocalQuadric {
+  Eigen::Matrix<double, 6, 1> coef = Eigen::Matrix<double, 6, 1>::Zero();  // a b c d e f
+  double residual_rms = 0.0;  // corrected for the six fitted parameters
+  bool ok = false;
+  // Mean curvature, positive where the surface bends away from the normal (convex
+  // with outward normals): -(a + c) for a near-level fit.
+  double mean_curvature() const { return -(coef[0] + coef[2]); }
+};
+LocalQuadric fit_local_quadric(const std::vector<Vec3f>& points, size_t i, const uint32_t* neighbours,
+                               size_t count, const LocalFrames& frames);
+
+struct MeanCurvatureOptions {
+  // Neighbours per quadric fit. Up to graph.k they come from the graph; more are
+  // queried from the index (a noisy cloud needs fits as wide as its kernels).
+  size_t k = 20;
+  int smoothing_passes = 2;   // neighbour averages of the result
+  size_t smoothing_k = 10;
+};
+
+// Signed mean curvature per point (1 / length unit) from local quadrics, smoothed
+// over the neighbour graph. frames must be oriented (the sign follows the normals).
+std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, const KnnIndex& index,
+                                           const NeighborGraph& graph, const LocalFrames& frames,
+                                           const MeanCurvatureOptions& options = {});
+
+CurvatureResult estimate_curvature(const std::vector<Vec3f>& points, const NeighborGraph& graph,
+                                   const LocalFrames& frames,
+                                   const EstimateCurvatureOptions& options = {});
+
+}  // namespace bodyscan

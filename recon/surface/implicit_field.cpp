@@ -1,0 +1,292 @@
+#include "recon/surface/implicit_field.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <numeric>
+
+namespace bodyscan {
+
+namespace {
+
+constexpr int kCoordBits = 21;
+constexpr int kMaxCoord = (1 << kCoordBits) - 1;
+
+// A kernel prepared for splatting: z = M (x - c) are its normalised local coordinates.
+// Nodes are visited inside the ellipsoid |M (x - c)| < r, whose normal axis is
+// widened by the bend's largest sag, and evaluated with the bent coordinate
+//   z3 = a z3' + b1 z1^2 + b2 z2^2   (z3' the widened-ellipsoid coordinate).
+struct Prepared {
+  Eigen::Matrix3f m;   // rows t1/s1, t2/s2, n/sn_visit
+  Vec3f center;
+  Vec3f half_extent;   // world-axis half size of the visited ellipsoid
+  float weight;
+  float a, b1, b2;
+};
+
+Prepared prepare(const Kernel& k, float r) {
+  Prepared p;
+  const float sag = 0.5f * std::abs(k.bend) * r * r *
+                    std::max(k.sigma_t1 * k.sigma_t1, k.sigma_t2 * k.sigma_t2);
+  const float sn_visit = k.sigma_n + sag / r;
+  p.m.row(0) = k.t1.transpose() / k.sigma_t1;
+  p.m.row(1) = k.t2.transpose() / k.sigma_t2;
+  p.m.row(2) = k.n.transpose() / sn_visit;
+  p.center = k.center;
+  for (int j = 0; j < 3; ++j) {
+    const float a = k.sigma_t1 * k.t1[j], b = k.sigma_t2 * k.t2[j], c = sn_visit * k.n[j];
+    p.half_extent[j] = r * std::sqrt(a * a + b * b + c * c);
+  }
+  p.weight = k.weight;
+  p.a = sn_visit / k.sigma_n;
+  p.b1 = 0.5f * k.bend * k.sigma_t1 * k.sigma_t1 / k.sigma_n;
+  p.b2 = 0.5f * k.bend * k.sigma_t2 * k.sigma_t2 / k.sigma_n;
+  return p;
+}
+
+struct Pair {
+  uint64_t key;
+  uint32_t kernel;
+  bool operator<(const Pair& o) const { return key != o.key ? key < o.key : kernel < o.kernel; }
+};
+
+}  // namespace
+
+uint64_t ImplicitField::pack(const Eigen::Vector3i& c) {
+  return (static_cast<uint64_t>(c.z()) << (2 * kCoordBits)) |
+         (static_cast<uint64_t>(c.y()) << kCoordBits) | static_cast<uint64_t>(c.x());
+}
+
+Eigen::Vector3i ImplicitField::brick_coord(size_t b) const {
+  const uint64_t k = keys_[b];
+  return {static_cast<int>(k & kMaxCoord), static_cast<int>((k >> kCoordBits) & kMaxCoord),
+          static_cast<int>(k >> (2 * kCoordBits))};
+}
+
+long ImplicitField::find_brick(const Eigen::Vector3i& c) const {
+  if ((c.array() < 0).any() || (c.array() > kMaxCoord).any()) return -1;
+  const uint64_t k = pack(c);
+  auto it = std::lower_bound(keys_.begin(), keys_.end(), k);
+  if (it == keys_.end() || *it != k) return -1;
+  return static_cast<long>(it - keys_.begin());
+}
+
+size_t ImplicitField::memory_bytes() const {
+  return keys_.capacity() * sizeof(uint64_t) + (values_.capacity() + weights_.capacity()) * sizeof(float);
+}
+
+float ImplicitField::value_at(const Eigen::Vector3i& node) const {
+  const long b = find_brick({node.x() >> brick_shift_, node.y() >> brick_shift_, node.z() >> brick_shift_});
+  if (b < 0) return 0.f;
+  const int m = brick_size_ - 1;
+  return values(static_cast<size_t>(b))[(node.x() & m) + brick_size_ * ((node.y() & m) + brick_size_ * (node.z() & m))];
+}
+
+float ImplicitField::weight_at(const Eigen::Vector3i& node) const {
+  const long b = find_brick({node.x() >> brick_shift_, node.y() >> brick_shift_, node.z() >> brick_shift_});
+  if (b < 0) return 0.f;
+  const int m = brick_size_ - 1;
+  return weights(static_cast<size_t>(b))[(node.x() & m) + brick_size_ * ((node.y() & m) + brick_size_ * (node.z() & m))];
+}
+
+void ImplicitField::evaluate(const std::vector<Kernel>& kernels, float epsilon, const Vec3d& x,
+                             double* value, double* weight) {
+  const double r2 = -2.0 * std::log(static_cast<double>(epsilon));
+  double f = 0.0, w = 0.0;
+  for (const Kernel& k : kernels) {
+    const Vec3d d = x - k.center.cast<double>();
+    const double z1 = d.dot(k.t1.cast<double>()) / k.sigma_t1;
+    const double z2 = d.dot(k.t2.cast<double>()) / k.sigma_t2;
+    const double z3 = (d.dot(k.n.cast<double>()) +
+                       0.5 * k.bend * (z1 * z1 * k.sigma_t1 * k.sigma_t1 + z2 * z2 * k.sigma_t2 * k.sigma_t2)) /
+                      k.sigma_n;
+    const double q = z1 * z1 + z2 * z2 + z3 * z3;
+    if (q >= r2) continue;
+    const double e = k.weight * std::exp(-0.5 * q);
+    f += -z3 * e;
+    w += e;
+  }
+  *value = f;
+  *weight = w;
+}
+
+StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
+                                             const ImplicitFieldOptions& options) {
+  if (!(options.voxel_size > 0.f) || !std::isfinite(options.voxel_size)) {
+    return invalid_argument("voxel size must be a positive number");
+  }
+  if (!(options.epsilon > 0.f && options.epsilon < 1.f)) {
+    return invalid_argument("error tolerance epsilon must be in (0, 1)");
+  }
+  const int bs = options.brick_size;
+  if (bs < 2 || bs > 1024 || (bs & (bs - 1)) != 0) {
+    return invalid_argument("brick size must be a power of two in [2, 1024]");
+  }
+  if (kernels.empty()) return invalid_argument("no points to build a surface from");
+
+  ImplicitField field;
+  field.voxel_size_ = options.voxel_size;
+  field.brick_size_ = bs;
+  field.brick_shift_ = 0;
+  while ((1 << field.brick_shift_) < bs) ++field.brick_shift_;
+
+  const float r2 = -2.f * std::log(options.epsilon);
+  const float r = std::sqrt(r2);
+  const double h = options.voxel_size;
+
+  std::vector<Prepared> prep(kernels.size());
+  tbb::parallel_for(size_t{0}, kernels.size(), [&](size_t i) { prep[i] = prepare(kernels[i], r); });
+
+  Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::max());
+  Vec3d hi = Vec3d::Constant(std::numeric_limits<double>::lowest());
+  for (const Prepared& p : prep) {
+    if (!p.center.allFinite() || !p.half_extent.allFinite() || !(p.weight > 0.f)) {
+      return invalid_argument("a kernel has a non-finite position or size, or a weight <= 0");
+    }
+    lo = lo.cwiseMin((p.center - p.half_extent).cast<double>());
+    hi = hi.cwiseMax((p.center + p.half_extent).cast<double>());
+  }
+  // Align the grid to multiples of the voxel size so that the nodes do not depend
+  // on the cloud's extent beyond that: the same points give the same grid.
+  field.origin_ = ((lo / h).array().floor() - 1.0).matrix() * h;
+  const Vec3d span = (hi - field.origin_) / h;
+  if ((span.array() + 2.0 > static_cast<double>(kMaxCoord)).any()) {
+    return out_of_range("the voxel size is too small for the cloud's extent (more than " +
+                        std::to_string(kMaxCoord) + " voxels along an axis)");
+  }
+
+  // Node range of each kernel's support, and the bricks it touches.
+  auto node_range = [&](const Prepared& p, Eigen::Vector3i& nlo, Eigen::Vector3i& nhi) {
+    const Vec3d a = ((p.center - p.half_extent).cast<double>() - field.origin_) / h;
+    const Vec3d b = ((p.center + p.half_extent).cast<double>() - field.origin_) / h;
+    nlo = a.array().ceil().cast<int>().max(0);
+    nhi = b.array().floor().cast<int>();
+  };
+  std::vector<size_t> counts(prep.size() + 1, 0);
+  tbb::parallel_for(size_t{0}, prep.size(), [&](size_t i) {
+    Eigen::Vector3i nlo, nhi;
+    node_range(prep[i], nlo, nhi);
+    if ((nhi.array() < nlo.array()).any()) return;
+    const Eigen::Vector3i blo = nlo.array() / bs, bhi = nhi.array() / bs;
+    counts[i + 1] = static_cast<size_t>((bhi - blo + Eigen::Vector3i::Ones()).prod());
+  });
+  std::partial_sum(counts.begin(), counts.end(), counts.begin());
+  if (counts.back() > 400'000'000ull) {
+    return out_of_range("the kernels are too large for the voxel size (" +
+                        std::to_string(counts.back()) + " kernel-brick overlaps)");
+  }
+  std::vector<Pair> pairs(counts.back());
+  tbb::parallel_for(size_t{0}, prep.size(), [&](size_t i) {
+    Eigen::Vector3i nlo, nhi;
+    node_range(prep[i], nlo, nhi);
+    if ((nhi.array() < nlo.array()).any()) return;
+    const Eigen::Vector3i blo = nlo.array() / bs, bhi = nhi.array() / bs;
+    size_t o = counts[i];
+    for (int z = blo.z(); z <= bhi.z(); ++z)
+      for (int y = blo.y(); y <= bhi.y(); ++y)
+        for (int x = blo.x(); x <= bhi.x(); ++x)
+          pairs[o++] = {ImplicitField::pack({x, y, z}), static_cast<uint32_t>(i)};
+  });
+  tbb::parallel_sort(pairs.begin(), pairs.end());
+  if (!report(options.progress, "field", 0.1)) return cancelled("reconstruction cancelled");
+
+  // Brick list and each brick's slice of the pairs.
+  std::vector<size_t> starts;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (i == 0 || pairs[i].key != pairs[i - 1].key) {
+      starts.push_back(i);
+      field.keys_.push_back(pairs[i].key);
+    }
+  }
+  starts.push_back(pairs.size());
+  const size_t nb = field.keys_.size();
+  if (nb > options.max_bricks) {
+    return out_of_range("the surface needs " + std::to_string(nb) + " bricks, more than the limit of " +
+                        std::to_string(options.max_bricks) + ": use a larger voxel size");
+  }
+  const size_t per = field.nodes_per_brick();
+  field.values_.assign(nb * per, 0.f);
+  field.weights_.assign(nb * per, 0.f);
+
+  std::atomic<size_t> done{0};
+  std::atomic<bool> stop{false};
+  std::mutex progress_mutex;  // the callback is not required to be thread-safe
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nb, 16), [&](const tbb::blocked_range<size_t>& range) {
+    if (stop.load(std::memory_order_relaxed)) return;
+    for (size_t b = range.begin(); b != range.end(); ++b) {
+      const Eigen::Vector3i bc = field.brick_coord(b);
+      const Eigen::Vector3i b0 = bc * bs;
+      float* fv = field.values_.data() + b * per;
+      float* wv = field.weights_.data() + b * per;
+      for (size_t pi = starts[b]; pi < starts[b + 1]; ++pi) {
+        const Prepared& p = prep[pairs[pi].kernel];
+        Eigen::Vector3i klo, khi;
+        node_range(p, klo, khi);
+        const Eigen::Vector3i nlo = klo.cwiseMax(b0);
+        const Eigen::Vector3i nhi = khi.cwiseMin(b0 + Eigen::Vector3i::Constant(bs - 1));
+        // Step of z along world x for one voxel. Rows start at the kernel's own first
+        // node (not the brick's), so every node's value is computed by the same float
+        // operations whatever the brick size.
+        const Vec3f dx = p.m.col(0) * static_cast<float>(h);
+        const float dd = dx.squaredNorm();
+        for (int z = nlo.z(); z <= nhi.z(); ++z) {
+          for (int y = nlo.y(); y <= nhi.y(); ++y) {
+            const Vec3d x0 = field.origin_ + h * Vec3d(klo.x(), y, z);
+            const Vec3f z0 = p.m * (x0 - p.center.cast<double>()).cast<float>();
+            // |z0 + t dx|^2 < r2 for t in (t_lo, t_hi).
+            const float bq = z0.dot(dx);
+            const float cq = z0.squaredNorm() - r2;
+            const float disc = bq * bq - dd * cq;
+            if (disc <= 0.f) continue;
+            const float sq = std::sqrt(disc);
+            const int t_lo = std::max(nlo.x() - klo.x(), static_cast<int>(std::ceil((-bq - sq) / dd)));
+            const int t_hi = std::min(nhi.x() - klo.x(), static_cast<int>(std::floor((-bq + sq) / dd)));
+            const int row = (y - b0.y()) * bs + (z - b0.z()) * bs * bs - b0.x() + klo.x();
+            for (int t = t_lo; t <= t_hi; ++t) {
+              const Vec3f zz = z0 + static_cast<float>(t) * dx;
+              const float z1s = zz.x() * zz.x(), z2s = zz.y() * zz.y();
+              const float z3 = p.a * zz.z() + p.b1 * z1s + p.b2 * z2s;
+              const float q = z1s + z2s + z3 * z3;
+              if (q >= r2) continue;
+              const float e = p.weight * std::exp(-0.5f * q);
+              const int idx = row + t;
+              fv[idx] += -z3 * e;
+              wv[idx] += e;
+            }
+          }
+        }
+      }
+    }
+    const size_t d = done.fetch_add(range.size()) + range.size();
+    if (options.progress) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      if (!options.progress("field", 0.1 + 0.9 * static_cast<double>(d) / nb)) stop = true;
+    }
+  });
+  if (stop) return cancelled("reconstruction cancelled");
+  return field;
+}
+
+float median_surface_weight(const ImplicitField& field, const std::vector<Vec3f>& points,
+                            size_t max_samples) {
+  if (points.empty()) return 0.f;
+  const size_t stride = std::max<size_t>(1, points.size() / std::max<size_t>(1, max_samples));
+  std::vector<float> w;
+  for (size_t i = 0; i < points.size(); i += stride) {
+    const Vec3d g = (points[i].cast<double>() - field.origin()) / field.voxel_size();
+    const Eigen::Vector3i node = g.array().round().cast<int>();
+    if ((node.array() < 0).any()) continue;
+    const float wi = field.weight_at(node);
+    if (wi > 0.f) w.push_back(wi);
+  }
+  if (w.empty()) return 0.f;
+  std::nth_element(w.begin(), w.begin() + static_cast<long>(w.size() / 2), w.end());
+  return w[w.size() / 2];
+}
+
+}  // namespace bodyscan

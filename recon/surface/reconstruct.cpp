@@ -1,0 +1,207 @@
+#include "recon/surface/reconstruct.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "recon/geometry/mesh_components.hpp"
+#include "recon/spatial/knn_index.hpp"
+#include "recon/surface/adapt_kernels.hpp"
+#include "recon/surface/estimate_curvature.hpp"
+#include "recon/surface/estimate_noise.hpp"
+#include "recon/surface/estimate_normals.hpp"
+#include "recon/surface/implicit_field.hpp"
+#include "recon/surface/marching_cubes.hpp"
+#include "recon/surface/orient_normals.hpp"
+
+namespace bodyscan {
+
+const char* to_string(NormalSource s) {
+  switch (s) {
+    case NormalSource::kAuto: return "auto";
+    case NormalSource::kInput: return "input";
+    case NormalSource::kCameras: return "cameras";
+    case NormalSource::kMst: return "mst";
+  }
+  return "?";
+}
+
+bool parse_normal_source(const std::string& text, NormalSource* out) {
+  for (NormalSource s : {NormalSource::kAuto, NormalSource::kInput, NormalSource::kCameras,
+                         NormalSource::kMst}) {
+    if (text == to_string(s)) {
+      *out = s;
+      return true;
+    }
+  }
+  return false;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+float median_of(std::vector<float> v) {
+  if (v.empty()) return 0.f;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
+                                                const ReconstructOptions& options) {
+  if (!input.is_consistent()) {
+    return invalid_argument("point cloud attributes do not have one entry per point");
+  }
+  // Points with zero confidence do not take part at all, not even as neighbours.
+  PointCloud kept;
+  const PointCloud* cloud = &input;
+  if (options.use_confidence && input.has_confidence() &&
+      std::any_of(input.confidence.begin(), input.confidence.end(), [](float c) { return !(c > 0.f); })) {
+    kept.camera_centres = input.camera_centres;
+    for (size_t i = 0; i < input.size(); ++i) {
+      if (!(input.confidence[i] > 0.f)) continue;
+      kept.positions.push_back(input.positions[i]);
+      kept.confidence.push_back(input.confidence[i]);
+      if (input.has_normals()) kept.normals.push_back(input.normals[i]);
+      if (!input.camera.empty()) kept.camera.push_back(input.camera[i]);
+    }
+    cloud = &kept;
+  }
+  const std::vector<Vec3f>& pts = cloud->positions;
+  if (pts.size() < 8) {
+    return invalid_argument("a surface needs at least 8 points with positive confidence; got " +
+                            std::to_string(pts.size()));
+  }
+  for (const Vec3f& p : pts) {
+    if (!p.allFinite()) return invalid_argument("the cloud has a non-finite coordinate");
+  }
+
+  ReconstructResult result;
+  ReconstructStats& st = result.stats;
+  st.input_points = input.size();
+  st.used_points = pts.size();
+
+  NormalSource source = options.normal_source;
+  if (source == NormalSource::kAuto) {
+    source = cloud->has_normals() ? NormalSource::kInput
+             : cloud->has_cameras() ? NormalSource::kCameras
+                                    : NormalSource::kMst;
+  }
+  if (source == NormalSource::kInput && !cloud->has_normals()) {
+    return invalid_argument("normal source 'input' chosen but the cloud has no normals");
+  }
+  if (source == NormalSource::kCameras && !cloud->has_cameras()) {
+    return invalid_argument("normal source 'cameras' chosen but the cloud has no camera ids and centres");
+  }
+  st.normals = source;
+
+  // Neighbours. 30 columns serve every later stage (density 10, normals up to 30).
+  auto t0 = Clock::now();
+  if (!report(options.progress, "neighbours", 0.0)) return cancelled("reconstruction cancelled");
+  const KnnIndex index(pts);
+  const size_t max_k = std::max<size_t>({options.density_k, options.normal_k, 30});
+  const NeighborGraph graph = knn_graph(index, pts, max_k);
+  st.t_neighbours = seconds_since(t0);
+
+  // Normals: a first PCA with 20 neighbours gives frames for the noise estimate; the
+  // final k grows with the noise, since PCA averages noise over k points.
+  t0 = Clock::now();
+  if (!report(options.progress, "normals", 0.0)) return cancelled("reconstruction cancelled");
+  LocalFrames frames = estimate_normals(pts, index, graph, {.k = 20});
+  const NoiseEstimate noise = estimate_noise(pts, index, graph, frames);
+  const std::vector<float> sigma_density = density_sigma(graph, options.density_k);
+  st.median_density_sigma = median_of(sigma_density);
+  st.noise_sigma = noise.sigma;
+  const float eta = st.median_density_sigma > 0.f ? noise.sigma / st.median_density_sigma : 0.f;
+  st.normal_k = options.normal_k ? options.normal_k : (eta < 0.05f ? 12 : eta < 0.15f ? 20 : 30);
+  if (st.normal_k != 20) frames = estimate_normals(pts, index, graph, {.k = st.normal_k});
+  if (source == NormalSource::kInput) {
+    for (size_t i = 0; i < pts.size(); ++i) {
+      Vec3f n = cloud->normals[i];
+      if (!(n.squaredNorm() > 0.f) || !n.allFinite()) {
+        return invalid_argument("input normal " + std::to_string(i) + " is zero or not finite");
+      }
+      n.normalize();
+      Vec3f t1 = frames.tangent1[i] - frames.tangent1[i].dot(n) * n;
+      if (t1.squaredNorm() < 1e-12f) t1 = n.unitOrthogonal();
+      t1.normalize();
+      frames.normals[i] = n;
+      frames.tangent1[i] = t1;
+      frames.tangent2[i] = n.cross(t1);
+    }
+  }
+  st.t_normals = seconds_since(t0);
+
+  t0 = Clock::now();
+  if (!report(options.progress, "orientation", 0.0)) return cancelled("reconstruction cancelled");
+  if (source == NormalSource::kCameras) {
+    orient_normals_toward_cameras(*cloud, frames);
+  } else if (source == NormalSource::kMst) {
+    st.orientation_components = orient_normals_mst(pts, graph, frames).components;
+  }
+  st.t_orientation = seconds_since(t0);
+
+  // Kernel sizes. Noise needs wider kernels to average over; the defaults follow
+  // the relative noise eta = noise / density sigma (tuned on the thesis's sphere
+  // table, see docs/benchmarks.md).
+  t0 = Clock::now();
+  if (!report(options.progress, "kernels", 0.0)) return cancelled("reconstruction cancelled");
+  st.sigma_scale = options.sigma_scale > 0.f ? options.sigma_scale : std::clamp(1.0f + 4.0f * eta, 1.0f, 4.0f);
+  st.normal_scale = options.normal_scale > 0.f ? options.normal_scale : std::clamp(0.5f + 2.0f * eta, 0.5f, 3.0f);
+  st.sharpening = options.sharpening;
+  CurvatureResult curvature;
+  if (options.sharpening != 0.f) curvature = estimate_curvature(pts, graph, frames);
+  AdaptKernelsOptions ko;
+  ko.sigma_user = st.sigma_scale;
+  ko.normal_scale = st.normal_scale;
+  ko.sharpening = options.sharpening;
+  ko.density_k = options.density_k;
+  ko.curvature_compensation = options.curvature_compensation;
+  std::vector<float> mean_curvature;
+  if (options.curvature_compensation) {
+    // The fit spans about the kernel: k grows with the kernel's area in spacings.
+    const size_t k = std::clamp<size_t>(static_cast<size_t>(12.f * st.sigma_scale * st.sigma_scale), 20, 200);
+    mean_curvature = estimate_mean_curvature(pts, index, graph, frames, {.k = k});
+  }
+  const std::vector<float> no_confidence;
+  const std::vector<Kernel> kernels =
+      adapt_kernels(pts, frames, sigma_density, options.sharpening != 0.f ? &curvature : nullptr,
+                    mean_curvature, options.use_confidence ? cloud->confidence : no_confidence, ko);
+  st.t_kernels = seconds_since(t0);
+
+  // Field. The voxel must resolve the thinnest kernel across the surface.
+  t0 = Clock::now();
+  st.voxel_size = options.voxel_size > 0.f
+                      ? options.voxel_size
+                      : 0.5f * st.median_density_sigma * std::min(1.f, st.normal_scale);
+  ImplicitFieldOptions fo;
+  fo.voxel_size = st.voxel_size;
+  fo.epsilon = options.epsilon;
+  fo.brick_size = options.brick_size;
+  fo.progress = options.progress;
+  ASSIGN_OR_RETURN(ImplicitField field, build_implicit_field(kernels, fo));
+  st.bricks = field.num_bricks();
+  st.field_bytes = field.memory_bytes();
+  st.t_field = seconds_since(t0);
+
+  t0 = Clock::now();
+  MarchingCubesOptions mo;
+  st.min_weight = std::max(1e-6f, options.min_relative_weight * median_surface_weight(field, pts));
+  mo.min_weight = st.min_weight;
+  mo.progress = options.progress;
+  ASSIGN_OR_RETURN(result.mesh, extract_isosurface(field, mo));
+  if (options.min_component_fraction > 0.0) {
+    st.components_removed = remove_small_components(result.mesh, options.min_component_fraction);
+  }
+  result.mesh.normals = compute_vertex_normals(result.mesh);
+  st.t_mesh = seconds_since(t0);
+  report(options.progress, "done", 1.0);
+  return result;
+}
+
+}  // namespace bodyscan

@@ -1,0 +1,37 @@
+// bodyscan: the command-line entry point. Each subcommand lives in its own file.
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+namespace bodyscan::cli {
+int run_reconstruct(int argc, char** argv);
+}
+
+namespace {
+void print_usage(FILE* out) {
+  std::fputs(
+      "usage: bodyscan <command> [options]\n"
+      "\n"
+      "commands:\n"
+      "  reconstruct IN.ply -o OUT.ply   points (PLY, optional normals) to a watertight mesh\n"
+      "\n"
+      "Run 'bodyscan <command> --help' for a command's options.\n",
+      out);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    print_usage(stderr);
+    return 2;
+  }
+  const std::string cmd = argv[1];
+  if (cmd == "-h" || cmd == "--help" || cmd == "help") {
+    print_usage(stdout);
+    return 0;
+  }
+  if (cmd == "reconstruct") return bodyscan::cli::run_reconstruct(argc - 1, argv + 1);
+  std::fprintf(stderr, "bodyscan: unknown command '%s'\n", cmd.c_str());
+  print_usage(stderr);
+  return 2;
+}
