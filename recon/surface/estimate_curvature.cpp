@@ -162,6 +162,37 @@ LocalQuadric fit_local_quadric(const std::vector<Vec3f>& points, size_t i, const
   return q;
 }
 
+namespace {
+
+// Mean curvature from how the (already smooth, wide-PCA) normals turn across the
+// neighbourhood: the shape operator S (2x2, symmetric, in the tangent plane) is
+// fitted by least squares to n_j - n_i = S d_ij over the tangential offsets d_ij,
+// and H = trace(S) / 2. Unlike a height-field fit this is not flattened by noise:
+// a noisy shell's nearest neighbours sit at similar heights, which biases fitted
+// heights (and so curvature) low, but barely moves the normals' turning.
+float shape_operator_mean_curvature(const std::vector<Vec3f>& points, size_t i, const uint32_t* nb,
+                                    size_t count, const LocalFrames& frames) {
+  const Vec3f &t1 = frames.tangent1[i], &t2 = frames.tangent2[i], &ni = frames.normals[i];
+  // Unknowns (s11, s12, s22); each neighbour gives two equations:
+  //   dn1 = s11 u + s12 v,   dn2 = s12 u + s22 v.
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  for (size_t j = 0; j < count; ++j) {
+    const Vec3f d = points[nb[j]] - points[i];
+    const Vec3f dn = frames.normals[nb[j]] - ni;
+    const double u = d.dot(t1), v = d.dot(t2);
+    const double dn1 = dn.dot(t1), dn2 = dn.dot(t2);
+    const Eigen::Vector3d r1(u, v, 0.0), r2(0.0, u, v);
+    ata += r1 * r1.transpose() + r2 * r2.transpose();
+    atb += r1 * dn1 + r2 * dn2;
+  }
+  const Eigen::Vector3d sol = ata.ldlt().solve(atb);
+  if (!sol.allFinite()) return 0.f;
+  return static_cast<float>(0.5 * (sol[0] + sol[2]));
+}
+
+}  // namespace
+
 std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, const KnnIndex& index,
                                            const NeighborGraph& graph, const LocalFrames& frames,
                                            const MeanCurvatureOptions& options) {
@@ -169,8 +200,7 @@ std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, con
   std::vector<float> h(n, 0.f);
   if (options.k <= graph.k) {
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-      const LocalQuadric q = fit_local_quadric(points, i, graph.row(i), options.k, frames);
-      h[i] = q.ok ? static_cast<float>(q.mean_curvature()) : 0.f;
+      h[i] = shape_operator_mean_curvature(points, i, graph.row(i), options.k, frames);
     });
   } else {
     const size_t k = std::min(options.k, n - 1);
@@ -179,12 +209,10 @@ std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, con
       std::vector<float> d2(k + 1);
       for (size_t i = r.begin(); i != r.end(); ++i) {
         const size_t got = index.knn(points[i], k + 1, idx.data(), d2.data());
-        // Drop the point itself (the fit adds it at the origin).
         size_t m = 0;
         for (size_t j = 0; j < got; ++j)
           if (idx[j] != i) idx[m++] = idx[j];
-        const LocalQuadric q = fit_local_quadric(points, i, idx.data(), std::min(m, k), frames);
-        h[i] = q.ok ? static_cast<float>(q.mean_curvature()) : 0.f;
+        h[i] = shape_operator_mean_curvature(points, i, idx.data(), std::min(m, k), frames);
       }
     });
   }

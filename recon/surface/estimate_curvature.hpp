@@ -71,8 +71,9 @@ struct MeanCurvatureOptions {
   size_t smoothing_k = 10;
 };
 
-// Signed mean curvature per point (1 / length unit) from local quadrics, smoothed
-// over the neighbour graph. frames must be oriented (the sign follows the normals).
+// Signed mean curvature per point (1 / length unit) from the turning of the
+// normals over each neighbourhood (a least-squares shape operator), smoothed over
+// the neighbour graph. frames must be oriented (the sign follows the normals).
 std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, const KnnIndex& index,
                                            const NeighborGraph& graph, const LocalFrames& frames,
                                            const MeanCurvatureOptions& options = {});

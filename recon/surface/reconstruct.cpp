@@ -164,9 +164,7 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   ko.curvature_compensation = options.curvature_compensation;
   std::vector<float> mean_curvature;
   if (options.curvature_compensation) {
-    // The fit spans about the kernel: k grows with the kernel's area in spacings.
-    const size_t k = std::clamp<size_t>(static_cast<size_t>(12.f * st.sigma_scale * st.sigma_scale), 20, 200);
-    mean_curvature = estimate_mean_curvature(pts, index, graph, frames, {.k = k});
+    mean_curvature = estimate_mean_curvature(pts, index, graph, frames, {.k = 20});
   }
   const std::vector<float> no_confidence;
   const std::vector<Kernel> kernels =

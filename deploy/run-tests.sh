@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Installs what the project needs, builds everything (with asserts on) and runs
+# every test. CI calls this through .ci/run.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+deploy/install-deps.sh
+BUILD_DIR=${BUILD_DIR:-build-test} BUILD_TYPE=RelWithDebInfo deploy/build.sh
+cd "${BUILD_DIR:-build-test}"
+ctest --output-on-failure -j "$(nproc)" --timeout 600
