@@ -57,6 +57,7 @@ std::vector<Kernel> adapt_kernels(const std::vector<Vec3f>& points, const LocalF
       k.bend = std::clamp(mean_curvature[i], -limit, limit);
     }
     k.weight = std::min(w, 1.f);
+    k.band = options.band;
   });
   size_t out = 0;
   for (size_t i = 0; i < n; ++i)

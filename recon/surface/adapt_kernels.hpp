@@ -37,6 +37,9 @@ struct AdaptKernelsOptions {
   // |bend| sigma_t <= max_bend.
   bool curvature_compensation = true;
   float max_bend = 0.7f;
+  // Normal reach of every kernel (Kernel::band), the points' unit; 0 = the full
+  // support.
+  float band = 0.f;
 };
 
 // Mean distance to the `k` nearest neighbours of each point (eq. 3.17).

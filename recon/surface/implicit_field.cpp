@@ -19,32 +19,37 @@ constexpr int kCoordBits = 21;
 constexpr int kMaxCoord = (1 << kCoordBits) - 1;
 
 // A kernel prepared for splatting: z = M (x - c) are its normalised local coordinates.
-// Nodes are visited inside the ellipsoid |M (x - c)| < r, whose normal axis is
-// widened by the bend's largest sag, and evaluated with the bent coordinate
-//   z3 = a z3' + b1 z1^2 + b2 z2^2   (z3' the widened-ellipsoid coordinate).
+// Nodes are visited in the elliptic cylinder |(z1, z2)| < r across the tangent
+// plane, cut by the slab |z3u| < slab along the normal (z3u = n . d / sn, the unbent
+// normal coordinate); the slab is the support's normal extent, or the kernel's
+// band when that is narrower, widened by the bend's largest sag. Each visited node
+// is then tested against the true (bent) support |z| < r:
+//   z3 = z3u + b1 z1^2 + b2 z2^2.
 struct Prepared {
-  Eigen::Matrix3f m;   // rows t1/s1, t2/s2, n/sn_visit
+  Eigen::Matrix3f m;   // rows t1/s1, t2/s2, n/sn
   Vec3f center;
-  Vec3f half_extent;   // world-axis half size of the visited ellipsoid
+  Vec3f half_extent;   // world-axis half size of the visited region
   float weight;
-  float a, b1, b2;
+  float slab;
+  float b1, b2;
 };
 
 Prepared prepare(const Kernel& k, float r) {
   Prepared p;
   const float sag = 0.5f * std::abs(k.bend) * r * r *
                     std::max(k.sigma_t1 * k.sigma_t1, k.sigma_t2 * k.sigma_t2);
-  const float sn_visit = k.sigma_n + sag / r;
+  const float normal_reach = k.band > 0.f ? std::min(k.band, r * k.sigma_n) : r * k.sigma_n;
+  const float slab_mm = normal_reach + sag;
   p.m.row(0) = k.t1.transpose() / k.sigma_t1;
   p.m.row(1) = k.t2.transpose() / k.sigma_t2;
-  p.m.row(2) = k.n.transpose() / sn_visit;
+  p.m.row(2) = k.n.transpose() / k.sigma_n;
   p.center = k.center;
   for (int j = 0; j < 3; ++j) {
-    const float a = k.sigma_t1 * k.t1[j], b = k.sigma_t2 * k.t2[j], c = sn_visit * k.n[j];
-    p.half_extent[j] = r * std::sqrt(a * a + b * b + c * c);
+    const float a = k.sigma_t1 * k.t1[j], b = k.sigma_t2 * k.t2[j];
+    p.half_extent[j] = r * std::sqrt(a * a + b * b) + slab_mm * std::abs(k.n[j]);
   }
   p.weight = k.weight;
-  p.a = sn_visit / k.sigma_n;
+  p.slab = slab_mm / k.sigma_n;
   p.b1 = 0.5f * k.bend * k.sigma_t1 * k.sigma_t1 / k.sigma_n;
   p.b2 = 0.5f * k.bend * k.sigma_t2 * k.sigma_t2 / k.sigma_n;
   return p;
@@ -53,7 +58,7 @@ Prepared prepare(const Kernel& k, float r) {
 // exp(x) for x <= 0, relative error < 2e-7 (x >= -87; 0 below): 2^(x log2 e) split into an
 // integer power (built in the exponent bits) and a degree-6 polynomial on [0, 1).
 // Branch-free, so the splatting loop vectorises; std::exp does not.
-inline float exp_nonpositive(float x) {
+__attribute__((always_inline)) inline float exp_nonpositive(float x) {
   x = x > -87.f ? x : -87.f;
   const float y = x * 1.44269504089f;
   // floor(y) by truncating a positive number: SSE2 has no floor instruction, and
@@ -82,13 +87,13 @@ inline float exp_nonpositive(float x) {
 // whichever brick it is in. Written as plain scalars
 // with restrict pointers and selects so that GCC vectorises it (the file is built
 // with -fno-trapping-math, which lets it turn the selects into masks).
-void splat_row(float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx,
-               float dy, float dz, const float a, float b1, float b2, float weight, float r2) {
+__attribute__((target_clones("arch=haswell", "default"))) void splat_row(float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx,
+               float dy, float dz, float b1, float b2, float weight, float r2) {
   for (int t = 0; t < n; ++t) {
     const float tf = static_cast<float>(t0 + t);
     const float z1 = zx + tf * dx, z2 = zy + tf * dy, z3u = zz + tf * dz;
     const float z1s = z1 * z1, z2s = z2 * z2;
-    const float z3 = a * z3u + b1 * z1s + b2 * z2s;
+    const float z3 = z3u + b1 * z1s + b2 * z2s;
     const float q = z1s + z2s + z3 * z3;
     const float wt = q < r2 ? weight : 0.f;
     const float e = wt * exp_nonpositive(-0.5f * q);
@@ -208,109 +213,159 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
                         std::to_string(kMaxCoord) + " voxels along an axis)");
   }
 
-  // Node range of each kernel's support, and the bricks it touches.
-  auto node_range = [&](const Prepared& p, Eigen::Vector3i& nlo, Eigen::Vector3i& nhi) {
+  // Node range of each kernel's support.
+  const size_t nk = prep.size();
+  std::vector<Eigen::Vector3i> klo(nk), khi(nk);
+  tbb::parallel_for(size_t{0}, nk, [&](size_t i) {
+    const Prepared& p = prep[i];
     const Vec3d a = ((p.center - p.half_extent).cast<double>() - field.origin_) / h;
     const Vec3d b = ((p.center + p.half_extent).cast<double>() - field.origin_) / h;
-    nlo = a.array().ceil().cast<int>().max(0);
-    nhi = b.array().floor().cast<int>();
-  };
-  std::vector<size_t> counts(prep.size() + 1, 0);
-  tbb::parallel_for(size_t{0}, prep.size(), [&](size_t i) {
-    Eigen::Vector3i nlo, nhi;
-    node_range(prep[i], nlo, nhi);
-    if ((nhi.array() < nlo.array()).any()) return;
-    const Eigen::Vector3i blo = nlo.array() / bs, bhi = nhi.array() / bs;
-    counts[i + 1] = static_cast<size_t>((bhi - blo + Eigen::Vector3i::Ones()).prod());
+    klo[i] = a.array().ceil().cast<int>().max(0);
+    khi[i] = b.array().floor().cast<int>();
+  });
+  auto empty_range = [&](size_t i) { return (khi[i].array() < klo[i].array()).any(); };
+
+  // Work is split into pencils: rows of bricks along x with one (y, z) brick
+  // coordinate. A kernel visits each pencil it overlaps once and splats whole grid
+  // rows there, split only where they cross bricks, so rows stay long; and two
+  // pencils never share a node, so they run in parallel without locks.
+  const int bs_shift = field.brick_shift_;
+  std::vector<size_t> counts(nk + 1, 0);
+  tbb::parallel_for(size_t{0}, nk, [&](size_t i) {
+    if (empty_range(i)) return;
+    const Eigen::Vector3i blo = klo[i].array() / bs, bhi = khi[i].array() / bs;
+    counts[i + 1] = static_cast<size_t>(bhi.y() - blo.y() + 1) * static_cast<size_t>(bhi.z() - blo.z() + 1);
   });
   std::partial_sum(counts.begin(), counts.end(), counts.begin());
-  if (counts.back() > 400'000'000ull) {
-    return out_of_range("the kernels are too large for the voxel size (" +
-                        std::to_string(counts.back()) + " kernel-brick overlaps)");
+  if (counts.back() > 200'000'000ull) {
+    return out_of_range("the kernels are too large for the voxel size (" + std::to_string(counts.back()) +
+                        " kernel-pencil overlaps): use a larger voxel size");
   }
   std::vector<Pair> pairs(counts.back());
-  tbb::parallel_for(size_t{0}, prep.size(), [&](size_t i) {
-    Eigen::Vector3i nlo, nhi;
-    node_range(prep[i], nlo, nhi);
-    if ((nhi.array() < nlo.array()).any()) return;
-    const Eigen::Vector3i blo = nlo.array() / bs, bhi = nhi.array() / bs;
+  tbb::parallel_for(size_t{0}, nk, [&](size_t i) {
+    if (empty_range(i)) return;
+    const Eigen::Vector3i blo = klo[i].array() / bs, bhi = khi[i].array() / bs;
     size_t o = counts[i];
     for (int z = blo.z(); z <= bhi.z(); ++z)
       for (int y = blo.y(); y <= bhi.y(); ++y)
-        for (int x = blo.x(); x <= bhi.x(); ++x)
-          pairs[o++] = {ImplicitField::pack({x, y, z}), static_cast<uint32_t>(i)};
+        pairs[o++] = {ImplicitField::pack({0, y, z}), static_cast<uint32_t>(i)};
   });
+  std::vector<size_t>().swap(counts);
   tbb::parallel_sort(pairs.begin(), pairs.end());
   if (!report(options.progress, "field", 0.1)) return cancelled("reconstruction cancelled");
 
-  // Brick list and each brick's slice of the pairs.
-  std::vector<size_t> starts;
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    if (i == 0 || pairs[i].key != pairs[i - 1].key) {
-      starts.push_back(i);
-      field.keys_.push_back(pairs[i].key);
-    }
-  }
+  std::vector<size_t> starts;  // each pencil's slice of `pairs`
+  for (size_t i = 0; i < pairs.size(); ++i)
+    if (i == 0 || pairs[i].key != pairs[i - 1].key) starts.push_back(i);
   starts.push_back(pairs.size());
-  const size_t nb = field.keys_.size();
+  const size_t np = starts.size() - 1;
+
+  // Phase 1: each pencil's bricks (the union of its kernels' x ranges), so that
+  // brick indices and the sorted key list are known before any value is written.
+  std::vector<std::vector<int>> pencil_bricks(np);
+  tbb::parallel_for(size_t{0}, np, [&](size_t pc) {
+    int xmin = INT32_MAX, xmax = INT32_MIN;
+    for (size_t pi = starts[pc]; pi < starts[pc + 1]; ++pi) {
+      xmin = std::min(xmin, klo[pairs[pi].kernel].x() >> bs_shift);
+      xmax = std::max(xmax, khi[pairs[pi].kernel].x() >> bs_shift);
+    }
+    std::vector<uint8_t> used(static_cast<size_t>(xmax - xmin + 1), 0);
+    for (size_t pi = starts[pc]; pi < starts[pc + 1]; ++pi) {
+      const uint32_t k = pairs[pi].kernel;
+      for (int x = klo[k].x() >> bs_shift; x <= (khi[k].x() >> bs_shift); ++x) used[x - xmin] = 1;
+    }
+    for (int x = xmin; x <= xmax; ++x)
+      if (used[x - xmin]) pencil_bricks[pc].push_back(x);
+  });
+  std::vector<size_t> first_brick(np + 1, 0);
+  for (size_t pc = 0; pc < np; ++pc) first_brick[pc + 1] = first_brick[pc] + pencil_bricks[pc].size();
+  const size_t nb = first_brick[np];
   if (nb > options.max_bricks) {
     return out_of_range("the surface needs " + std::to_string(nb) + " bricks, more than the limit of " +
                         std::to_string(options.max_bricks) + ": use a larger voxel size");
+  }
+  field.keys_.resize(nb);
+  for (size_t pc = 0; pc < np; ++pc) {
+    const uint64_t yz = pairs[starts[pc]].key;  // x bits are 0
+    for (size_t j = 0; j < pencil_bricks[pc].size(); ++j)
+      field.keys_[first_brick[pc] + j] = yz | static_cast<uint64_t>(pencil_bricks[pc][j]);
   }
   const size_t per = field.nodes_per_brick();
   field.values_.assign(nb * per, 0.f);
   field.weights_.assign(nb * per, 0.f);
 
+  // Phase 2: splat.
   std::atomic<size_t> done{0};
   std::atomic<bool> stop{false};
   std::mutex progress_mutex;  // the callback is not required to be thread-safe
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nb, 16), [&](const tbb::blocked_range<size_t>& range) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, np, 4), [&](const tbb::blocked_range<size_t>& range) {
     if (stop.load(std::memory_order_relaxed)) return;
-    for (size_t b = range.begin(); b != range.end(); ++b) {
-      const Eigen::Vector3i bc = field.brick_coord(b);
-      const Eigen::Vector3i b0 = bc * bs;
-      float* fv = field.values_.data() + b * per;
-      float* wv = field.weights_.data() + b * per;
-      for (size_t pi = starts[b]; pi < starts[b + 1]; ++pi) {
-        const Prepared& p = prep[pairs[pi].kernel];
-        Eigen::Vector3i klo, khi;
-        node_range(p, klo, khi);
-        const Eigen::Vector3i nlo = klo.cwiseMax(b0);
-        const Eigen::Vector3i nhi = khi.cwiseMin(b0 + Eigen::Vector3i::Constant(bs - 1));
-        // Step of z along world x for one voxel. Rows start at the kernel's own first
-        // node (not the brick's), so every node's value is computed by the same float
-        // operations whatever the brick size.
+    std::vector<long> brick_of;  // x brick coordinate - xmin -> brick index, -1 if none
+    for (size_t pc = range.begin(); pc != range.end(); ++pc) {
+      const uint64_t yz = pairs[starts[pc]].key;
+      const int by = static_cast<int>((yz >> kCoordBits) & kMaxCoord);
+      const int bz = static_cast<int>(yz >> (2 * kCoordBits));
+      const std::vector<int>& xs = pencil_bricks[pc];
+      const int xmin = xs.front();
+      brick_of.assign(static_cast<size_t>(xs.back() - xmin + 1), -1);
+      for (size_t j = 0; j < xs.size(); ++j) brick_of[xs[j] - xmin] = static_cast<long>(first_brick[pc] + j);
+      const int y_first = by * bs, z_first = bz * bs;
+      for (size_t pi = starts[pc]; pi < starts[pc + 1]; ++pi) {
+        const uint32_t ki = pairs[pi].kernel;
+        const Prepared& p = prep[ki];
+        const Eigen::Vector3i& lo = klo[ki];
+        const Eigen::Vector3i& hi = khi[ki];
+        // z at the kernel's first node and its steps along x, y, z, all from
+        // integer offsets: a node's value does not depend on the brick size.
+        const Vec3f zb = p.m * (field.origin_ + h * lo.cast<double>() - p.center.cast<double>()).cast<float>();
         const Vec3f dx = p.m.col(0) * static_cast<float>(h);
-        const float dd = dx.squaredNorm();
-        // z at the kernel's first node, and its steps along y and z, computed from
-        // integer offsets so that a node's value does not depend on the brick.
-        const Vec3f zb = p.m * (field.origin_ + h * klo.cast<double>() - p.center.cast<double>()).cast<float>();
         const Vec3f dy = p.m.col(1) * static_cast<float>(h);
         const Vec3f dz = p.m.col(2) * static_cast<float>(h);
-        const float inv_dd = 1.f / dd;
-        const float t_min = static_cast<float>(nlo.x() - klo.x());
-        const float t_max = static_cast<float>(nhi.x() - klo.x());
-        for (int z = nlo.z(); z <= nhi.z(); ++z) {
-          const Vec3f zz = zb + static_cast<float>(z - klo.z()) * dz;
-          for (int y = nlo.y(); y <= nhi.y(); ++y) {
-            const Vec3f z0 = zz + static_cast<float>(y - klo.y()) * dy;
-            // |z0 + t dx|^2 < r2 for t in (t_lo, t_hi).
-            const float bq = z0.dot(dx);
-            const float cq = z0.squaredNorm() - r2;
-            const float disc = bq * bq - dd * cq;
-            if (disc <= 0.f) continue;
-            const float sq = std::sqrt(disc);
-            const float lo_f = std::max(t_min, (-bq - sq) * inv_dd);
-            const float hi_f = std::min(t_max, (-bq + sq) * inv_dd);
+        const float dd12 = dx.x() * dx.x() + dx.y() * dx.y();
+        const float t_max = static_cast<float>(hi.x() - lo.x());
+        const int z0i = std::max(lo.z(), z_first), z1i = std::min(hi.z(), z_first + bs - 1);
+        const int y0i = std::max(lo.y(), y_first), y1i = std::min(hi.y(), y_first + bs - 1);
+        for (int z = z0i; z <= z1i; ++z) {
+          const Vec3f zz = zb + static_cast<float>(z - lo.z()) * dz;
+          for (int y = y0i; y <= y1i; ++y) {
+            const Vec3f z0 = zz + static_cast<float>(y - lo.y()) * dy;
+            // Cylinder: |z0_12 + t dx_12|^2 < r2; slab: |z0_3 + t dx_3| < slab.
+            float lo_f = 0.f, hi_f = t_max;
+            const float bq = z0.x() * dx.x() + z0.y() * dx.y();
+            const float cq = z0.x() * z0.x() + z0.y() * z0.y() - r2;
+            if (dd12 > 1e-12f) {
+              const float disc = bq * bq - dd12 * cq;
+              if (disc <= 0.f) continue;
+              const float sq = std::sqrt(disc);
+              lo_f = std::max(lo_f, (-bq - sq) / dd12);
+              hi_f = std::min(hi_f, (-bq + sq) / dd12);
+            } else if (cq >= 0.f) {
+              continue;  // the row runs along the normal, outside the cylinder
+            }
+            if (std::abs(dx.z()) > 1e-12f) {
+              const float s0 = (-p.slab - z0.z()) / dx.z(), s1 = (p.slab - z0.z()) / dx.z();
+              lo_f = std::max(lo_f, std::min(s0, s1));
+              hi_f = std::min(hi_f, std::max(s0, s1));
+            } else if (std::abs(z0.z()) >= p.slab) {
+              continue;
+            }
             if (hi_f < lo_f) continue;
-            // ceil / floor of small non-negative numbers without libm calls.
+            // ceil / floor of non-negative numbers without libm calls.
             int t_lo = static_cast<int>(lo_f);
             if (static_cast<float>(t_lo) < lo_f) ++t_lo;
             const int t_hi = static_cast<int>(hi_f);
             if (t_hi < t_lo) continue;
-            const int row = (y - b0.y()) * bs + (z - b0.z()) * bs * bs - b0.x() + klo.x();
-            splat_row(fv + row + t_lo, wv + row + t_lo, t_lo, t_hi - t_lo + 1, z0.x(), z0.y(), z0.z(),
-                      dx.x(), dx.y(), dx.z(), p.a, p.b1, p.b2, p.weight, r2);
+            const int row_offset = (y - y_first) * bs + (z - z_first) * bs * bs;
+            // Split the row where it crosses bricks.
+            for (int gx = lo.x() + t_lo; gx <= lo.x() + t_hi;) {
+              const int bx = gx >> bs_shift;
+              const int seg_end = std::min(lo.x() + t_hi, ((bx + 1) << bs_shift) - 1);
+              const size_t b = static_cast<size_t>(brick_of[bx - xmin]);
+              const size_t idx = b * per + static_cast<size_t>(row_offset + (gx - (bx << bs_shift)));
+              splat_row(field.values_.data() + idx, field.weights_.data() + idx, gx - lo.x(), seg_end - gx + 1,
+                        z0.x(), z0.y(), z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.weight, r2);
+              gx = seg_end + 1;
+            }
           }
         }
       }
@@ -318,7 +373,7 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
     const size_t d = done.fetch_add(range.size()) + range.size();
     if (options.progress) {
       std::lock_guard<std::mutex> lock(progress_mutex);
-      if (!options.progress("field", 0.1 + 0.9 * static_cast<double>(d) / nb)) stop = true;
+      if (!options.progress("field", 0.1 + 0.9 * static_cast<double>(d) / static_cast<double>(np))) stop = true;
     }
   });
   if (stop) return cancelled("reconstruction cancelled");

@@ -48,12 +48,18 @@ struct Kernel {
   // Mean curvature (1 / length), positive where the surface bends away from n.
   // 0 = the thesis's flat kernel. Callers keep |bend| sigma_t well below 1.
   float bend = 0.f;
+  // If > 0, the kernel reaches at most this far along its normal (before the
+  // bend), the points' unit. Marching cubes only needs the field within a few
+  // voxels of the surface, and every kernel that matters there has its plane that
+  // close (within the noise), so a band of a few voxels plus the noise keeps the
+  // field near the surface while skipping most of each kernel's normal extent.
+  float band = 0.f;
 };
 
 struct ImplicitFieldOptions {
   float voxel_size = 1.f;   // grid spacing, the points' unit (> 0)
   float epsilon = 1e-3f;    // error tolerance of eq. 3.26, in (0, 1)
-  int brick_size = 8;       // nodes per brick side, a power of two in [2, 1024]
+  int brick_size = 16;      // nodes per brick side, a power of two in [2, 1024]
   // Refuse to allocate more than this many bricks (each brick_size^3 * 8 bytes):
   // protects against a voxel size far too small for the cloud.
   size_t max_bricks = 4'000'000;

@@ -100,11 +100,12 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   }
   st.normals = source;
 
-  // Neighbours. 30 columns serve every later stage (density 10, normals up to 30).
+  // Neighbours. 20 columns serve every later stage (density 10, normals, curvature
+  // and noise fits); wider neighbourhoods for noisy clouds are queried as needed.
   auto t0 = Clock::now();
   if (!report(options.progress, "neighbours", 0.0)) return cancelled("reconstruction cancelled");
   const KnnIndex index(pts);
-  const size_t max_k = std::max<size_t>({options.density_k, options.normal_k, 30});
+  const size_t max_k = std::max<size_t>({options.density_k, 20});
   const NeighborGraph graph = knn_graph(index, pts, max_k);
   st.t_neighbours = seconds_since(t0);
 
@@ -118,7 +119,12 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   st.median_density_sigma = median_of(sigma_density);
   st.noise_sigma = noise.sigma;
   const float eta = st.median_density_sigma > 0.f ? noise.sigma / st.median_density_sigma : 0.f;
-  st.normal_k = options.normal_k ? options.normal_k : (eta < 0.05f ? 12 : eta < 0.15f ? 20 : 30);
+  // PCA averages the noise over k points; once the noise nears the spacing the
+  // neighbourhood must grow with its square to keep the normals' tilt small.
+  st.normal_k = options.normal_k ? options.normal_k
+                : eta < 0.05f    ? 12
+                : eta < 0.4f     ? 20
+                                 : static_cast<size_t>(std::min(200.f, 20.f * (eta / 0.4f) * (eta / 0.4f)));
   if (st.normal_k != 20) frames = estimate_normals(pts, index, graph, {.k = st.normal_k});
   if (source == NormalSource::kInput) {
     for (size_t i = 0; i < pts.size(); ++i) {
@@ -151,8 +157,9 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   // table, see docs/benchmarks.md).
   t0 = Clock::now();
   if (!report(options.progress, "kernels", 0.0)) return cancelled("reconstruction cancelled");
-  st.sigma_scale = options.sigma_scale > 0.f ? options.sigma_scale : std::clamp(1.0f + 4.0f * eta, 1.0f, 4.0f);
-  st.normal_scale = options.normal_scale > 0.f ? options.normal_scale : std::clamp(0.5f + 2.0f * eta, 0.5f, 3.0f);
+  st.sigma_scale = options.sigma_scale > 0.f ? options.sigma_scale
+                                              : std::clamp(1.0f + 1.5f * eta + 1.5f * eta * eta, 1.0f, 8.0f);
+  st.normal_scale = options.normal_scale > 0.f ? options.normal_scale : std::clamp(0.6f + 0.9f * eta, 0.6f, 3.0f);
   st.sharpening = options.sharpening;
   CurvatureResult curvature;
   if (options.sharpening != 0.f) curvature = estimate_curvature(pts, graph, frames);
@@ -162,6 +169,19 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   ko.sharpening = options.sharpening;
   ko.density_k = options.density_k;
   ko.curvature_compensation = options.curvature_compensation;
+  // The voxel must resolve the thinnest kernel across the surface, and a sparse
+  // cloud still deserves a fine grid (it costs little): at least 200 voxels along
+  // the bounding box's diagonal.
+  Vec3f lo = pts[0], hi = pts[0];
+  for (const Vec3f& p : pts) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  st.voxel_size = options.voxel_size > 0.f
+                      ? options.voxel_size
+                      : std::min(0.7f * st.median_density_sigma * std::min(1.f, st.normal_scale),
+                                 (hi - lo).norm() / 200.f);
+  ko.band = options.band_voxels > 0.f ? options.band_voxels * st.voxel_size + 3.f * st.noise_sigma : 0.f;
   std::vector<float> mean_curvature;
   if (options.curvature_compensation) {
     mean_curvature = estimate_mean_curvature(pts, index, graph, frames, {.k = 20});
@@ -172,11 +192,7 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
                     mean_curvature, options.use_confidence ? cloud->confidence : no_confidence, ko);
   st.t_kernels = seconds_since(t0);
 
-  // Field. The voxel must resolve the thinnest kernel across the surface.
   t0 = Clock::now();
-  st.voxel_size = options.voxel_size > 0.f
-                      ? options.voxel_size
-                      : 0.5f * st.median_density_sigma * std::min(1.f, st.normal_scale);
   ImplicitFieldOptions fo;
   fo.voxel_size = st.voxel_size;
   fo.epsilon = options.epsilon;

@@ -51,7 +51,10 @@ struct ReconstructOptions {
   float min_relative_weight = 0.2f;
   // Components with fewer triangles than this fraction of the largest are dropped.
   double min_component_fraction = 0.01;
-  int brick_size = 8;
+  int brick_size = 16;
+  // Kernels reach this many voxels plus three noise sigmas along their normals
+  // (Kernel::band); 0 = their full support.
+  float band_voxels = 2.5f;
   ProgressFn progress;
 };
 
