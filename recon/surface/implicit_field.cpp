@@ -27,6 +27,10 @@ constexpr int kMaxCoord = (1 << kCoordBits) - 1;
 //   z3 = z3u + b1 z1^2 + b2 z2^2.
 struct Prepared {
   Eigen::Matrix3f m;   // rows t1/s1, t2/s2, n/sn
+  // The visited region lies inside the ellipsoid (x - c)^T A (x - c) <= 2 r^2,
+  // A = M^T diag(1, 1, (r / slab)^2) M; per grid layer z its y extent bounds the
+  // rows worth looking at (a tilted disk's box is mostly empty).
+  float yy = 0.f, yz = 0.f, zz = 0.f;  // y-extent quadratic at fixed z (Schur complement of A)
   Vec3f center;
   Vec3f half_extent;   // world-axis half size of the visited region
   float weight;
@@ -50,6 +54,12 @@ Prepared prepare(const Kernel& k, float r) {
   }
   p.weight = k.weight;
   p.slab = slab_mm / k.sigma_n;
+  Eigen::Matrix3f scaled = p.m;
+  scaled.row(2) *= r / p.slab;
+  const Eigen::Matrix3f a = scaled.transpose() * scaled;
+  p.yy = a(1, 1) - a(0, 1) * a(0, 1) / a(0, 0);
+  p.yz = a(1, 2) - a(0, 1) * a(0, 2) / a(0, 0);
+  p.zz = a(2, 2) - a(0, 2) * a(0, 2) / a(0, 0);
   p.b1 = 0.5f * k.bend * k.sigma_t1 * k.sigma_t1 / k.sigma_n;
   p.b2 = 0.5f * k.bend * k.sigma_t2 * k.sigma_t2 / k.sigma_n;
   return p;
@@ -87,15 +97,21 @@ __attribute__((always_inline)) inline float exp_nonpositive(float x) {
 // whichever brick it is in. Written as plain scalars
 // with restrict pointers and selects so that GCC vectorises it (the file is built
 // with -fno-trapping-math, which lets it turn the selects into masks).
-__attribute__((target_clones("arch=haswell", "default"))) void splat_row(float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx,
-               float dy, float dz, float b1, float b2, float weight, float r2) {
+// A node takes the kernel's contribution exactly when it lies in the bent support
+// (q < r2) and in the normal slab; the caller may pass any superset of those nodes
+// (whole 8-node chunks, so the vector loop needs no scalar tail) without changing
+// a single value.
+__attribute__((target_clones("arch=haswell", "default"))) void splat_row(
+    float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx, float dy,
+    float dz, float b1, float b2, float weight, float r2, float slab2) {
   for (int t = 0; t < n; ++t) {
     const float tf = static_cast<float>(t0 + t);
     const float z1 = zx + tf * dx, z2 = zy + tf * dy, z3u = zz + tf * dz;
     const float z1s = z1 * z1, z2s = z2 * z2;
     const float z3 = z3u + b1 * z1s + b2 * z2s;
     const float q = z1s + z2s + z3 * z3;
-    const float wt = q < r2 ? weight : 0.f;
+    const bool inside = (q < r2) & (z3u * z3u < slab2);
+    const float wt = inside ? weight : 0.f;
     const float e = wt * exp_nonpositive(-0.5f * q);
     f[t] += -z3 * e;
     w[t] += e;
@@ -325,9 +341,21 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
         const float t_max = static_cast<float>(hi.x() - lo.x());
         const int z0i = std::max(lo.z(), z_first), z1i = std::min(hi.z(), z_first + bs - 1);
         const int y0i = std::max(lo.y(), y_first), y1i = std::min(hi.y(), y_first + bs - 1);
+        const float r2x2 = 2.f * r2;
         for (int z = z0i; z <= z1i; ++z) {
           const Vec3f zz = zb + static_cast<float>(z - lo.z()) * dz;
-          for (int y = y0i; y <= y1i; ++y) {
+          // y extent of the bounding ellipsoid in this layer: yy t^2 + 2 yz dzw t + zz dzw^2 <= 2 r^2.
+          const float dzw = static_cast<float>(field.origin_.z() + h * z) - p.center.z();
+          const float bq_y = p.yz * dzw;
+          const float disc_y = bq_y * bq_y - p.yy * (p.zz * dzw * dzw - r2x2);
+          if (disc_y <= 0.f) continue;
+          const float sq_y = std::sqrt(disc_y);
+          const float cy = (p.center.y() - static_cast<float>(field.origin_.y())) / static_cast<float>(h);
+          const float ylo_f = cy + (-bq_y - sq_y) / p.yy / static_cast<float>(h);
+          const float yhi_f = cy + (-bq_y + sq_y) / p.yy / static_cast<float>(h);
+          const int ya = std::max(y0i, static_cast<int>(std::floor(ylo_f)));
+          const int yb = std::min(y1i, static_cast<int>(std::ceil(yhi_f)));
+          for (int y = ya; y <= yb; ++y) {
             const Vec3f z0 = zz + static_cast<float>(y - lo.y()) * dy;
             // Cylinder: |z0_12 + t dx_12|^2 < r2; slab: |z0_3 + t dx_3| < slab.
             float lo_f = 0.f, hi_f = t_max;
@@ -356,14 +384,22 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
             const int t_hi = static_cast<int>(hi_f);
             if (t_hi < t_lo) continue;
             const int row_offset = (y - y_first) * bs + (z - z_first) * bs * bs;
-            // Split the row where it crosses bricks.
+            // Split the row where it crosses bricks; within a brick widen the
+            // segment to whole 8-node chunks when the brick allows.
             for (int gx = lo.x() + t_lo; gx <= lo.x() + t_hi;) {
               const int bx = gx >> bs_shift;
-              const int seg_end = std::min(lo.x() + t_hi, ((bx + 1) << bs_shift) - 1);
+              const int brick_x = bx << bs_shift;
+              const int seg_end = std::min(lo.x() + t_hi, brick_x + bs - 1);
+              int first = gx - brick_x, last = seg_end - brick_x;
+              if (bs % 8 == 0) {
+                first &= ~7;
+                last |= 7;
+              }
               const size_t b = static_cast<size_t>(brick_of[bx - xmin]);
-              const size_t idx = b * per + static_cast<size_t>(row_offset + (gx - (bx << bs_shift)));
-              splat_row(field.values_.data() + idx, field.weights_.data() + idx, gx - lo.x(), seg_end - gx + 1,
-                        z0.x(), z0.y(), z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.weight, r2);
+              const size_t idx = b * per + static_cast<size_t>(row_offset + first);
+              splat_row(field.values_.data() + idx, field.weights_.data() + idx, brick_x + first - lo.x(),
+                        last - first + 1, z0.x(), z0.y(), z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.weight, r2,
+                        p.slab * p.slab);
               gx = seg_end + 1;
             }
           }
