@@ -74,8 +74,8 @@ Cell tune(const PointCloud& cloud, ReconstructOptions& best_opt) {
   const std::vector<float> sigmas = {0.5f, 0.65f, 0.8f, 1.f, 1.25f, 1.5f, 2.f, 2.5f, 3.f, 4.f, 5.f, 6.f};
   const std::vector<float> normals = {0.2f, 0.3f, 0.4f, 0.5f, 0.75f, 1.f, 1.5f, 2.f, 3.f};
   const std::vector<float> sharpen = {0.f, 0.25f, 0.5f, 1.f, 2.f};
-  const std::vector<float> voxels = {0.1f, 0.15f, 0.2f, 0.3f};  // x spacing
-  const std::vector<float> ks = {8.f, 12.f, 20.f, 30.f};
+  const std::vector<float> voxels = {0.2f, 0.3f, 0.45f, 0.7f};  // x density sigma
+  const std::vector<float> ks = {8.f, 12.f, 20.f, 40.f, 80.f};
   for (int round = 0; round < 2; ++round) {
     auto try_values = [&](const std::vector<float>& values, auto set) {
       for (float v : values) {

@@ -49,9 +49,13 @@ NoiseEstimate estimate_noise(const std::vector<Vec3f>& points, const KnnIndex& i
       }
     });
     const float sigma = median(residual);
-    const bool settled = k > options.k && sigma < 1.1f * est.sigma;
+    const bool settled = k > options.k && sigma <= 1.1f * est.sigma;
     est.sigma = std::max(est.sigma, sigma);
-    if (settled || 2 * k > widest) break;
+    // Noise well below the spacing is fully seen by the first fit; only noise that
+    // rivals the spacing hides in a narrow one. Widening a fit on clean data only
+    // bends it over edges and corners.
+    const bool small = est.sigma < 0.3f * est.median_spacing;
+    if (settled || small || 2 * k > widest) break;
   }
   return est;
 }

@@ -166,16 +166,18 @@ float ImplicitField::weight_at(const Eigen::Vector3i& node) const {
 void ImplicitField::evaluate(const std::vector<Kernel>& kernels, float epsilon, const Vec3d& x,
                              double* value, double* weight) {
   const double r2 = -2.0 * std::log(static_cast<double>(epsilon));
+  const float r = static_cast<float>(std::sqrt(r2));
   double f = 0.0, w = 0.0;
   for (const Kernel& k : kernels) {
+    const double slab = prepare(k, r).slab;  // the same normal band as the grid
     const Vec3d d = x - k.center.cast<double>();
     const double z1 = d.dot(k.t1.cast<double>()) / k.sigma_t1;
     const double z2 = d.dot(k.t2.cast<double>()) / k.sigma_t2;
-    const double z3 = (d.dot(k.n.cast<double>()) +
-                       0.5 * k.bend * (z1 * z1 * k.sigma_t1 * k.sigma_t1 + z2 * z2 * k.sigma_t2 * k.sigma_t2)) /
-                      k.sigma_n;
+    const double z3u = d.dot(k.n.cast<double>()) / k.sigma_n;
+    const double z3 =
+        z3u + 0.5 * k.bend * (z1 * z1 * k.sigma_t1 * k.sigma_t1 + z2 * z2 * k.sigma_t2 * k.sigma_t2) / k.sigma_n;
     const double q = z1 * z1 + z2 * z2 + z3 * z3;
-    if (q >= r2) continue;
+    if (q >= r2 || std::abs(z3u) >= slab) continue;
     const double e = k.weight * std::exp(-0.5 * q);
     f += -z3 * e;
     w += e;
@@ -314,6 +316,7 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
   std::atomic<size_t> done{0};
   std::atomic<bool> stop{false};
   std::mutex progress_mutex;  // the callback is not required to be thread-safe
+  double last_fraction = 0.1;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, np, 4), [&](const tbb::blocked_range<size_t>& range) {
     if (stop.load(std::memory_order_relaxed)) return;
     std::vector<long> brick_of;  // x brick coordinate - xmin -> brick index, -1 if none
@@ -409,7 +412,9 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
     const size_t d = done.fetch_add(range.size()) + range.size();
     if (options.progress) {
       std::lock_guard<std::mutex> lock(progress_mutex);
-      if (!options.progress("field", 0.1 + 0.9 * static_cast<double>(d) / static_cast<double>(np))) stop = true;
+      // Under the lock, so that reports never go backwards.
+      last_fraction = std::max(last_fraction, std::min(1.0, 0.1 + 0.9 * static_cast<double>(d) / static_cast<double>(np)));
+      if (!options.progress("field", last_fraction)) stop = true;
     }
   });
   if (stop) return cancelled("reconstruction cancelled");

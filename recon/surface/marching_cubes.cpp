@@ -24,6 +24,17 @@ int edge_between(int c0, int c1) {
   return 4 * a + corner_bit(base, (a + 1) % 3) + 2 * corner_bit(base, (a + 2) % 3);
 }
 
+// The two cube faces an edge lies on, as bits of a 6-bit set (face 2a + side).
+int edge_faces(int e) {
+  const int a = e / 4, b = (a + 1) % 3, c = (a + 2) % 3;
+  return (1 << (2 * b + (e & 1))) | (1 << (2 * c + ((e >> 1) & 1)));
+}
+
+// True when three cube edges all lie on one face of the cube.
+bool edges_share_face(int e0, int e1, int e2) {
+  return (edge_faces(e0) & edge_faces(e1) & edge_faces(e2)) != 0;
+}
+
 using CaseTable = std::array<std::vector<std::array<uint8_t, 3>>, 256>;
 
 CaseTable build_table() {
@@ -62,9 +73,24 @@ CaseTable build_table() {
         e = f;
       }
       assert(e == loop.front());
-      for (size_t i = 1; i + 1 < loop.size(); ++i) {
-        table[mask].push_back({static_cast<uint8_t>(loop[0]), static_cast<uint8_t>(loop[i]),
-                               static_cast<uint8_t>(loop[i + 1])});
+      // Fan from the first corner that makes no triangle lie in a cube face: such
+      // a triangle would be matched by the neighbouring cell's identical one with
+      // the opposite winding, and their edges would be used four times.
+      const size_t m = loop.size();
+      size_t apex = 0;
+      for (size_t start = 0; start < m; ++start) {
+        bool flat = false;
+        for (size_t i = 1; i + 1 < m && !flat; ++i) {
+          flat = edges_share_face(loop[start], loop[(start + i) % m], loop[(start + i + 1) % m]);
+        }
+        if (!flat) {
+          apex = start;
+          break;
+        }
+      }
+      for (size_t i = 1; i + 1 < m; ++i) {
+        table[mask].push_back({static_cast<uint8_t>(loop[apex]), static_cast<uint8_t>(loop[(apex + i) % m]),
+                               static_cast<uint8_t>(loop[(apex + i + 1) % m])});
       }
     }
   }
@@ -131,6 +157,7 @@ StatusOr<TriangleMesh> extract_isosurface(const ImplicitField& field,
   std::vector<std::vector<Vec3f>> verts(nb);
   std::vector<std::vector<uint32_t>> edge_ids(nb);
   std::mutex progress_mutex;
+  double last_fraction = 0.0;
   std::atomic<size_t> done{0};
   std::atomic<bool> stop{false};
   // Both passes count into `done`, so the fraction runs 0..1 over the two.
@@ -138,9 +165,9 @@ StatusOr<TriangleMesh> extract_isosurface(const ImplicitField& field,
     const size_t d = done.fetch_add(count) + count;
     if (!options.progress) return;
     std::lock_guard<std::mutex> lock(progress_mutex);
-    if (!options.progress("mesh", static_cast<double>(d) / (2.0 * static_cast<double>(nb)))) {
-      stop = true;
-    }
+    // Under the lock, so that reports never go backwards.
+    last_fraction = std::max(last_fraction, std::min(1.0, static_cast<double>(d) / (2.0 * static_cast<double>(nb))));
+    if (!options.progress("mesh", last_fraction)) stop = true;
   };
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nb, 8), [&](const tbb::blocked_range<size_t>& r) {
     if (stop) return;

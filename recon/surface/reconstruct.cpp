@@ -169,18 +169,10 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   ko.sharpening = options.sharpening;
   ko.density_k = options.density_k;
   ko.curvature_compensation = options.curvature_compensation;
-  // The voxel must resolve the thinnest kernel across the surface, and a sparse
-  // cloud still deserves a fine grid (it costs little): at least 200 voxels along
-  // the bounding box's diagonal.
-  Vec3f lo = pts[0], hi = pts[0];
-  for (const Vec3f& p : pts) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
+  // The voxel must resolve the thinnest kernel across the surface.
   st.voxel_size = options.voxel_size > 0.f
                       ? options.voxel_size
-                      : std::min(0.7f * st.median_density_sigma * std::min(1.f, st.normal_scale),
-                                 (hi - lo).norm() / 200.f);
+                      : 0.7f * st.median_density_sigma * std::min(1.f, st.normal_scale);
   ko.band = options.band_voxels > 0.f ? options.band_voxels * st.voxel_size + 3.f * st.noise_sigma : 0.f;
   std::vector<float> mean_curvature;
   if (options.curvature_compensation) {

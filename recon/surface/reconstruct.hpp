@@ -48,7 +48,7 @@ struct ReconstructOptions {
   // Marching cubes needs this much Gaussian weight at a node, as a fraction of the
   // median weight on the surface (median_surface_weight): cuts the spurious zero
   // crossings in kernels' tails that noise creates.
-  float min_relative_weight = 0.2f;
+  float min_relative_weight = 0.1f;
   // Components with fewer triangles than this fraction of the largest are dropped.
   double min_component_fraction = 0.01;
   int brick_size = 16;

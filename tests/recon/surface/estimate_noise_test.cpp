@@ -83,6 +83,26 @@ TEST(EstimateNoise, NoiseFreeIsNearZero) {
   }
 }
 
+TEST(EstimateNoise, NoiseFreeCubeIsNearZero) {
+  // A noise-free cube [-1, 1]^3, 6000 area-uniform points (median nearest-neighbour
+  // spacing 0.03): most
+  // points lie on flat faces, and the median of the fits is meant to be "robust to
+  // edges" (estimate_noise.hpp).
+  TriangleMesh cube;
+  for (int i = 0; i < 8; ++i) cube.vertices.emplace_back(2 * (i & 1) - 1, 2 * ((i >> 1) & 1) - 1, 2 * ((i >> 2) & 1) - 1);
+  cube.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                    {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  const PointCloud c = sample_mesh_uniform(cube, 6000, 13, false);
+  const KnnIndex index(c.positions);
+  const NeighborGraph g = knn_graph(index, c.positions, 30);
+  const LocalFrames f = estimate_normals(c.positions, index, g, {.k = 20});
+  // The first fit (k = 20) alone sees the faces as flat.
+  const NoiseEstimate narrow = estimate_noise(c.positions, index, g, f, {.max_k = 20});
+  EXPECT_LT(narrow.sigma, 0.05f * narrow.median_spacing);
+  const NoiseEstimate est = estimate_noise(c.positions, index, g, f);
+  EXPECT_LT(est.sigma, 0.05f * est.median_spacing);
+}
+
 TEST(EstimateNoise, MedianSpacingIsTheNearestNeighbourMedian) {
   const PointCloud c = plane_cloud();
   const NoiseEstimate est = estimate(c.positions);

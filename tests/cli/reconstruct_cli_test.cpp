@@ -1,0 +1,190 @@
+// `bodyscan reconstruct` as a user runs it: the built executable, its exit codes,
+// what it prints, and the mesh it writes.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "recon/geometry/sample_surface.hpp"
+#include "recon/io/ply.hpp"
+#include "tests/test_data.hpp"
+
+// tests/CMakeLists.txt passes the executable's path ($<TARGET_FILE:bodyscan>); the
+// fallback is where the tests' build directory puts it.
+#ifndef BODYSCAN_BIN
+#define BODYSCAN_BIN BODYSCAN_SOURCE_DIR "/build-tests/server/bodyscan"
+#endif
+
+namespace bodyscan {
+namespace {
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Single-quoted for /bin/sh (temp paths contain no quotes, but be safe).
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Runs `bodyscan <args>` with stdout and stderr captured in files under `dir`.
+CliResult bodyscan(const std::string& args, const std::string& dir) {
+  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
+  const std::string cmd = quote(BODYSCAN_BIN) + " " + args + " >" + quote(out) + " 2>" + quote(err) + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  CliResult r;
+  if (status != -1 && WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+class ReconstructCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(std::filesystem::exists(BODYSCAN_BIN)) << "build the bodyscan target first: " << BODYSCAN_BIN;
+    dir_ = testing::temp_dir();
+  }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  std::string dir_;
+};
+
+TEST_F(ReconstructCli, ReconstructsASphere) {
+  // 1000 points on a sphere of radius 50 mm, no normals, ASCII (as a user might hand in).
+  PointCloud cloud = fibonacci_sphere(1000, 50.0);
+  cloud.normals.clear();
+  ASSERT_TRUE(write_ply(path("sphere.ply"), cloud, PlyFormat::kAscii).ok());
+  const CliResult r = bodyscan("reconstruct " + quote(path("sphere.ply")) + " -o " + quote(path("mesh.ply")), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("triangles"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("points      1000"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("normals     mst"), std::string::npos) << r.out;
+  auto mesh = read_ply_mesh(path("mesh.ply"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  const MeshTopology t = analyze_topology(*mesh);
+  EXPECT_TRUE(t.closed());
+  EXPECT_EQ(t.components, 1u);
+  EXPECT_EQ(t.euler_characteristic, 2);
+  // The sphere's volume within 2%, wound outward.
+  const double ball = 4.0 / 3.0 * std::numbers::pi * 50.0 * 50.0 * 50.0;
+  EXPECT_NEAR(signed_volume(*mesh), ball, 0.02 * ball);
+  // The printed triangle count is the file's.
+  EXPECT_NE(r.out.find("triangles   " + std::to_string(mesh->num_triangles())), std::string::npos) << r.out;
+  // Written with vertex normals, binary by default.
+  EXPECT_EQ(mesh->normals.size(), mesh->vertices.size());
+  EXPECT_NE(slurp(path("mesh.ply")).find("binary_little_endian"), std::string::npos);
+}
+
+TEST_F(ReconstructCli, QuietAsciiAndOptions) {
+  PointCloud cloud = fibonacci_sphere(500, 1.0);
+  ASSERT_TRUE(write_ply(path("s.ply"), cloud).ok());
+  const CliResult r = bodyscan("reconstruct " + quote(path("s.ply")) + " --output " + quote(path("m.ply")) +
+                             " --ascii -q --sigma 1.2 --normal-sigma 0.6 --normals mst --normal-k 15 --voxel 0.06",
+                         dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_EQ(slurp(path("m.ply")).rfind("ply\nformat ascii 1.0", 0), 0u);
+  auto mesh = read_ply_mesh(path("m.ply"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_TRUE(analyze_topology(*mesh).closed());
+}
+
+TEST_F(ReconstructCli, MissingInputNamesTheFile) {
+  const std::string missing = path("no-such-cloud.ply");
+  const CliResult r = bodyscan("reconstruct " + quote(missing) + " -o " + quote(path("out.ply")), dir_);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.exit_code, -1) << "did not exit normally";
+  EXPECT_NE(r.err.find("no-such-cloud.ply"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
+}
+
+TEST_F(ReconstructCli, GarbageInputIsAnError) {
+  {
+    std::ofstream f(path("garbage.ply"), std::ios::binary);
+    f << "this is not a PLY file\n\x01\x02\x03";
+  }
+  const CliResult r = bodyscan("reconstruct " + quote(path("garbage.ply")) + " -o " + quote(path("out.ply")), dir_);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.exit_code, -1) << "did not exit normally (crash?)";
+  EXPECT_FALSE(r.err.empty());
+  EXPECT_NE(r.err.find("garbage.ply"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
+}
+
+TEST_F(ReconstructCli, TooFewPointsIsAnError) {
+  PointCloud cloud = fibonacci_sphere(5, 1.0);
+  ASSERT_TRUE(write_ply(path("five.ply"), cloud).ok());
+  const CliResult r = bodyscan("reconstruct " + quote(path("five.ply")) + " -o " + quote(path("out.ply")), dir_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("8 points"), std::string::npos) << r.err;
+}
+
+TEST_F(ReconstructCli, BadOptionValuesExitTwo) {
+  PointCloud cloud = fibonacci_sphere(100, 1.0);
+  ASSERT_TRUE(write_ply(path("s.ply"), cloud).ok());
+  const std::string io = quote(path("s.ply")) + " -o " + quote(path("m.ply"));
+  for (const std::string bad : {"--sigma abc", "--sigma -1", "--sigma 0", "--voxel nan", "--epsilon 1",
+                                "--epsilon 2", "--normals sideways", "--sharpen -0.5", "--sigma 1x"}) {
+    const CliResult r = bodyscan("reconstruct " + io + " " + bad, dir_);
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+    EXPECT_FALSE(r.err.empty()) << bad;
+  }
+  const CliResult r = bodyscan("reconstruct " + io + " --sigma abc", dir_);
+  EXPECT_NE(r.err.find("--sigma"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("abc"), std::string::npos) << r.err;
+  // A value missing at the end of the line.
+  EXPECT_EQ(bodyscan("reconstruct " + io + " --sigma", dir_).exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(path("m.ply")));
+}
+
+TEST_F(ReconstructCli, UsageErrorsExitTwo) {
+  PointCloud cloud = fibonacci_sphere(100, 1.0);
+  ASSERT_TRUE(write_ply(path("s.ply"), cloud).ok());
+  const std::string in = quote(path("s.ply"));
+  {
+    const CliResult r = bodyscan("reconstruct " + in + " -o " + quote(path("m.ply")) + " --frobnicate", dir_);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--frobnicate"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(bodyscan("reconstruct " + in, dir_).exit_code, 2);                            // no output
+  EXPECT_EQ(bodyscan("reconstruct -o " + quote(path("m.ply")), dir_).exit_code, 2);     // no input
+  EXPECT_EQ(bodyscan("reconstruct " + in + " -o " + quote(path("m.obj")), dir_).exit_code, 2);
+  EXPECT_EQ(bodyscan("reconstruct " + in + " " + in + " -o " + quote(path("m.ply")), dir_).exit_code, 2);
+  EXPECT_EQ(bodyscan("frobnicate", dir_).exit_code, 2);  // unknown command
+  EXPECT_EQ(bodyscan("", dir_).exit_code, 2);            // no command
+  EXPECT_FALSE(std::filesystem::exists(path("m.ply")));
+}
+
+TEST_F(ReconstructCli, HelpExitsZero) {
+  {
+    const CliResult r = bodyscan("reconstruct --help", dir_);
+    EXPECT_EQ(r.exit_code, 0);
+    EXPECT_NE(r.out.find("usage: bodyscan reconstruct"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--sigma"), std::string::npos);
+  }
+  {
+    const CliResult r = bodyscan("--help", dir_);
+    EXPECT_EQ(r.exit_code, 0);
+    EXPECT_NE(r.out.find("reconstruct"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(bodyscan("reconstruct -h", dir_).exit_code, 0);
+}
+
+}  // namespace
+}  // namespace bodyscan
