@@ -31,7 +31,6 @@ struct AdaptKernelsOptions {
   float sigma_user = 1.f;        // tangential size in units of sigma_density
   float normal_scale = 0.5f;     // sigma_n in units of sigma_density
   float sharpening = 0.f;        // s; 0 = no curvature adaptation
-  size_t density_k = 10;         // n of eq. 3.17
   float min_sigma_fraction = 0.25f;
   // Bend kernels by the local mean curvature (implicit_field.hpp), clamped so that
   // |bend| sigma_t <= max_bend.

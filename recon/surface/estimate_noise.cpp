@@ -1,5 +1,6 @@
 #include "recon/surface/estimate_noise.hpp"
 
+#include "recon/core/median.hpp"
 #include "recon/surface/estimate_curvature.hpp"
 
 #include <tbb/blocked_range.h>
@@ -21,13 +22,9 @@ NoiseEstimate estimate_noise(const std::vector<Vec3f>& points, const KnnIndex& i
   auto sample_index = [&](size_t s) {
     return std::min(n - 1, static_cast<size_t>(static_cast<double>(s) * stride));
   };
-  auto median = [](std::vector<float>& v) {
-    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
   std::vector<float> spacing(samples);
   for (size_t s = 0; s < samples; ++s) spacing[s] = graph.row_distances(sample_index(s))[0];
-  est.median_spacing = median(spacing);
+  est.median_spacing = median_in_place(spacing);
   est.samples = samples;
 
   // A quadric needs well over six points, and a fit wider than a fraction of the
@@ -48,7 +45,7 @@ NoiseEstimate estimate_noise(const std::vector<Vec3f>& points, const KnnIndex& i
         residual[s] = q.ok ? static_cast<float>(q.residual_rms) : 0.f;
       }
     });
-    const float sigma = median(residual);
+    const float sigma = median_in_place(residual);
     const bool settled = k > options.k && sigma <= 1.1f * est.sigma;
     est.sigma = std::max(est.sigma, sigma);
     // Noise well below the spacing is fully seen by the first fit; only noise that

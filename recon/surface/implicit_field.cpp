@@ -11,6 +11,8 @@
 #include <mutex>
 #include <numeric>
 
+#include "recon/core/median.hpp"
+
 namespace bodyscan {
 
 namespace {
@@ -433,9 +435,7 @@ float median_surface_weight(const ImplicitField& field, const std::vector<Vec3f>
     const float wi = field.weight_at(node);
     if (wi > 0.f) w.push_back(wi);
   }
-  if (w.empty()) return 0.f;
-  std::nth_element(w.begin(), w.begin() + static_cast<long>(w.size() / 2), w.end());
-  return w[w.size() / 2];
+  return median_in_place(w);
 }
 
 }  // namespace bodyscan

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "recon/core/median.hpp"
 #include "recon/geometry/mesh_components.hpp"
 #include "recon/spatial/knn_index.hpp"
 #include "recon/surface/adapt_kernels.hpp"
@@ -42,12 +43,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-float median_of(std::vector<float> v) {
-  if (v.empty()) return 0.f;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace
@@ -116,7 +111,8 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   LocalFrames frames = estimate_normals(pts, index, graph, {.k = 20});
   const NoiseEstimate noise = estimate_noise(pts, index, graph, frames);
   const std::vector<float> sigma_density = density_sigma(graph, options.density_k);
-  st.median_density_sigma = median_of(sigma_density);
+  std::vector<float> sigma_sample = sigma_density;
+  st.median_density_sigma = median_in_place(sigma_sample);
   st.noise_sigma = noise.sigma;
   const float eta = st.median_density_sigma > 0.f ? noise.sigma / st.median_density_sigma : 0.f;
   // PCA averages the noise over k points; once the noise nears the spacing the
@@ -167,7 +163,6 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   ko.sigma_user = st.sigma_scale;
   ko.normal_scale = st.normal_scale;
   ko.sharpening = options.sharpening;
-  ko.density_k = options.density_k;
   ko.curvature_compensation = options.curvature_compensation;
   // The voxel must resolve the thinnest kernel across the surface.
   st.voxel_size = options.voxel_size > 0.f

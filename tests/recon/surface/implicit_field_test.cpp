@@ -2,6 +2,7 @@
 // direct evaluation, curvature compensation, option checks and memory that follows
 // the surface.
 #include "recon/surface/implicit_field.hpp"
+#include "tests/recon/surface/sphere_kernels.hpp"
 
 #include <gtest/gtest.h>
 
@@ -33,24 +34,7 @@ ImplicitFieldOptions field_options(float voxel, int brick_size = 8, float epsilo
 // Squared normalised radius of the ellipsoid cut: eq. 3.26 with epsilon.
 double cut_r2(float epsilon) { return -2.0 * std::log(static_cast<double>(epsilon)); }
 
-// Kernels on a sphere of `radius` about `centre` with exact outward normals and
-// tangents from the Fibonacci points.
-std::vector<Kernel> sphere_kernels(size_t n, double radius, const Vec3f& centre, float sigma_t,
-                                   float sigma_n, float bend) {
-  const PointCloud c = fibonacci_sphere(n, radius);
-  std::vector<Kernel> ks(n);
-  for (size_t i = 0; i < n; ++i) {
-    Kernel& k = ks[i];
-    k.center = c.positions[i] + centre;
-    k.n = c.normals[i];
-    k.t1 = k.n.unitOrthogonal();
-    k.t2 = k.n.cross(k.t1);
-    k.sigma_t1 = k.sigma_t2 = sigma_t;
-    k.sigma_n = sigma_n;
-    k.bend = bend;
-  }
-  return ks;
-}
+using bodyscan::testing::sphere_kernels;
 
 // The smallest q = |z|^2 over the kernels at x (the bent coordinate as the header
 // defines it), to tell nodes well inside or outside every support from nodes on a

@@ -16,6 +16,7 @@
 
 #include "recon/geometry/mesh_components.hpp"
 #include "recon/geometry/sample_surface.hpp"
+#include "tests/recon/surface/sphere_kernels.hpp"
 
 namespace bodyscan {
 namespace {
@@ -308,20 +309,9 @@ TEST(MarchingCubesTable, HalfCubeIsOneQuad) {
 // Kernels on a sphere of `radius` about `centre`, exact normals, bent by the sphere's
 // curvature so the zero set sits on the sphere.
 std::vector<Kernel> sphere_kernels(size_t n, double radius, const Vec3f& centre) {
-  const PointCloud c = fibonacci_sphere(n, radius);
   const float spacing = static_cast<float>(std::sqrt(4 * std::numbers::pi / static_cast<double>(n)) * radius);
-  std::vector<Kernel> ks(n);
-  for (size_t i = 0; i < n; ++i) {
-    Kernel& k = ks[i];
-    k.center = c.positions[i] + centre;
-    k.n = c.normals[i];
-    k.t1 = k.n.unitOrthogonal();
-    k.t2 = k.n.cross(k.t1);
-    k.sigma_t1 = k.sigma_t2 = 1.4f * spacing;
-    k.sigma_n = 0.5f * spacing;
-    k.bend = static_cast<float>(1 / radius);
-  }
-  return ks;
+  return bodyscan::testing::sphere_kernels(n, radius, centre, 1.4f * spacing, 0.5f * spacing,
+                                           static_cast<float>(1 / radius));
 }
 
 ImplicitField build(const std::vector<Kernel>& ks, float voxel, int brick_size = 8) {
