@@ -33,6 +33,9 @@ void usage(FILE* out) {
       "  --normal-k K           neighbours per PCA normal (default: from the noise)\n"
       "  --keep-fragments       keep small disconnected pieces (default: drop those under\n"
       "                         1% of the largest)\n"
+      "  --keep-holes           leave the field's zero set open where it is (default: trim\n"
+      "                         flaps past the data and fill every hole; filled vertices\n"
+      "                         get confidence 0 in the output)\n"
       "  --ascii                write ASCII PLY (default binary)\n"
       "  -q, --quiet            print only errors\n",
       out);
@@ -104,6 +107,8 @@ int run_reconstruct(int argc, char** argv) {
       }
     } else if (a == "--keep-fragments") {
       opt.min_component_fraction = 0.0;
+    } else if (a == "--keep-holes") {
+      opt.close_holes = false;
     } else if (a == "--ascii") {
       ascii = true;
     } else if (a == "-q" || a == "--quiet") {
@@ -182,6 +187,10 @@ int run_reconstruct(int argc, char** argv) {
     std::printf("parameters  sigma %.3g  normal-sigma %.3g  sharpen %.3g  voxel %.4g  normal-k %zu\n",
                 s.sigma_scale, s.normal_scale, s.sharpening, s.voxel_size, s.normal_k);
     std::printf("field       %zu bricks, %.1f MB\n", s.bricks, static_cast<double>(s.field_bytes) / 1e6);
+    const MeshTopology topology = analyze_topology(rec->mesh);
+    std::printf("surface     %s, %zu component%s; %zu hole%s filled (%.4g square units), %zu flap triangles trimmed\n",
+                topology.closed() ? "closed" : "open", topology.components, topology.components == 1 ? "" : "s",
+                s.holes_filled, s.holes_filled == 1 ? "" : "s", s.hole_area, s.flap_triangles_trimmed);
     std::printf("time        %.2f s total (neighbours %.2f, normals %.2f, orientation %.2f, "
                 "kernels %.2f, field %.2f, mesh %.2f)\n",
                 total, s.t_neighbours, s.t_normals, s.t_orientation, s.t_kernels, s.t_field, s.t_mesh);

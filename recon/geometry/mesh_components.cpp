@@ -57,10 +57,12 @@ void remove_unreferenced_vertices(TriangleMesh& mesh) {
     remap[v] = next;
     mesh.vertices[next] = mesh.vertices[v];
     if (!mesh.normals.empty()) mesh.normals[next] = mesh.normals[v];
+    if (!mesh.confidence.empty()) mesh.confidence[next] = mesh.confidence[v];
     ++next;
   }
   mesh.vertices.resize(next);
   if (!mesh.normals.empty()) mesh.normals.resize(next);
+  if (!mesh.confidence.empty()) mesh.confidence.resize(next);
   for (Triangle& t : mesh.triangles)
     for (uint32_t& v : t) v = remap[v];
 }

@@ -9,6 +9,7 @@ namespace bodyscan {
 
 bool TriangleMesh::is_consistent() const {
   if (!normals.empty() && normals.size() != vertices.size()) return false;
+  if (!confidence.empty() && confidence.size() != vertices.size()) return false;
   const size_t n = vertices.size();
   for (const Triangle& t : triangles) {
     if (t[0] >= n || t[1] >= n || t[2] >= n) return false;

@@ -18,12 +18,17 @@ struct TriangleMesh {
   std::vector<Triangle> triangles;
   // Optional unit vertex normals (outward). Empty if not known.
   std::vector<Vec3f> normals;
+  // Optional per-vertex confidence in [0, 1]: 1 where the surface rests on
+  // measured points, 0 where it was invented to close a hole (fill_holes.hpp).
+  // Empty if not known. Measurements flag loops that cross low-confidence parts.
+  std::vector<float> confidence;
 
   size_t num_vertices() const { return vertices.size(); }
   size_t num_triangles() const { return triangles.size(); }
   bool empty() const { return triangles.empty(); }
 
-  // True when every index is in range and normals are absent or one per vertex.
+  // True when every index is in range and normals and confidence are absent or
+  // one per vertex.
   bool is_consistent() const;
 };
 

@@ -1196,6 +1196,7 @@ StatusOr<TriangleMesh> read_ply_mesh(const std::string& path) {
   TriangleMesh mesh;
   mesh.vertices = std::move(data.cloud.positions);
   mesh.normals = std::move(data.cloud.normals);
+  mesh.confidence = std::move(data.cloud.confidence);
   mesh.triangles = std::move(data.triangles);
   return mesh;
 }
@@ -1281,6 +1282,7 @@ std::string encode_ply(const TriangleMesh& mesh, PlyFormat format) {
   assert(mesh.vertices.size() <= static_cast<size_t>(std::numeric_limits<int32_t>::max()));
   const size_t n = mesh.vertices.size();
   const bool normals = per_point(mesh.normals, n);
+  const bool confidence = per_point(mesh.confidence, n);
 
   std::string s = "ply\n";
   s += format_line(format);
@@ -1288,19 +1290,21 @@ std::string encode_ply(const TriangleMesh& mesh, PlyFormat format) {
   s += "element vertex " + std::to_string(n) + "\n";
   s += "property float x\nproperty float y\nproperty float z\n";
   if (normals) s += "property float nx\nproperty float ny\nproperty float nz\n";
+  if (confidence) s += "property float confidence\n";
   s += "element face " + std::to_string(mesh.triangles.size()) + "\n";
   s += "property list uchar int vertex_indices\n";
   s += "end_header\n";
 
   if (format == PlyFormat::kBinaryLittleEndian) {
     const size_t header_size = s.size();
-    s.resize(header_size + n * (normals ? 24 : 12) + mesh.triangles.size() * 13);
+    s.resize(header_size + n * ((normals ? 24 : 12) + (confidence ? 4 : 0)) + mesh.triangles.size() * 13);
     char* p = s.data() + header_size;
     for (size_t i = 0; i < n; ++i) {
       for (int k = 0; k < 3; ++k) put(p, mesh.vertices[i][k]);
       if (normals) {
         for (int k = 0; k < 3; ++k) put(p, mesh.normals[i][k]);
       }
+      if (confidence) put(p, mesh.confidence[i]);
     }
     for (const Triangle& t : mesh.triangles) {
       put(p, uint8_t{3});
@@ -1317,6 +1321,7 @@ std::string encode_ply(const TriangleMesh& mesh, PlyFormat format) {
       s.push_back(' ');
       append_vec3(s, mesh.normals[i]);
     }
+    if (confidence) append_field(s, mesh.confidence[i]);
     s.push_back('\n');
   }
   for (const Triangle& t : mesh.triangles) {
@@ -1340,7 +1345,7 @@ Status write_ply(const std::string& path, const TriangleMesh& mesh, PlyFormat fo
   if (!mesh.is_consistent()) {
     return invalid_argument(path +
                             ": not written: a triangle index is out of range, or the "
-                            "normals are not one per vertex");
+                            "normals or confidences are not one per vertex");
   }
   if (mesh.vertices.size() > static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
     return out_of_range(path + ": not written: more vertices than a PLY int index can address");

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "recon/core/median.hpp"
+#include "recon/geometry/fill_holes.hpp"
 #include "recon/geometry/mesh_components.hpp"
 #include "recon/spatial/knn_index.hpp"
 #include "recon/surface/adapt_kernels.hpp"
@@ -196,6 +197,25 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   mo.min_weight = st.min_weight;
   mo.progress = options.progress;
   ASSIGN_OR_RETURN(result.mesh, extract_isosurface(field, mo));
+  if (options.close_holes) {
+    // The field reaches past its data at creases and thin gaps (its kernels' planes
+    // run on beyond them) and stops where the weight runs out, leaving open flaps
+    // a few kernel widths long; peel those back to the data, then close every loop.
+    const float reach = options.hole_trim_distance > 0.f ? options.hole_trim_distance
+                                                         : st.median_density_sigma + 3.f * st.noise_sigma;
+    const float reach2 = reach * reach;
+    st.flap_triangles_trimmed = trim_boundary_flaps(result.mesh, [&](uint32_t v) {
+      uint32_t nearest = 0;
+      float d2 = 0.f;
+      return index.knn(result.mesh.vertices[v], 1, &nearest, &d2) == 0 || d2 > reach2;
+    });
+    HoleFillOptions fill;
+    fill.max_hole_area = options.max_hole_area_fraction * surface_area(result.mesh);
+    const HoleFillStats holes = fill_holes(result.mesh, fill);
+    st.holes_filled = holes.holes_filled;
+    st.hole_area = holes.area_added;
+  }
+  // After the trimming, which may cut islands off a flap.
   if (options.min_component_fraction > 0.0) {
     st.components_removed = remove_small_components(result.mesh, options.min_component_fraction);
   }

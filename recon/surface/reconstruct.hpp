@@ -3,7 +3,7 @@
 //   k nearest neighbours -> PCA frames (eq. 3.12-3.13) -> orientation (cameras or
 //   minimum spanning tree) -> kernel sizes from density and curvature (eq. 3.17-3.25)
 //   -> implicit field on a sparse grid (eq. 3.14-3.15, 3.27) -> marching cubes
-//   -> stray components removed.
+//   -> stray components removed -> flaps trimmed and holes filled (fill_holes.hpp).
 //
 // Every parameter left at 0 is chosen from the data: the thesis's density scaling
 // makes the kernels follow the cloud's scale and spacing, and the noise estimate
@@ -51,6 +51,16 @@ struct ReconstructOptions {
   float min_relative_weight = 0.1f;
   // Components with fewer triangles than this fraction of the largest are dropped.
   double min_component_fraction = 0.01;
+  // Close the surface (fill_holes.hpp): first trim boundary flaps farther than
+  // hole_trim_distance from every point (0 = the median density sigma plus three
+  // noise sigmas), then fill every hole up to max_hole_area_fraction. Off = the
+  // field's zero set as is.
+  bool close_holes = true;
+  float hole_trim_distance = 0.f;
+  // Openings whose fill would exceed this fraction of the surface's area are taken
+  // as the surface's real edge and stay open (a scanned patch, a tube's ends); a
+  // body's unseen soles or crown are 1-3 % of its skin.
+  double max_hole_area_fraction = 0.05;
   int brick_size = 16;
   // Kernels reach this many voxels plus three noise sigmas along their normals
   // (Kernel::band); 0 = their full support.
@@ -71,6 +81,9 @@ struct ReconstructStats {
   size_t bricks = 0;
   size_t field_bytes = 0;
   size_t components_removed = 0;
+  size_t flap_triangles_trimmed = 0;
+  size_t holes_filled = 0;
+  double hole_area = 0.0;  // area of the fill, the cloud's unit squared
   // Wall-clock seconds per stage.
   double t_neighbours = 0, t_normals = 0, t_orientation = 0, t_kernels = 0, t_field = 0, t_mesh = 0;
   double total_seconds() const {

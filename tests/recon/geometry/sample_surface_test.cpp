@@ -12,6 +12,7 @@
 
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/io/ply.hpp"
+#include "tests/test_meshes.hpp"
 
 namespace bodyscan {
 namespace {
@@ -24,17 +25,7 @@ TriangleMesh load_body() {
   return mesh.ok() ? std::move(mesh).value() : TriangleMesh{};
 }
 
-// The box [0, sx] × [0, sy] × [0, sz], wound counter-clockwise seen from outside; faces
-// are triangles 2k and 2k + 1 for k = z0, z1, y0, y1, x0, x1.
-TriangleMesh box(float sx, float sy, float sz) {
-  TriangleMesh m;
-  for (int i = 0; i < 8; ++i) {
-    m.vertices.emplace_back((i & 1) * sx, ((i >> 1) & 1) * sy, ((i >> 2) & 1) * sz);
-  }
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return m;
-}
+TriangleMesh box(float sx, float sy, float sz) { return testing::box_mesh(Vec3f::Zero(), Vec3f(sx, sy, sz)); }
 
 double triangle_area(const TriangleMesh& m, size_t t) {
   const Vec3d a = m.vertices[m.triangles[t][0]].cast<double>();

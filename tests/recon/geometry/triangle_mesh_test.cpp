@@ -6,26 +6,12 @@
 #include <cmath>
 
 #include "recon/io/ply.hpp"
+#include "tests/test_meshes.hpp"
 
 namespace bodyscan {
 namespace {
 
-// Unit cube [0,1]^3, vertex index x + 2y + 4z, each face split into two triangles
-// wound counter-clockwise seen from outside.
-TriangleMesh unit_cube() {
-  TriangleMesh mesh;
-  for (int i = 0; i < 8; ++i) {
-    mesh.vertices.emplace_back(static_cast<float>(i & 1), static_cast<float>((i >> 1) & 1),
-                               static_cast<float>((i >> 2) & 1));
-  }
-  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    mesh.triangles.push_back({q[0], q[1], q[2]});
-    mesh.triangles.push_back({q[0], q[2], q[3]});
-  }
-  return mesh;
-}
+using testing::unit_cube;
 
 TEST(TriangleMeshTest, ClosedCube) {
   const TriangleMesh cube = unit_cube();

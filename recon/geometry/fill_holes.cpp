@@ -1,0 +1,545 @@
+#include "recon/geometry/fill_holes.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "recon/geometry/mesh_components.hpp"
+
+namespace bodyscan {
+
+namespace {
+
+uint64_t key(uint32_t a, uint32_t b) { return (static_cast<uint64_t>(a) << 32) | b; }
+uint64_t undirected_key(uint32_t a, uint32_t b) { return a < b ? key(a, b) : key(b, a); }
+
+// Every triangle's half-edges filed under their start vertex (compressed rows).
+struct HalfEdges {
+  std::vector<size_t> start;
+  std::vector<uint32_t> to;
+  std::vector<uint32_t> triangle;
+
+  explicit HalfEdges(const TriangleMesh& mesh) : start(mesh.vertices.size() + 1, 0) {
+    for (const Triangle& t : mesh.triangles)
+      for (uint32_t v : t) ++start[v + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    to.resize(start.back());
+    triangle.resize(start.back());
+    std::vector<size_t> fill(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+      const Triangle& t = mesh.triangles[i];
+      for (int k = 0; k < 3; ++k) {
+        const size_t slot = fill[t[k]]++;
+        to[slot] = t[(k + 1) % 3];
+        triangle[slot] = static_cast<uint32_t>(i);
+      }
+    }
+  }
+  size_t count(uint32_t a, uint32_t b) const {
+    if (a + 1 >= start.size()) return 0;
+    size_t n = 0;
+    for (size_t s = start[a]; s < start[a + 1]; ++s) n += to[s] == b;
+    return n;
+  }
+  long find(uint32_t a, uint32_t b) const {
+    if (a + 1 >= start.size()) return -1;
+    for (size_t s = start[a]; s < start[a + 1]; ++s)
+      if (to[s] == b) return static_cast<long>(triangle[s]);
+    return -1;
+  }
+  bool connected(uint32_t a, uint32_t b) const { return count(a, b) + count(b, a) > 0; }
+};
+
+// The boundary loops, each in the mesh's own half-edge direction, split where a
+// loop passes a vertex twice so that every loop visits its vertices once.
+std::vector<std::vector<uint32_t>> boundary_loops(const TriangleMesh& mesh, const HalfEdges& he) {
+  std::vector<std::pair<uint32_t, uint32_t>> edges;  // (from, to)
+  for (const Triangle& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = t[k], b = t[(k + 1) % 3];
+      if (he.count(b, a) == 0 && he.count(a, b) == 1) edges.emplace_back(a, b);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<uint8_t> used(edges.size(), 0);
+  auto next_from = [&](uint32_t v) -> long {
+    auto it = std::lower_bound(edges.begin(), edges.end(), std::make_pair(v, uint32_t{0}));
+    for (; it != edges.end() && it->first == v; ++it) {
+      const size_t i = static_cast<size_t>(it - edges.begin());
+      if (!used[i]) return static_cast<long>(i);
+    }
+    return -1;
+  };
+
+  std::vector<std::vector<uint32_t>> loops;
+  for (size_t e0 = 0; e0 < edges.size(); ++e0) {
+    if (used[e0]) continue;
+    std::vector<uint32_t> seq{edges[e0].first};
+    long e = static_cast<long>(e0);
+    bool closed = false;
+    while (e >= 0) {
+      used[static_cast<size_t>(e)] = 1;
+      const uint32_t b = edges[static_cast<size_t>(e)].second;
+      if (b == seq.front()) {
+        closed = true;
+        break;
+      }
+      seq.push_back(b);
+      e = next_from(b);
+    }
+    if (!closed) continue;  // only on a non-manifold boundary; left open
+    // Split at repeated vertices.
+    std::vector<uint32_t> stack;
+    std::unordered_map<uint32_t, size_t> position;
+    auto emit = [&](size_t from) {
+      std::vector<uint32_t> loop(stack.begin() + static_cast<long>(from), stack.end());
+      for (uint32_t v : loop) position.erase(v);
+      stack.resize(from);
+      if (loop.size() >= 3) loops.push_back(std::move(loop));
+    };
+    for (uint32_t v : seq) {
+      auto it = position.find(v);
+      if (it != position.end()) emit(it->second);
+      position[v] = stack.size();
+      stack.push_back(v);
+    }
+    emit(0);
+  }
+  return loops;
+}
+
+Vec3f unit_normal(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+  const Vec3f n = (b - a).cross(c - a);
+  const float len = n.norm();
+  return len > 0.f ? Vec3f(n / len) : Vec3f::Zero();
+}
+
+// One hole being filled: the patch triangles and what the filling needs to know
+// about the mesh around them.
+class HolePatch {
+ public:
+  HolePatch(TriangleMesh& mesh, const HalfEdges& he, std::unordered_set<uint64_t>& added_edges)
+      : mesh_(mesh), he_(he), added_(added_edges), first_new_vertex_(static_cast<uint32_t>(mesh.vertices.size())) {}
+
+  // Triangulates the polygon (fill winding: consecutive vertices are the new
+  // triangles' edges). `edge_normal[k]` is the unit normal of the mesh triangle on
+  // edge k -> k+1 (zero when unknown).
+  void triangulate(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal, size_t max_dp) {
+    const size_t n = poly.size();
+    if (n == 3) {
+      add({poly[0], poly[1], poly[2]});
+      return;
+    }
+    if (n > max_dp) {
+      size_t si = 0, sj = 0;
+      if (find_split(poly, &si, &sj)) {
+        std::vector<uint32_t> a(poly.begin() + static_cast<long>(si), poly.begin() + static_cast<long>(sj) + 1);
+        std::vector<Vec3f> na(edge_normal.begin() + static_cast<long>(si), edge_normal.begin() + static_cast<long>(sj));
+        na.push_back(Vec3f::Zero());  // the diagonal
+        std::vector<uint32_t> b(poly.begin() + static_cast<long>(sj), poly.end());
+        b.insert(b.end(), poly.begin(), poly.begin() + static_cast<long>(si) + 1);
+        std::vector<Vec3f> nb(edge_normal.begin() + static_cast<long>(sj), edge_normal.end());
+        nb.insert(nb.end(), edge_normal.begin(), edge_normal.begin() + static_cast<long>(si));
+        nb.push_back(Vec3f::Zero());
+        added_.insert(undirected_key(poly[si], poly[sj]));
+        triangulate(a, na, max_dp);
+        triangulate(b, nb, max_dp);
+        return;
+      }
+    }
+    if (!minimum_dihedral_triangulation(poly, edge_normal)) fan(poly);
+  }
+
+  void refine() {
+    constexpr float kAlpha = 1.41421356f;  // Liepa's density factor sqrt(2)
+    for (const Triangle& t : tris_)
+      for (uint32_t v : t) scale_of(v);
+    for (int pass = 0; pass < 30; ++pass) {
+      bool split = false;
+      const size_t count = tris_.size();
+      for (size_t i = 0; i < count; ++i) {
+        const Triangle t = tris_[i];
+        const Vec3f c = (pos(t[0]) + pos(t[1]) + pos(t[2])) / 3.f;
+        const float sc = (scale_[t[0]] + scale_[t[1]] + scale_[t[2]]) / 3.f;
+        bool big = true;
+        for (uint32_t v : t) {
+          const float d = kAlpha * (c - pos(v)).norm();
+          big = big && d > sc && d > scale_[v];
+        }
+        if (!big) continue;
+        const uint32_t m = static_cast<uint32_t>(mesh_.vertices.size());
+        mesh_.vertices.push_back(c);
+        scale_[m] = sc;
+        remove_edges(i);
+        tris_[i] = {t[0], t[1], m};
+        insert_edges(i);
+        add({t[1], t[2], m});
+        add({t[2], t[0], m});
+        relax(t[0], t[1]);
+        relax(t[1], t[2]);
+        relax(t[2], t[0]);
+        split = true;
+      }
+      for (int r = 0; r < 50; ++r) {
+        bool flipped = false;
+        for (size_t i = 0; i < tris_.size(); ++i) {
+          for (int k = 0; k < 3; ++k) flipped = relax(tris_[i][k], tris_[i][(k + 1) % 3]) || flipped;
+        }
+        if (!flipped) break;
+      }
+      if (!split) break;
+    }
+  }
+
+  // New vertices minimise sum |L v|^2, L the umbrella operator (mean of the
+  // neighbours minus the vertex), over the new vertices (membrane) or over the new
+  // and the loop's vertices (thin plate: the loop's rings pull the patch along the
+  // surrounding curvature).
+  void fair(const std::vector<uint32_t>& loop, bool thin_plate) {
+    const uint32_t nv = static_cast<uint32_t>(mesh_.vertices.size());
+    const uint32_t k = nv - first_new_vertex_;
+    if (k == 0) return;
+    std::unordered_map<uint32_t, std::vector<uint32_t>> ring;
+    auto link = [&](uint32_t a, uint32_t b) {
+      auto& r = ring[a];
+      if (std::find(r.begin(), r.end(), b) == r.end()) r.push_back(b);
+    };
+    for (const Triangle& t : tris_)
+      for (int j = 0; j < 3; ++j) {
+        link(t[j], t[(j + 1) % 3]);
+        link(t[(j + 1) % 3], t[j]);
+      }
+    for (uint32_t v : loop) {
+      for (size_t s = he_.start[v]; s < he_.start[v + 1]; ++s) {
+        const Triangle& t = mesh_.triangles[he_.triangle[s]];
+        for (uint32_t u : t)
+          if (u != v) link(v, u);
+      }
+    }
+    std::vector<Eigen::Triplet<double>> triplets;
+    std::vector<Vec3d> rhs;
+    size_t row = 0;
+    auto add_row = [&](uint32_t v) {
+      const auto& r = ring[v];
+      if (r.empty()) return;
+      const double w = 1.0 / static_cast<double>(r.size());
+      Vec3d b = Vec3d::Zero();
+      auto put = [&](uint32_t u, double c) {
+        if (u >= first_new_vertex_) {
+          triplets.emplace_back(static_cast<int>(row), static_cast<int>(u - first_new_vertex_), c);
+        } else {
+          b -= c * mesh_.vertices[u].cast<double>();
+        }
+      };
+      for (uint32_t u : r) put(u, w);
+      put(v, -1.0);
+      rhs.push_back(b);
+      ++row;
+    };
+    for (uint32_t v = first_new_vertex_; v < nv; ++v) add_row(v);
+    if (thin_plate)
+      for (uint32_t v : loop) add_row(v);
+    Eigen::SparseMatrix<double> a(static_cast<int>(row), static_cast<int>(k));
+    a.setFromTriplets(triplets.begin(), triplets.end());
+    Eigen::MatrixXd b(static_cast<int>(row), 3);
+    for (size_t i = 0; i < row; ++i) b.row(static_cast<int>(i)) = rhs[i].transpose();
+    const Eigen::SparseMatrix<double> normal = a.transpose() * a;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
+    if (solver.info() != Eigen::Success) return;
+    const Eigen::MatrixXd x = solver.solve(a.transpose() * b);
+    if (solver.info() != Eigen::Success || !x.allFinite()) return;
+    for (uint32_t i = 0; i < k; ++i) mesh_.vertices[first_new_vertex_ + i] = x.row(static_cast<int>(i)).transpose().cast<float>();
+  }
+
+  const std::vector<Triangle>& triangles() const { return tris_; }
+  double area() const {
+    double sum = 0.0;
+    for (const Triangle& t : tris_) sum += 0.5 * static_cast<double>((pos(t[1]) - pos(t[0])).cross(pos(t[2]) - pos(t[0])).norm());
+    return sum;
+  }
+  // Forgets the patch and any vertex it added.
+  void discard() {
+    tris_.clear();
+    edges_.clear();
+    mesh_.vertices.resize(first_new_vertex_);
+  }
+
+ private:
+  const Vec3f& pos(uint32_t v) const { return mesh_.vertices[v]; }
+
+  // An edge the patch may not create: it exists in the mesh, in another patch, or
+  // in this one.
+  bool edge_taken(uint32_t a, uint32_t b) const {
+    return (a < first_new_vertex_ && b < first_new_vertex_ && he_.connected(a, b)) ||
+           added_.count(undirected_key(a, b)) > 0 || edges_.count(key(a, b)) > 0 || edges_.count(key(b, a)) > 0;
+  }
+
+  float scale_of(uint32_t v) {
+    auto it = scale_.find(v);
+    if (it != scale_.end()) return it->second;
+    double sum = 0.0;
+    size_t n = 0;
+    if (v + 1 < he_.start.size()) {
+      for (size_t s = he_.start[v]; s < he_.start[v + 1]; ++s, ++n) sum += (pos(he_.to[s]) - pos(v)).norm();
+    }
+    float value = n ? static_cast<float>(sum / static_cast<double>(n)) : 0.f;
+    if (n == 0) {  // a vertex with no mesh edges: its patch edges
+      for (const Triangle& t : tris_)
+        for (int k = 0; k < 3; ++k)
+          if (t[k] == v) value = std::max(value, (pos(t[(k + 1) % 3]) - pos(v)).norm());
+    }
+    scale_[v] = value;
+    return value;
+  }
+
+  void insert_edges(size_t i) {
+    const Triangle& t = tris_[i];
+    for (int k = 0; k < 3; ++k) edges_[key(t[k], t[(k + 1) % 3])] = static_cast<uint32_t>(i);
+  }
+  void remove_edges(size_t i) {
+    const Triangle& t = tris_[i];
+    for (int k = 0; k < 3; ++k) edges_.erase(key(t[k], t[(k + 1) % 3]));
+  }
+  void add(const Triangle& t) {
+    tris_.push_back(t);
+    insert_edges(tris_.size() - 1);
+  }
+
+  // Flips edge a-b to the other diagonal of its two patch triangles when that
+  // satisfies the Delaunay condition the current one breaks.
+  bool relax(uint32_t a, uint32_t b) {
+    auto i1 = edges_.find(key(a, b)), i2 = edges_.find(key(b, a));
+    if (i1 == edges_.end() || i2 == edges_.end()) return false;  // on the loop
+    const size_t t1 = i1->second, t2 = i2->second;
+    auto third = [&](size_t t) {
+      for (uint32_t v : tris_[t])
+        if (v != a && v != b) return v;
+      return a;
+    };
+    const uint32_t c = third(t1), d = third(t2);
+    if (c == d) return false;
+    auto angle = [&](uint32_t apex) {
+      const Vec3f u = (pos(a) - pos(apex)).normalized(), w = (pos(b) - pos(apex)).normalized();
+      return std::acos(std::clamp(u.dot(w), -1.f, 1.f));
+    };
+    if (angle(c) + angle(d) <= static_cast<float>(M_PI) + 1e-4f) return false;
+    if (edge_taken(c, d)) return false;
+    remove_edges(t1);
+    remove_edges(t2);
+    tris_[t1] = {a, d, c};
+    tris_[t2] = {d, b, c};
+    insert_edges(t1);
+    insert_edges(t2);
+    return true;
+  }
+
+  // A diagonal (i, j) cutting a long loop into two parts of at least a quarter of
+  // it each, as short as possible relative to the loop length it cuts off.
+  bool find_split(const std::vector<uint32_t>& poly, size_t* si, size_t* sj) const {
+    const size_t n = poly.size();
+    const size_t min_part = std::max<size_t>(3, n / 4);
+    double best = std::numeric_limits<double>::max();
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t j = i + min_part; j + min_part <= n + i && j < n; ++j) {
+        const double d = (pos(poly[i]) - pos(poly[j])).norm();
+        if (d < best && !edge_taken(poly[i], poly[j])) {
+          best = d;
+          *si = i;
+          *sj = j;
+        }
+      }
+    }
+    return best < std::numeric_limits<double>::max();
+  }
+
+  bool minimum_dihedral_triangulation(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal) {
+    const size_t n = poly.size();
+    struct Cell {
+      float min_cos = -2.f;  // < -1: no triangulation
+      float area = 0.f;
+      int m = -1;
+      Vec3f normal = Vec3f::Zero();  // of the triangle (i, m, j)
+    };
+    std::vector<Cell> w(n * n);
+    auto at = [&](size_t i, size_t j) -> Cell& { return w[i * n + j]; };
+    for (size_t i = 0; i + 1 < n; ++i) at(i, i + 1).min_cos = 1.f;
+    for (size_t len = 2; len < n; ++len) {
+      for (size_t i = 0; i + len < n; ++i) {
+        const size_t j = i + len;
+        if (len < n - 1 && edge_taken(poly[i], poly[j])) continue;
+        Cell best;
+        const Vec3f& pi = pos(poly[i]);
+        const Vec3f& pj = pos(poly[j]);
+        for (size_t m = i + 1; m < j; ++m) {
+          const Cell& left = at(i, m);
+          const Cell& right = at(m, j);
+          if (left.min_cos < -1.5f || right.min_cos < -1.5f) continue;
+          const Vec3f nrm = (pos(poly[m]) - pi).cross(pj - pi);
+          const float twice_area = nrm.norm();
+          const Vec3f u = twice_area > 0.f ? Vec3f(nrm / twice_area) : Vec3f::Zero();
+          float c = std::min(left.min_cos, right.min_cos);
+          if (twice_area <= 0.f) c = -1.f;  // degenerate: the worst angle
+          const Vec3f& n_left = m == i + 1 ? edge_normal[i] : left.normal;
+          const Vec3f& n_right = j == m + 1 ? edge_normal[m] : right.normal;
+          if (!n_left.isZero()) c = std::min(c, u.dot(n_left));
+          if (!n_right.isZero()) c = std::min(c, u.dot(n_right));
+          if (len == n - 1 && !edge_normal[n - 1].isZero()) c = std::min(c, u.dot(edge_normal[n - 1]));
+          const float area = left.area + right.area + 0.5f * twice_area;
+          if (c > best.min_cos + 1e-6f || (c >= best.min_cos - 1e-6f && area < best.area)) {
+            best.min_cos = c;
+            best.area = area;
+            best.m = static_cast<int>(m);
+            best.normal = u;
+          }
+        }
+        at(i, j) = best;
+      }
+    }
+    if (at(0, n - 1).m < 0) return false;
+    std::vector<std::pair<size_t, size_t>> stack{{0, n - 1}};
+    while (!stack.empty()) {
+      const auto [i, j] = stack.back();
+      stack.pop_back();
+      const size_t m = static_cast<size_t>(at(i, j).m);
+      add({poly[i], poly[m], poly[j]});
+      if (m - i >= 2) stack.emplace_back(i, m);
+      if (j - m >= 2) stack.emplace_back(m, j);
+    }
+    return true;
+  }
+
+  // Fallback: a fan around a new vertex at the loop's centroid.
+  void fan(const std::vector<uint32_t>& poly) {
+    Vec3f c = Vec3f::Zero();
+    for (uint32_t v : poly) c += pos(v);
+    c /= static_cast<float>(poly.size());
+    const uint32_t m = static_cast<uint32_t>(mesh_.vertices.size());
+    mesh_.vertices.push_back(c);
+    for (size_t k = 0; k < poly.size(); ++k) add({poly[k], poly[(k + 1) % poly.size()], m});
+  }
+
+  TriangleMesh& mesh_;
+  const HalfEdges& he_;
+  std::unordered_set<uint64_t>& added_;
+  const uint32_t first_new_vertex_;
+  std::vector<Triangle> tris_;
+  std::unordered_map<uint64_t, uint32_t> edges_;  // directed patch edge -> patch triangle
+  std::unordered_map<uint32_t, float> scale_;     // local edge length per vertex
+};
+
+}  // namespace
+
+HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
+  HoleFillStats stats;
+  const HalfEdges he(mesh);
+  const std::vector<std::vector<uint32_t>> loops = boundary_loops(mesh, he);
+  stats.holes = loops.size();
+  const size_t original_vertices = mesh.vertices.size();
+  if (mesh.confidence.empty()) mesh.confidence.assign(original_vertices, 1.f);
+  std::vector<Triangle> added_triangles;
+  std::unordered_set<uint64_t> added_edges;
+  for (const std::vector<uint32_t>& loop : loops) {
+    stats.largest_hole_edges = std::max(stats.largest_hole_edges, loop.size());
+    if (options.max_hole_edges && loop.size() > options.max_hole_edges) continue;
+    // The fill walks the loop backwards: each patch triangle uses a loop edge in
+    // the direction opposite to the mesh triangle beside it.
+    const std::vector<uint32_t> poly(loop.rbegin(), loop.rend());
+    std::vector<Vec3f> edge_normal(poly.size());
+    for (size_t k = 0; k < poly.size(); ++k) {
+      const long t = he.find(poly[(k + 1) % poly.size()], poly[k]);
+      edge_normal[k] = Vec3f::Zero();
+      if (t >= 0) {
+        const Triangle& tri = mesh.triangles[static_cast<size_t>(t)];
+        edge_normal[k] = unit_normal(mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]);
+      }
+    }
+    HolePatch patch(mesh, he, added_edges);
+    patch.triangulate(poly, edge_normal, std::max<size_t>(options.max_dp_edges, 4));
+    if (options.max_hole_area > 0.0 && patch.area() > options.max_hole_area) {
+      patch.discard();
+      continue;
+    }
+    if (options.refine) patch.refine();
+    if (options.fairing != HoleFairing::kNone) patch.fair(loop, options.fairing == HoleFairing::kThinPlate);
+    stats.area_added += patch.area();
+    for (const Triangle& t : patch.triangles()) {
+      added_triangles.push_back(t);
+      for (int k = 0; k < 3; ++k) added_edges.insert(undirected_key(t[k], t[(k + 1) % 3]));
+    }
+    ++stats.holes_filled;
+  }
+  stats.triangles_added = added_triangles.size();
+  stats.vertices_added = mesh.vertices.size() - original_vertices;
+  mesh.triangles.insert(mesh.triangles.end(), added_triangles.begin(), added_triangles.end());
+  mesh.confidence.resize(mesh.vertices.size(), 0.f);
+  if (!mesh.normals.empty()) mesh.normals = compute_vertex_normals(mesh);
+  return stats;
+}
+
+size_t trim_boundary_flaps(TriangleMesh& mesh, const std::function<bool(uint32_t vertex)>& unsupported) {
+  const size_t nv = mesh.vertices.size(), nt = mesh.triangles.size();
+  // Triangles around each vertex.
+  std::vector<size_t> start(nv + 1, 0);
+  for (const Triangle& t : mesh.triangles)
+    for (uint32_t v : t) ++start[v + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<uint32_t> around(start.back());
+  {
+    std::vector<size_t> fill(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < nt; ++i)
+      for (uint32_t v : mesh.triangles[i]) around[fill[v]++] = static_cast<uint32_t>(i);
+  }
+  std::vector<uint8_t> alive(nt, 1);
+  std::vector<int8_t> cache(nv, -1);
+  auto is_unsupported = [&](uint32_t v) {
+    if (cache[v] < 0) cache[v] = unsupported(v) ? 1 : 0;
+    return cache[v] == 1;
+  };
+  auto has_half_edge = [&](uint32_t a, uint32_t b) {  // an alive triangle walks a -> b
+    for (size_t s = start[a]; s < start[a + 1]; ++s) {
+      const uint32_t t = around[s];
+      if (!alive[t]) continue;
+      const Triangle& tri = mesh.triangles[t];
+      for (int k = 0; k < 3; ++k)
+        if (tri[k] == a && tri[(k + 1) % 3] == b) return true;
+    }
+    return false;
+  };
+  auto on_boundary = [&](uint32_t t) {
+    const Triangle& tri = mesh.triangles[t];
+    for (int k = 0; k < 3; ++k)
+      if (!has_half_edge(tri[(k + 1) % 3], tri[k])) return true;
+    return false;
+  };
+  std::vector<uint32_t> queue;
+  for (uint32_t t = 0; t < nt; ++t)
+    if (on_boundary(t)) queue.push_back(t);
+  size_t removed = 0;
+  while (!queue.empty()) {
+    const uint32_t t = queue.back();
+    queue.pop_back();
+    if (!alive[t]) continue;
+    const Triangle& tri = mesh.triangles[t];
+    if (!is_unsupported(tri[0]) || !is_unsupported(tri[1]) || !is_unsupported(tri[2])) continue;
+    if (!on_boundary(t)) continue;
+    alive[t] = 0;
+    ++removed;
+    for (uint32_t v : tri)
+      for (size_t s = start[v]; s < start[v + 1]; ++s)
+        if (alive[around[s]]) queue.push_back(around[s]);
+  }
+  if (removed == 0) return 0;
+  size_t out = 0;
+  for (size_t i = 0; i < nt; ++i)
+    if (alive[i]) mesh.triangles[out++] = mesh.triangles[i];
+  mesh.triangles.resize(out);
+  remove_unreferenced_vertices(mesh);
+  return removed;
+}
+
+}  // namespace bodyscan
