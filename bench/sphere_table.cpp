@@ -4,10 +4,13 @@
 // from the points.
 //
 //   sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S]
+//                [--cloud-dir DIR]
 //
 // --defaults runs reconstruct_surface with no options (everything from the data).
 // --tuned searches sigma, normal sigma, sharpening and voxel per cell by coordinate
 // descent, as the thesis tuned sigma_xy and sigma_z per cell, and prints the winners.
+// --cloud-dir writes each cell's cloud to DIR/sphere_N_s.ply for a peer to run on
+// (bench/sphere_vs_open3d.sh).
 // Prints a Markdown table with the thesis's value and our ratio per cell.
 #include <chrono>
 #include <cmath>
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "recon/geometry/sample_surface.hpp"
+#include "recon/io/ply.hpp"
 #include "recon/surface/reconstruct.hpp"
 
 using namespace bodyscan;
@@ -72,7 +76,7 @@ Cell tune(const PointCloud& cloud, ReconstructOptions& best_opt) {
   Cell best = base;
   const float spacing = base.stats.median_density_sigma;
   const std::vector<float> sigmas = {0.5f, 0.65f, 0.8f, 1.f, 1.25f, 1.5f, 2.f, 2.5f, 3.f, 4.f, 5.f, 6.f};
-  const std::vector<float> normals = {0.2f, 0.3f, 0.4f, 0.5f, 0.75f, 1.f, 1.5f, 2.f, 3.f};
+  const std::vector<float> normals = {0.2f, 0.3f, 0.4f, 0.5f, 0.75f, 1.f, 1.5f, 2.f, 3.f, 4.f, 6.f};
   const std::vector<float> sharpen = {0.f, 0.25f, 0.5f, 1.f, 2.f};
   const std::vector<float> voxels = {0.2f, 0.3f, 0.45f, 0.7f};  // x density sigma
   const std::vector<float> ks = {8.f, 12.f, 20.f, 40.f, 80.f};
@@ -103,6 +107,7 @@ int main(int argc, char** argv) {
   bool defaults = false, tuned = false;
   double nonuniform = 0.0;
   uint64_t seed = 1;
+  std::string cloud_dir;
   std::vector<std::pair<size_t, double>> cells;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -110,6 +115,7 @@ int main(int argc, char** argv) {
     else if (a == "--tuned") tuned = true;
     else if (a == "--nonuniform" && i + 1 < argc) nonuniform = std::atof(argv[++i]);
     else if (a == "--seed" && i + 1 < argc) seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (a == "--cloud-dir" && i + 1 < argc) cloud_dir = argv[++i];
     else if (a == "--cells" && i + 1 < argc) {
       std::string s = argv[++i];
       size_t pos = 0;
@@ -122,7 +128,7 @@ int main(int argc, char** argv) {
         pos = comma + 1;
       }
     } else {
-      std::fprintf(stderr, "usage: sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S]\n");
+      std::fprintf(stderr, "usage: sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S] [--cloud-dir DIR]\n");
       return 2;
     }
   }
@@ -141,6 +147,15 @@ int main(int argc, char** argv) {
       for (size_t c = 0; c < kNoise.size(); ++c)
         if (kSizes[r] == n && std::abs(kNoise[c] - s) < 1e-12) thesis = kThesis[r][c];
     const PointCloud cloud = make_cloud(n, s, nonuniform, seed + n * 131 + static_cast<uint64_t>(s * 1000));
+    if (!cloud_dir.empty()) {
+      char name[64];
+      std::snprintf(name, sizeof name, "/sphere_%zu_%.2f.ply", n, s);
+      const Status w = write_ply(cloud_dir + name, cloud);
+      if (!w.ok()) {
+        std::fprintf(stderr, "sphere_table: %s\n", w.message().c_str());
+        return 1;
+      }
+    }
     std::printf("| %zu | %.2f | %.6f |", n, s, thesis);
     if (defaults) {
       const Cell d = run(cloud, {});

@@ -55,6 +55,7 @@ std::vector<Kernel> adapt_kernels(const std::vector<Vec3f>& points, const LocalF
     if (options.curvature_compensation && !mean_curvature.empty()) {
       const float limit = options.max_bend / std::max(k.sigma_t1, k.sigma_t2);
       k.bend = std::clamp(mean_curvature[i], -limit, limit);
+      k.center -= (k.bend * options.noise_sigma * options.noise_sigma) * k.n;
     }
     k.weight = std::min(w, 1.f);
     k.band = options.band;

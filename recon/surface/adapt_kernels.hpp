@@ -36,6 +36,11 @@ struct AdaptKernelsOptions {
   // |bend| sigma_t <= max_bend.
   bool curvature_compensation = true;
   float max_bend = 0.7f;
+  // Per-axis noise of the points (the cloud's unit). Noise along a curved surface
+  // moves points to its convex side on average, by H sigma^2 (a point displaced by
+  // t along the tangent plane of a sphere of radius R lies |t|^2 / 2R outside it);
+  // with curvature compensation each kernel is moved back by that much.
+  float noise_sigma = 0.f;
   // Normal reach of every kernel (Kernel::band), the points' unit; 0 = the full
   // support.
   float band = 0.f;

@@ -40,7 +40,7 @@ struct ReconstructOptions {
   // curvature bias; implicit_field.hpp). Off = the thesis's flat kernels.
   bool curvature_compensation = true;
   float voxel_size = 0.f;     // grid spacing in the cloud's unit (0 = auto)
-  float epsilon = 1e-3f;      // kernel cut-off tolerance, eq. 3.26
+  float epsilon = 1e-2f;      // kernel cut-off tolerance, eq. 3.26
   size_t density_k = 10;      // neighbours of eq. 3.17
   size_t normal_k = 0;        // neighbours per PCA normal (0 = auto from the noise)
   NormalSource normal_source = NormalSource::kAuto;
@@ -64,7 +64,7 @@ struct ReconstructOptions {
   int brick_size = 16;
   // Kernels reach this many voxels plus three noise sigmas along their normals
   // (Kernel::band); 0 = their full support.
-  float band_voxels = 2.5f;
+  float band_voxels = 1.5f;
   ProgressFn progress;
 };
 

@@ -110,9 +110,11 @@ TEST(ImplicitFieldEvaluate, SingleFlatKernelClosedForm) {
   EXPECT_EQ(w, 0.0);
 }
 
-TEST(ImplicitFieldEvaluate, BentKernelZeroSetIsTheParaboloid) {
-  // bend b: the zero set is n = -b (t1^2 + t2^2) / 2, the osculating paraboloid of a
-  // surface bending away from n with mean curvature b.
+TEST(ImplicitFieldEvaluate, BentKernelZeroSetIsTheOsculatingSphere) {
+  // bend b: the zero set is the sphere of radius 1 / b touching the tangent plane
+  // at the centre, n = -(1 - sqrt(1 - b^2 r^2)) / b, for a surface bending away from
+  // n with mean curvature b; to second order the paraboloid -b r^2 / 2. Beyond
+  // r = 1 / b, where the sphere turns vertical, it goes on as -b r^2.
   Kernel k;
   k.center = Vec3f::Zero();
   k.t1 = Vec3f::UnitX();
@@ -122,13 +124,17 @@ TEST(ImplicitFieldEvaluate, BentKernelZeroSetIsTheParaboloid) {
   k.sigma_n = 0.1f;
   k.bend = 0.8f;
   double v, w;
-  for (double u : {-0.6, -0.2, 0.3, 0.7}) {
-    const double sag = -0.5 * 0.8 * u * u;
-    ImplicitField::evaluate({k}, 1e-3f, Vec3d(u, 0.3 * u, sag * (1 + 0.09)), &v, &w);
+  for (double u : {-0.6, -0.2, 0.3, 0.7, 1.3}) {
+    const double r2 = u * u * 1.09;  // the point below is at (u, 0.3 u)
+    auto sphere = [](double rr) { return rr * 0.64 < 1 ? -(1.0 - std::sqrt(1.0 - 0.64 * rr)) / 0.8 : -0.8 * rr; };
+    const double sag = sphere(r2);
+    ImplicitField::evaluate({k}, 1e-3f, Vec3d(u, 0.3 * u, sag), &v, &w);
     EXPECT_NEAR(v, 0.0, 1e-7) << u;
-    ImplicitField::evaluate({k}, 1e-3f, Vec3d(u, 0.0, sag - 0.02), &v, &w);
-    EXPECT_GT(v, 0.0) << u;  // below the paraboloid: inside
-    ImplicitField::evaluate({k}, 1e-3f, Vec3d(u, 0.0, sag + 0.02), &v, &w);
+    if (std::abs(u) < 0.3) EXPECT_NEAR(sag, -0.4 * r2, 0.01 * std::abs(sag)) << "paraboloid near the centre";
+    const double sag0 = sphere(u * u);
+    ImplicitField::evaluate({k}, 1e-3f, Vec3d(u, 0.0, sag0 - 0.02), &v, &w);
+    EXPECT_GT(v, 0.0) << u;  // below the sphere: inside
+    ImplicitField::evaluate({k}, 1e-3f, Vec3d(u, 0.0, sag0 + 0.02), &v, &w);
     EXPECT_LT(v, 0.0) << u;
   }
 }
