@@ -7,8 +7,10 @@
 //                [--cloud-dir DIR]
 //
 // --defaults runs reconstruct_surface with no options (everything from the data).
-// --tuned searches sigma, normal sigma, sharpening and voxel per cell by coordinate
-// descent, as the thesis tuned sigma_xy and sigma_z per cell, and prints the winners.
+// --tuned searches sigma, normal sigma, sharpening, the PCA neighbourhood and the
+// voxel per cell by coordinate descent from the defaults (two rounds; one, and no
+// voxel below 0.45 density sigmas, for N >= 4096), as the thesis tuned sigma_xy and
+// sigma_z per cell, and prints the winners.
 // --cloud-dir writes each cell's cloud to DIR/sphere_N_s.ply for a peer to run on
 // (bench/sphere_vs_open3d.sh).
 // Prints a Markdown table with the thesis's value and our ratio per cell.
@@ -78,9 +80,13 @@ Cell tune(const PointCloud& cloud, ReconstructOptions& best_opt) {
   const std::vector<float> sigmas = {0.5f, 0.65f, 0.8f, 1.f, 1.25f, 1.5f, 2.f, 2.5f, 3.f, 4.f, 5.f, 6.f};
   const std::vector<float> normals = {0.2f, 0.3f, 0.4f, 0.5f, 0.75f, 1.f, 1.5f, 2.f, 3.f, 4.f, 6.f};
   const std::vector<float> sharpen = {0.f, 0.25f, 0.5f, 1.f, 2.f};
-  const std::vector<float> voxels = {0.2f, 0.3f, 0.45f, 0.7f};  // x density sigma
+  // Fine voxels only pay on sparse clouds (where a voxel of 0.7 density sigmas is a
+  // good part of the radius); on dense ones they cost minutes per cell.
+  const bool dense = cloud.size() >= 4096;
+  const std::vector<float> voxels =
+      dense ? std::vector<float>{0.45f, 0.7f} : std::vector<float>{0.2f, 0.3f, 0.45f, 0.7f};  // x density sigma
   const std::vector<float> ks = {8.f, 12.f, 20.f, 40.f, 80.f};
-  for (int round = 0; round < 2; ++round) {
+  for (int round = 0; round < (dense ? 1 : 2); ++round) {
     auto try_values = [&](const std::vector<float>& values, auto set) {
       for (float v : values) {
         ReconstructOptions o = best_opt;

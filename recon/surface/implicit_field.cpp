@@ -8,7 +8,6 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
-#include <cstdlib>
 #include <mutex>
 #include <numeric>
 
@@ -55,7 +54,7 @@ float sphere_sag(float bend, float r) {
 
 Prepared prepare(const Kernel& k, float r) {
   Prepared p;
-  const float sag = getenv("PSAG") ? 0.5f * std::abs(k.bend) * r * r * std::max(k.sigma_t1 * k.sigma_t1, k.sigma_t2 * k.sigma_t2) : sphere_sag(k.bend, r * std::max(k.sigma_t1, k.sigma_t2));
+  const float sag = sphere_sag(k.bend, r * std::max(k.sigma_t1, k.sigma_t2));
   const float normal_reach = k.band > 0.f ? std::min(k.band, r * k.sigma_n) : r * k.sigma_n;
   const float slab_mm = normal_reach + sag;
   p.m.row(0) = k.t1.transpose() / k.sigma_t1;
@@ -78,7 +77,7 @@ Prepared prepare(const Kernel& k, float r) {
   p.b2 = 0.5f * k.bend * k.sigma_t2 * k.sigma_t2 / k.sigma_n;
   p.kx = 2.f * k.bend * k.sigma_n;
   const float reach = r * std::max(k.sigma_t1, k.sigma_t2);
-  p.exact = getenv("FORCE") ? false : k.bend * k.bend * reach * reach > 0.25f;
+  p.exact = k.bend * k.bend * reach * reach > 0.25f;
   return p;
 }
 
