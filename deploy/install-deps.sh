@@ -11,6 +11,7 @@ packages=(
   libeigen3-dev        # linear algebra (recon)
   libnanoflann-dev     # k-nearest-neighbour search (recon)
   libtbb-dev           # parallel loops (recon)
+  nlohmann-json3-dev   # rig descriptions, API documents (hw, server)
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 if [[ "${1:-}" == "--bench" ]]; then

@@ -21,6 +21,8 @@ enum class StatusCode {
   kFailedPrecondition,
   kCancelled,
   kInternal,
+  kDeadlineExceeded,  // a device did not answer in time (a camera frame timeout)
+  kUnavailable,       // a device is gone (unplugged, powered off)
 };
 
 class Status {
@@ -54,6 +56,8 @@ inline Status failed_precondition(std::string m) {
 }
 inline Status cancelled(std::string m) { return {StatusCode::kCancelled, std::move(m)}; }
 inline Status internal_error(std::string m) { return {StatusCode::kInternal, std::move(m)}; }
+inline Status deadline_exceeded(std::string m) { return {StatusCode::kDeadlineExceeded, std::move(m)}; }
+inline Status unavailable(std::string m) { return {StatusCode::kUnavailable, std::move(m)}; }
 
 template <typename T>
 class StatusOr {

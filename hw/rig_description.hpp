@@ -1,0 +1,116 @@
+// The rig description: a JSON file saying what a rig is made of (docs/rig-description.md
+// documents every field). Real rigs use the frame and controller parts; the simulator
+// also uses the true camera and laser poses and the subject. Calibration never reads
+// the poses: it finds them (thesis §3.1).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hw/camera_model.hpp"
+#include "recon/core/status.hpp"
+
+namespace bodyscan::hw {
+
+// Two equal rectangular frames of square white tubing, one on the floor (its light
+// centres in Y = 0) and one above it (light centres in Y = top_height). Each frame
+// has a front pole (Z = +depth/2) and a back pole (Z = -depth/2) running along X,
+// joined by side poles; the front pole carries lights facing +Z, the back pole
+// lights facing -Z, at the same X positions (thesis §2.1: a camera sees the eight
+// lights of one side, four per frame).
+struct FrameGeometry {
+  double width = 1800;        // X distance between the side poles' centre lines, mm
+  double depth = 1100;        // Z distance between the front and back poles' centre lines
+  double top_height = 2300;   // Y of the top frame's light centres
+  double tube = 40;           // side of the square tubing
+  std::vector<double> light_x = {-700, -250, 250, 700};  // along each front and back pole
+  double light_diameter = 30;  // the diffuser disc
+};
+
+enum class PixelFormat { kMono8, kMono12, kMono16 };
+const char* to_string(PixelFormat f);
+int bits_per_pixel(PixelFormat f);  // significant bits: 8, 12 or 16
+
+struct CameraDescription {
+  std::string id;
+  Vec3d position = Vec3d::Zero();  // centre of projection, world mm
+  Vec3d look_at = Vec3d::Zero();   // a world point on the optical axis
+  double focal_mm = 6;
+  double pixel_size_um = 5.3;
+  int width = 1280, height = 1024;
+  Distortion distortion;
+  PixelFormat pixel_format = PixelFormat::kMono8;
+  // Sensor (for the simulator): electrons at full scale, read noise in electrons,
+  // and the exposure in microseconds the camera starts with.
+  double full_well_e = 10000;
+  double read_noise_e = 12;
+  double exposure_us = 10000;
+  double gain_db = 0;
+
+  CameraModel model() const;  // the true model, for the simulator and tests only
+};
+
+// A line laser on a stepper motor. Its plane contains the rotation axis through
+// `position`; at step s it holds the direction `aim` turned by s * step_angle about
+// the axis (right-handed).
+struct LaserDescription {
+  std::string id;
+  Vec3d position = Vec3d::Zero();
+  Vec3d axis = Vec3d::UnitY();
+  Vec3d aim = -Vec3d::UnitZ();  // horizontal pointing direction at step 0
+  double step_angle_deg = 0.05;
+  int min_step = -200, max_step = 200;
+  double line_width_mm = 1.0;   // full width at half maximum of the stripe's cross profile
+  double power = 1.0;           // stripe brightness relative to a full-scale white target
+
+  // Unit normal of the plane at a step, and the plane's offset d (n . x = d).
+  Vec3d plane_normal(int step) const;
+  double plane_offset(int step) const { return plane_normal(step).dot(position); }
+};
+
+struct SubjectMotion {
+  double sway_mm = 0, sway_hz = 0.25;        // side-to-side (X) and front-back (Z) sway
+  double breathing_mm = 0, breathing_hz = 0.25;  // chest radius change
+};
+
+struct SimulationDescription {
+  std::string subject;   // body mesh (PLY, mm, Y up), relative to the description file
+  Vec3d subject_offset = Vec3d::Zero();  // added to the mesh (after standing it on the floor)
+  double subject_yaw_deg = 0;            // turn about the vertical axis
+  SubjectMotion motion;
+  double frame_rate_hz = 30;
+  uint64_t seed = 1;
+  double room_light = 0.6;       // white-surface brightness with room lights on, fraction of full scale
+  double ambient_light = 0.02;   // with room lights off
+  double frame_light = 1.5;      // frame light brightness (saturates a little, like a real diffuser)
+  double speckle_contrast = 0.25;  // std/mean of laser speckle
+};
+
+struct RigDescription {
+  std::string name;
+  std::string source;  // the file it was read from, for messages
+  FrameGeometry frame;
+  std::vector<CameraDescription> cameras;
+  std::vector<LaserDescription> lasers;
+  // Lasers that may run together (thesis §2.3): each group's planes never cross
+  // inside the frame at any pair of steps. Every laser is in exactly one group.
+  std::vector<std::vector<std::string>> laser_groups;
+  SimulationDescription simulation;
+
+  const LaserDescription* find_laser(const std::string& id) const;
+};
+
+// Parses and checks a description. `source` names it in messages and is the folder
+// relative paths (the subject) are resolved against.
+StatusOr<RigDescription> parse_rig_description(const std::string& json_text, const std::string& source);
+StatusOr<RigDescription> load_rig_description(const std::string& path);
+// The description as JSON (what parse_rig_description reads back unchanged).
+std::string to_json(const RigDescription& rig);
+
+// The shipped layouts: "thesis" (thesis fig. 2.2: 3 cameras, 4 lasers, two at a time)
+// and "square" (thesis fig. 6.1: 4 cameras, 4 lasers). Their files live in
+// hw/rigs/; this returns the path for a name, or an error listing the names.
+StatusOr<std::string> shipped_rig_path(const std::string& name);
+
+}  // namespace bodyscan::hw

@@ -1,0 +1,148 @@
+#include "hw/rig_description.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+namespace bodyscan::hw {
+namespace {
+
+RigDescription load_shipped(const std::string& name) {
+  auto path = shipped_rig_path(name);
+  EXPECT_TRUE(path.ok()) << path.status().message();
+  auto rig = load_rig_description(*path);
+  EXPECT_TRUE(rig.ok()) << rig.status().message();
+  return rig.ok() ? *rig : RigDescription{};
+}
+
+// The shipped thesis layout as JSON, for tests to break.
+nlohmann::json thesis_json() {
+  return nlohmann::json::parse(to_json(load_shipped("thesis")));
+}
+
+std::string parse_error(const nlohmann::json& j) {
+  auto r = parse_rig_description(j.dump(), "test.json");
+  EXPECT_FALSE(r.ok());
+  return r.ok() ? "" : r.status().message();
+}
+
+TEST(RigDescription, ShippedLayoutsLoad) {
+  const RigDescription thesis = load_shipped("thesis");
+  EXPECT_EQ(thesis.cameras.size(), 3u);
+  EXPECT_EQ(thesis.lasers.size(), 4u);
+  ASSERT_EQ(thesis.laser_groups.size(), 2u);  // two lasers at a time (thesis §2.3)
+  EXPECT_EQ(thesis.laser_groups[0].size(), 2u);
+  EXPECT_TRUE(std::filesystem::exists(thesis.simulation.subject)) << thesis.simulation.subject;
+  const RigDescription square = load_shipped("square");
+  EXPECT_EQ(square.cameras.size(), 4u);
+  EXPECT_EQ(square.frame.width, square.frame.depth);
+  EXPECT_FALSE(shipped_rig_path("hexagon").ok());
+}
+
+TEST(RigDescription, EveryShippedCameraSeesTheEightLightsOfItsSide) {
+  for (const char* name : {"thesis", "square"}) {
+    const RigDescription rig = load_shipped(name);
+    const FrameGeometry& f = rig.frame;
+    for (const CameraDescription& c : rig.cameras) {
+      const CameraModel m = c.model();
+      const double side = c.position.z() > 0 ? 1.0 : -1.0;  // front cameras see the front poles
+      for (double y : {0.0, f.top_height})
+        for (double x : f.light_x) {
+          const auto p = m.project(Vec3d(x, y, side * 0.5 * f.depth));
+          ASSERT_TRUE(p) << name << " " << c.id;
+          EXPECT_GT(p->x(), 20) << name << " " << c.id << " light x " << x << " y " << y;
+          EXPECT_LT(p->x(), c.width - 21) << name << " " << c.id << " light x " << x << " y " << y;
+          EXPECT_GT(p->y(), 20) << name << " " << c.id << " light x " << x << " y " << y;
+          EXPECT_LT(p->y(), c.height - 21) << name << " " << c.id << " light x " << x << " y " << y;
+        }
+    }
+  }
+}
+
+TEST(RigDescription, EveryShippedLaserPlaneCrossesBothTopPolesAndTheBottomFront) {
+  for (const char* name : {"thesis", "square"}) {
+    const RigDescription rig = load_shipped(name);
+    const double half_w = 0.5 * rig.frame.width - rig.frame.tube, half_d = 0.5 * rig.frame.depth;
+    for (const LaserDescription& l : rig.lasers) {
+      for (int step : {l.min_step, 0, l.max_step}) {
+        const Vec3d n = l.plane_normal(step);
+        EXPECT_NEAR(n.dot(l.axis), 0.0, 1e-12);
+        for (double z : {-half_d, half_d}) {
+          // x where the plane meets the pole z = const (any height: the plane is vertical).
+          const double x = (l.plane_offset(step) - n.z() * z) / n.x();
+          EXPECT_LT(std::abs(x), half_w) << name << " " << l.id << " step " << step << " pole z " << z;
+        }
+      }
+    }
+  }
+}
+
+TEST(RigDescription, PlaneTurnsByTheStepAngle) {
+  LaserDescription l;
+  l.position = Vec3d(0, 1000, 2000);
+  l.aim = -Vec3d::UnitZ();
+  l.step_angle_deg = 0.1;
+  EXPECT_NEAR((l.plane_normal(0) - Vec3d::UnitY().cross(-Vec3d::UnitZ())).norm(), 0.0, 1e-12);
+  const double angle = std::acos(std::clamp(l.plane_normal(0).dot(l.plane_normal(100)), -1.0, 1.0));
+  EXPECT_NEAR(angle * 180 / M_PI, 10.0, 1e-9);
+  EXPECT_NEAR(l.plane_offset(7), l.plane_normal(7).dot(l.position), 1e-9);
+}
+
+TEST(RigDescription, RoundTripsThroughJson) {
+  const RigDescription a = load_shipped("thesis");
+  auto b = parse_rig_description(to_json(a), a.source);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  EXPECT_EQ(to_json(*b), to_json(a));
+  EXPECT_EQ(b->cameras[1].distortion.p2, a.cameras[1].distortion.p2);
+  EXPECT_EQ(b->simulation.subject, a.simulation.subject);
+}
+
+TEST(RigDescription, ErrorsNameTheField) {
+  EXPECT_NE(parse_error(nlohmann::json::parse("{}")).find("missing field 'frame'"), std::string::npos);
+  {
+    auto r = parse_rig_description("{\"frame\": [1,", "broken.json");
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.status().message().find("broken.json: not valid JSON"), std::string::npos) << r.status().message();
+  }
+  auto j = thesis_json();
+  j["cameras"][1]["focal_mm"] = -4;
+  EXPECT_NE(parse_error(j).find("rig.cameras[1]: 'focal_mm' must be positive"), std::string::npos) << parse_error(j);
+  j = thesis_json();
+  j["cameras"][0]["focl_mm"] = 4;
+  EXPECT_NE(parse_error(j).find("unknown field 'focl_mm'"), std::string::npos);
+  j = thesis_json();
+  j["cameras"][2]["id"] = j["cameras"][0]["id"];
+  EXPECT_NE(parse_error(j).find("is used twice"), std::string::npos);
+  j = thesis_json();
+  j["lasers"][0]["position"] = {1, 2};
+  EXPECT_NE(parse_error(j).find("rig.lasers[0]: 'position' must be [x, y, z]"), std::string::npos) << parse_error(j);
+  j = thesis_json();
+  j["laser_groups"][0][0] = "nope";
+  EXPECT_NE(parse_error(j).find("unknown laser id \"nope\""), std::string::npos);
+  j = thesis_json();
+  j["frame"]["light_x"] = {0, 1, 2};
+  EXPECT_NE(parse_error(j).find("4 positions"), std::string::npos);
+  j = thesis_json();
+  j["cameras"][0]["distortion"]["k1"] = -3.0;
+  EXPECT_NE(parse_error(j).find("folds over"), std::string::npos) << parse_error(j);
+  EXPECT_FALSE(load_rig_description("/nonexistent/rig.json").ok());
+}
+
+TEST(RigDescription, LasersWhosePlanesCrossInsideTheFrameCannotRunTogether) {
+  // The two front lasers sweep the same region: their planes meet inside the frame.
+  auto j = thesis_json();
+  using nlohmann::json;  // json::array: a braced list of string pairs would become an object
+  j["laser_groups"] = json::array({json::array({"front-left", "front-right"}), json::array({"back-left", "back-right"})});
+  const std::string e = parse_error(j);
+  EXPECT_NE(e.find("cannot run together: their planes cross inside the frame"), std::string::npos) << e;
+  // A laser left out of every group runs alone.
+  j = thesis_json();
+  j["laser_groups"] = json::array({json::array({"front-left", "back-right"})});
+  auto r = parse_rig_description(j.dump(), "test.json");
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->laser_groups.size(), 3u) << e;
+}
+
+}  // namespace
+}  // namespace bodyscan::hw
