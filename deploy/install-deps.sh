@@ -12,6 +12,7 @@ packages=(
   libnanoflann-dev     # k-nearest-neighbour search (recon)
   libtbb-dev           # parallel loops (recon)
   nlohmann-json3-dev   # rig descriptions, API documents (hw, server)
+  libembree-dev        # ray casting for the simulated rig (hw/sim)
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 if [[ "${1:-}" == "--bench" ]]; then

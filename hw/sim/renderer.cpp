@@ -1,0 +1,173 @@
+#include "hw/sim/renderer.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace bodyscan::hw::sim {
+
+namespace {
+
+constexpr double kReferenceExposureUs = 10000;
+
+double albedo(Surface s) {
+  switch (s) {
+    case Surface::kSubject: return 0.65;  // skin and underwear
+    case Surface::kFrame: return 0.92;    // white tubing
+    case Surface::kFloor: return 0.25;
+    case Surface::kNone: return 0.0;
+  }
+  return 0.0;
+}
+
+struct Light {
+  double base = 0;   // room, ambient and frame lights
+  double laser = 0;  // laser stripes (speckled)
+};
+
+uint64_t mix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
+
+Renderer::Renderer(const CameraDescription& camera, const SimulationDescription& sim)
+    : camera_(camera), sim_(sim), model_(camera.model()) {
+  rays_.assign(static_cast<size_t>(camera.width) * camera.height, Vec3f::Zero());
+  tbb::parallel_for(0, camera.height, [&](int y) {
+    for (int x = 0; x < camera.width; ++x) {
+      const auto r = model_.ray(Vec2d(x, y));
+      if (r) rays_[static_cast<size_t>(y) * camera.width + x] = r->cast<float>();
+    }
+  });
+}
+
+Hit Renderer::surface_at(const Scene& scene, const Vec2d& pixel) const {
+  const auto r = model_.ray(pixel);
+  if (!r) return {};
+  return scene.intersect(model_.centre(), *r);
+}
+
+namespace {
+
+// The light reaching a surface point through pixel (x, y).
+Light light_at(const Scene& scene, const Lighting& lighting, const SimulationDescription& sim, const CameraModel& model,
+               const std::vector<Vec3f>& rays, int width, int height, int x, int y) {
+  Light out;
+  const Vec3f& rf = rays[static_cast<size_t>(y) * width + x];
+  if (rf.isZero()) return out;
+  const Vec3d r = rf.cast<double>();
+  const Vec3d& c = model.centre();
+  const Hit h = scene.intersect(c, r);
+  const double ambient = lighting.room_lights ? sim.room_light : sim.ambient_light;
+  if (h.surface == Surface::kNone) {
+    out.base = 0.05 * ambient;  // the room beyond the rig
+    return out;
+  }
+  const double a = albedo(h.surface);
+  out.base = a * ambient * (0.35 + 0.65 * std::abs(h.normal.dot(r)));
+
+  const FrameGeometry& f = scene.rig().frame;
+  if (lighting.frame_lights && h.surface == Surface::kFrame && std::abs(h.normal.z()) > 0.99) {
+    // The lights sit on the poles' outer faces (front lights face +Z, back -Z).
+    const double side = h.normal.z() > 0 ? 1.0 : -1.0;
+    const double face_z = side * (0.5 * f.depth + 0.5 * f.tube);
+    if (std::abs(h.position.z() - face_z) < 1.0) {
+      const double radius = 0.5 * f.light_diameter;
+      for (double ly : {0.0, f.top_height})
+        for (double lx : f.light_x) {
+          const double rho = std::hypot(h.position.x() - lx, h.position.y() - ly);
+          if (rho < radius) {
+            // A diffuser: even in the middle, falling off over its outer fifth.
+            const double edge = std::clamp((radius - rho) / (0.2 * radius), 0.0, 1.0);
+            out.base += sim.frame_light * edge * edge * (3 - 2 * edge);
+          }
+        }
+    }
+  }
+
+  if (!lighting.lasers.empty()) {
+    // The pixel's footprint on the surface's tangent plane, for the stripe's
+    // profile integrated over the pixel.
+    auto neighbour = [&](int nx, int ny) -> Vec3d {
+      nx = std::clamp(nx, 0, width - 1);
+      ny = std::clamp(ny, 0, height - 1);
+      const Vec3d rn = rays[static_cast<size_t>(ny) * width + nx].cast<double>();
+      const double den = rn.dot(h.normal);
+      if (std::abs(den) < 1e-6) return h.position;
+      return c + ((h.position - c).dot(h.normal) / den) * rn;
+    };
+    const Vec3d dx = neighbour(x + 1, y) - neighbour(x - 1, y), dy = neighbour(x, y + 1) - neighbour(x, y - 1);
+    for (const ActiveLaser& al : lighting.lasers) {
+      const LaserDescription& l = *al.laser;
+      const Vec3d n = l.plane_normal(al.step);
+      const double d = n.dot(h.position) - l.plane_offset(al.step);
+      const double sigma = l.line_width_mm / 2.354820045;
+      const double gx = 0.5 * n.dot(dx), gy = 0.5 * n.dot(dy);  // plane distance per pixel
+      const double var = sigma * sigma + (gx * gx + gy * gy) / 12.0;
+      if (d * d > 16 * var) continue;
+      const Vec3d to_laser = l.position - h.position;
+      const double dist = to_laser.norm();
+      const Vec3d aim = Eigen::AngleAxisd(al.step * l.step_angle_deg * M_PI / 180.0, l.axis) * l.aim;
+      if (aim.dot(-to_laser) <= 0) continue;  // behind the laser's fan
+      const Vec3d toward = to_laser / dist;
+      const double incidence = h.normal.dot(toward);
+      if (incidence <= 0) continue;  // the laser lights the other side
+      if (scene.occluded(h.position + 0.05 * h.normal, toward, dist)) continue;  // laser shadow
+      out.laser += l.power * a * incidence * (sigma / std::sqrt(var)) * std::exp(-0.5 * d * d / var);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<float> Renderer::irradiance(const Scene& scene, const Lighting& lighting) const {
+  const int w = camera_.width, h = camera_.height;
+  std::vector<float> out(static_cast<size_t>(w) * h);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const Light l = light_at(scene, lighting, sim_, model_, rays_, w, h, x, y);
+      out[static_cast<size_t>(y) * w + x] = static_cast<float>(l.base + l.laser);
+    }
+  });
+  return out;
+}
+
+Frame Renderer::render(const Scene& scene, const Lighting& lighting, const Exposure& exposure,
+                       uint64_t frame_number) const {
+  const int w = camera_.width, h = camera_.height;
+  Frame frame;
+  frame.width = w;
+  frame.height = h;
+  frame.format = exposure.format;
+  frame.exposure_us = exposure.exposure_us;
+  frame.gain_db = exposure.gain_db;
+  frame.pixels.resize(static_cast<size_t>(w) * h);
+  const double max_value = (1 << bits_per_pixel(exposure.format)) - 1;
+  const double electrons_per_unit = camera_.full_well_e * exposure.exposure_us / kReferenceExposureUs;
+  const double dn_per_electron = std::pow(10.0, exposure.gain_db / 20.0) * max_value / camera_.full_well_e;
+  const uint64_t seed = mix(sim_.seed ^ mix(frame_number) ^ mix(std::hash<std::string>()(camera_.id)));
+  tbb::parallel_for(0, h, [&](int y) {
+    std::mt19937_64 rng(mix(seed + static_cast<uint64_t>(y)));
+    std::normal_distribution<double> normal;
+    for (int x = 0; x < w; ++x) {
+      const Light l = light_at(scene, lighting, sim_, model_, rays_, w, h, x, y);
+      double units = l.base;
+      if (l.laser > 0) units += l.laser * std::max(0.0, 1.0 + sim_.speckle_contrast * normal(rng));
+      double e = units * electrons_per_unit;
+      e += std::sqrt(std::max(e, 0.0)) * normal(rng) + camera_.read_noise_e * normal(rng);
+      const double dn = std::round(e * dn_per_electron);
+      frame.pixels[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(std::clamp(dn, 0.0, max_value));
+    }
+  });
+  return frame;
+}
+
+}  // namespace bodyscan::hw::sim

@@ -1,0 +1,56 @@
+// What a camera of the simulated rig sees: the scene under room and frame lights,
+// laser stripes where the laser reaches a surface the camera sees, lens distortion
+// (rays are cast through the distorted pixels), speckle, shot and read noise,
+// saturation. Deterministic for a seed and frame number.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "hw/camera.hpp"
+#include "hw/camera_model.hpp"
+#include "hw/sim/scene.hpp"
+
+namespace bodyscan::hw::sim {
+
+struct ActiveLaser {
+  const LaserDescription* laser = nullptr;
+  int step = 0;
+};
+
+struct Lighting {
+  bool room_lights = false;
+  bool frame_lights = false;
+  std::vector<ActiveLaser> lasers;  // the lasers that are on, at their steps
+};
+
+struct Exposure {
+  PixelFormat format = PixelFormat::kMono8;
+  double exposure_us = 10000;
+  double gain_db = 0;
+};
+
+// One camera's renderer: keeps the camera's pixel rays (distortion inverted once).
+class Renderer {
+ public:
+  Renderer(const CameraDescription& camera, const SimulationDescription& sim);
+  const CameraModel& model() const { return model_; }
+
+  // Renders one frame of the scene as it is now. `frame_number` seeds the noise.
+  Frame render(const Scene& scene, const Lighting& lighting, const Exposure& exposure, uint64_t frame_number) const;
+
+  // The noise-free irradiance image, fraction of full scale at the reference
+  // exposure (10 ms, 0 dB): what render() starts from. For tests.
+  std::vector<float> irradiance(const Scene& scene, const Lighting& lighting) const;
+
+  // Ground truth: the surface point seen through a (sub-)pixel, if any.
+  Hit surface_at(const Scene& scene, const Vec2d& pixel) const;
+
+ private:
+  CameraDescription camera_;
+  SimulationDescription sim_;
+  CameraModel model_;
+  std::vector<Vec3f> rays_;  // per pixel, unit, world (zero where the lens model fails)
+};
+
+}  // namespace bodyscan::hw::sim
