@@ -1,0 +1,55 @@
+// The simulated rig: cameras and a controller behind the same interfaces as real
+// hardware, rendering what the cameras would see of the subject in the frames.
+// Ground truth (the scene, the true camera models) is reachable for tests and
+// accuracy reports only; calibration and scanning get the Camera and Controller
+// interfaces like any backend.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "hw/camera.hpp"
+#include "hw/controller.hpp"
+#include "hw/sim/renderer.hpp"
+#include "hw/sim/scene.hpp"
+
+namespace bodyscan::hw::sim {
+
+class SimulatedRig {
+ public:
+  // Loads the subject named in the description (if any) and builds the scene.
+  static StatusOr<std::unique_ptr<SimulatedRig>> create(const RigDescription& rig);
+  // With a subject mesh given directly (mm, Y up); the description's subject is ignored.
+  static StatusOr<std::unique_ptr<SimulatedRig>> create(const RigDescription& rig, const TriangleMesh& subject);
+  ~SimulatedRig();
+
+  const RigDescription& description() const { return rig_; }
+  Controller& controller();
+  size_t num_cameras() const { return cameras_.size(); }
+  Camera& camera(size_t i);
+
+  // Ground truth, for tests and accuracy reports.
+  const Scene& scene() const { return *scene_; }
+  const Renderer& renderer(size_t camera) const { return *renderers_[camera]; }
+
+  // Fault injection: camera `i` answers `frames` more grabs, then fails every grab
+  // with `code` (kDeadlineExceeded: stops answering; kUnavailable: unplugged).
+  void fail_camera_after(size_t i, uint64_t frames, StatusCode code);
+
+ private:
+  SimulatedRig() = default;
+  class SimController;
+  class SimCamera;
+  friend class SimCamera;
+  Lighting lighting() const;  // from the controller's state
+
+  RigDescription rig_;
+  std::unique_ptr<Scene> scene_;
+  std::vector<std::unique_ptr<Renderer>> renderers_;
+  std::unique_ptr<SimController> controller_;
+  std::vector<std::unique_ptr<SimCamera>> cameras_;
+  mutable std::mutex scene_mutex_;  // the scene is posed per grab
+};
+
+}  // namespace bodyscan::hw::sim

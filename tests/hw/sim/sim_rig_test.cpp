@@ -1,0 +1,137 @@
+#include "hw/sim/sim_rig.hpp"
+
+#include <gtest/gtest.h>
+
+namespace bodyscan::hw::sim {
+namespace {
+
+std::unique_ptr<SimulatedRig> thesis_rig(int scale_down = 4) {
+  auto path = shipped_rig_path("thesis");
+  EXPECT_TRUE(path.ok());
+  auto desc = load_rig_description(*path);
+  EXPECT_TRUE(desc.ok()) << desc.status().message();
+  // Quarter-resolution sensors (same field of view) keep the test quick.
+  for (CameraDescription& c : desc->cameras) {
+    c.width /= scale_down;
+    c.height /= scale_down;
+    c.pixel_size_um *= scale_down;
+  }
+  auto rig = SimulatedRig::create(*desc);
+  EXPECT_TRUE(rig.ok()) << rig.status().message();
+  return rig.ok() ? std::move(rig).value() : nullptr;
+}
+
+TEST(SimulatedRig, ControllerStepsLightsAndSafety) {
+  auto rig = thesis_rig();
+  ASSERT_TRUE(rig);
+  Controller& c = rig->controller();
+  EXPECT_EQ(c.num_lasers(), 4);
+  EXPECT_EQ(c.move_to(0, 10).code(), StatusCode::kFailedPrecondition);  // not homed
+  ASSERT_TRUE(c.home(0).ok());
+  EXPECT_TRUE(c.move_to(0, 10).ok());
+  EXPECT_EQ(*c.current_step(0), 10);
+  const Status far = c.move_to(0, 100000);
+  EXPECT_EQ(far.code(), StatusCode::kOutOfRange);
+  EXPECT_NE(far.message().find("front-left"), std::string::npos) << far.message();
+  EXPECT_EQ(c.set_laser(7, true).code(), StatusCode::kInvalidArgument);
+  {
+    LasersOff guard(c);
+    ASSERT_TRUE(c.set_laser(0, true).ok());
+    ASSERT_TRUE(c.set_laser(3, true).ok());
+    EXPECT_TRUE(c.laser_on(0));
+  }
+  for (int i = 0; i < 4; ++i) EXPECT_FALSE(c.laser_on(i)) << "the guard switches every laser off";
+}
+
+TEST(SimulatedRig, GrabsFramesWithIdsTimesAndTheBodyLitByTheLaser) {
+  auto rig = thesis_rig();
+  ASSERT_TRUE(rig);
+  Camera& cam = rig->camera(0);
+  EXPECT_EQ(cam.info().id, "front-left");
+  auto base = cam.grab();
+  ASSERT_TRUE(base.ok()) << base.status().message();
+  EXPECT_EQ(base->frame_id, 1u);
+  EXPECT_EQ(base->width, 320);
+  Controller& c = rig->controller();
+  ASSERT_TRUE(c.home(0).ok());
+  // Aim the front-left laser at the torso (x = -100 at the body's centre plane).
+  const LaserDescription& l = rig->description().lasers[0];
+  int step = 0;
+  double miss = 1e9;
+  for (int s = l.min_step; s <= l.max_step; ++s) {
+    const double x = (l.plane_offset(s) - l.plane_normal(s).y() * 1150) / l.plane_normal(s).x();  // z = 0
+    if (std::abs(x + 100) < miss) miss = std::abs(x + 100), step = s;
+  }
+  ASSERT_TRUE(c.move_to(0, step).ok());
+  ASSERT_TRUE(c.set_laser(0, true).ok());
+  auto lit = cam.grab();
+  ASSERT_TRUE(lit.ok());
+  EXPECT_EQ(lit->frame_id, 2u);
+  EXPECT_GT(lit->timestamp_ns, base->timestamp_ns);
+  // The stripe: many rows have a pixel far brighter than in the base frame, and the
+  // surface under the brightest one lies on the laser's plane.
+  int rows_with_stripe = 0;
+  double worst_plane_distance = 0;
+  for (int y = 0; y < lit->height; ++y) {
+    int best = -1, peak = 0;
+    for (int x = 0; x < lit->width; ++x) {
+      const int d = lit->at(x, y) - base->at(x, y);
+      if (d > peak) peak = d, best = x;
+    }
+    if (peak < 25) continue;
+    ++rows_with_stripe;
+    const Hit h = rig->renderer(0).surface_at(rig->scene(), Vec2d(best, y));
+    ASSERT_NE(h.surface, Surface::kNone);
+    worst_plane_distance = std::max(worst_plane_distance, std::abs(l.plane_normal(step).dot(h.position) - l.plane_offset(step)));
+  }
+  // The body spans about 140 of the 256 rows (the camera sees the whole frame);
+  // the plane crosses the torso and a leg.
+  EXPECT_GT(rows_with_stripe, 25);
+  // Within a (quarter-resolution) pixel's footprint of the plane.
+  EXPECT_LT(worst_plane_distance, 8.0);
+  ASSERT_TRUE(c.all_lasers_off().ok());
+}
+
+TEST(SimulatedRig, CameraThatStopsAnsweringReportsIt) {
+  auto rig = thesis_rig(8);
+  ASSERT_TRUE(rig);
+  rig->fail_camera_after(1, 2, StatusCode::kDeadlineExceeded);
+  rig->fail_camera_after(2, 0, StatusCode::kUnavailable);
+  EXPECT_TRUE(rig->camera(1).grab().ok());
+  EXPECT_TRUE(rig->camera(1).grab().ok());
+  auto third = rig->camera(1).grab(std::chrono::milliseconds(500));
+  ASSERT_FALSE(third.ok());
+  EXPECT_EQ(third.status().code(), StatusCode::kDeadlineExceeded);
+  EXPECT_NE(third.status().message().find("front-right"), std::string::npos);
+  EXPECT_NE(third.status().message().find("500 ms"), std::string::npos);
+  auto gone = rig->camera(2).grab();
+  ASSERT_FALSE(gone.ok());
+  EXPECT_EQ(gone.status().code(), StatusCode::kUnavailable);
+  EXPECT_TRUE(rig->camera(0).grab().ok());  // the others go on
+}
+
+TEST(SimulatedRig, SubjectStandsOnTheFloorAndBreathes) {
+  auto path = shipped_rig_path("thesis");
+  auto desc = load_rig_description(*path);
+  ASSERT_TRUE(desc.ok());
+  desc->simulation.motion.breathing_mm = 6;
+  desc->simulation.motion.breathing_hz = 0.5;
+  desc->cameras.resize(1);
+  desc->cameras[0].width = 64;
+  desc->cameras[0].height = 64;
+  auto rig = SimulatedRig::create(*desc);
+  ASSERT_TRUE(rig.ok()) << rig.status().message();
+  const Scene& s = (*rig)->scene();
+  float min_y = 1e9f;
+  for (const Vec3f& v : s.subject().vertices) min_y = std::min(min_y, v.y());
+  EXPECT_NEAR(min_y, s.floor_y(), 1e-3);
+  // At half a breathing period the chest has moved out by the full amplitude.
+  const TriangleMesh rest = s.subject();
+  const_cast<Scene&>(s).set_time(1.0);
+  double most = 0;
+  for (size_t i = 0; i < rest.vertices.size(); ++i) most = std::max(most, static_cast<double>((s.subject().vertices[i] - rest.vertices[i]).norm()));
+  EXPECT_NEAR(most, 6.0, 0.01);
+}
+
+}  // namespace
+}  // namespace bodyscan::hw::sim
