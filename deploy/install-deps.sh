@@ -13,6 +13,7 @@ packages=(
   libtbb-dev           # parallel loops (recon)
   nlohmann-json3-dev   # rig descriptions, API documents (hw, server)
   libembree-dev        # ray casting for the simulated rig (hw/sim)
+  libpng-dev           # camera images (recon/io)
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 if [[ "${1:-}" == "--bench" ]]; then

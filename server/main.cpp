@@ -5,6 +5,7 @@
 
 namespace bodyscan::cli {
 int run_reconstruct(int argc, char** argv);
+int run_sim(int argc, char** argv);
 }
 
 namespace {
@@ -14,6 +15,7 @@ void print_usage(FILE* out) {
       "\n"
       "commands:\n"
       "  reconstruct IN.ply -o OUT.ply   points (PLY, optional normals) to a watertight mesh\n"
+      "  sim render --rig RIG --out DIR  what the simulated rig's cameras see (PNG + index)\n"
       "\n"
       "Run 'bodyscan <command> --help' for a command's options.\n",
       out);
@@ -31,6 +33,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (cmd == "reconstruct") return bodyscan::cli::run_reconstruct(argc - 1, argv + 1);
+  if (cmd == "sim") return bodyscan::cli::run_sim(argc - 1, argv + 1);
   std::fprintf(stderr, "bodyscan: unknown command '%s'\n", cmd.c_str());
   print_usage(stderr);
   return 2;

@@ -1,0 +1,63 @@
+#include "recon/io/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <system_error>
+
+namespace bodyscan {
+
+namespace {
+std::string errno_text(int error) { return std::generic_category().message(error); }
+}  // namespace
+
+Status write_file_atomically(const std::string& path, std::string_view bytes) {
+  // A reader (or a crash) must never see half a file: write beside the target,
+  // make it durable, then rename over the target in one step.
+  const std::string temp = path + ".tmp-" + std::to_string(::getpid());
+  std::FILE* f = std::fopen(temp.c_str(), "wb");
+  if (f == nullptr) {
+    const int error = errno;
+    return io_error(path + ": cannot create " + temp + ": " + errno_text(error));
+  }
+  auto fail = [&](const std::string& what, int error) {
+    if (f != nullptr) std::fclose(f);
+    std::remove(temp.c_str());
+    return io_error(path + ": " + what + ": " + errno_text(error));
+  };
+  if (!bytes.empty() && std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size()) {
+    const int error = errno;
+    return fail("cannot write " + temp, error);
+  }
+  if (std::fflush(f) != 0) {
+    const int error = errno;
+    return fail("cannot write " + temp, error);
+  }
+  if (::fsync(::fileno(f)) != 0) {
+    const int error = errno;
+    return fail("cannot sync " + temp, error);
+  }
+  const int closed = std::fclose(f);
+  const int close_error = errno;
+  f = nullptr;
+  if (closed != 0) return fail("cannot close " + temp, close_error);
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    const int error = errno;
+    return fail("cannot rename " + temp + " to " + path, error);
+  }
+  // Make the rename itself durable. Best effort: the data is already in place, and
+  // some file systems refuse fsync on directories.
+  const size_t slash = path.find_last_of('/');
+  const std::string dir =
+      slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+  return Status::Ok();
+}
+
+}  // namespace bodyscan
