@@ -21,10 +21,11 @@ void usage(FILE* out) {
   std::fputs(
       "usage: bodyscan sim render --rig RIG --out DIR [options]\n"
       "\n"
-      "Renders what the simulated rig's cameras see during one calibration (room\n"
-      "lights, frame lights off and on) and one full scan (per laser group: a base\n"
-      "frame with the lasers off, then every step with the group's lasers on), as\n"
-      "PNG images in DIR with DIR/index.json listing them.\n"
+      "Renders what the simulated rig's cameras see during one calibration (the\n"
+      "dot-grid target before each camera, room lights, frame lights off and on) and\n"
+      "one full scan (per laser group: a base frame with the lasers off, then every\n"
+      "step with the group's lasers on), as PNG images in DIR with DIR/index.json\n"
+      "listing them.\n"
       "\n"
       "  --rig RIG        thesis, square, or a rig description file (JSON)\n"
       "  --body BODY.ply  the subject (default: the rig description's)\n"
@@ -168,7 +169,27 @@ int run_sim(int argc, char** argv) {
     return s.ok();
   };
 
-  // Calibration: the room, then the frame lights off and on (thesis §3.1.2).
+  // Calibration: the dot grid held before each camera in turn (thesis §3.1.1), the
+  // room, then the frame lights off and on (thesis §3.1.2).
+  if (!check(ctl.set_room_lights(true))) return 1;
+  for (size_t c = 0; c < rig.num_cameras(); ++c) {
+    rig.hold_dot_grid(c, true);
+    auto frame = rig.camera(c).grab();
+    rig.hold_dot_grid(c, false);
+    if (!frame.ok()) {
+      std::fprintf(stderr, "bodyscan sim render: %s\n", frame.status().message().c_str());
+      return 1;
+    }
+    const std::string id = rig.camera(c).info().id;
+    const std::string file = "calibration/" + id + "/dot_grid.png";
+    std::filesystem::create_directories(std::filesystem::path(out) / "calibration" / id, ec);
+    GrayImage img{frame->width, frame->height, hw::bits_per_pixel(frame->format) > 8 ? 16 : 8, std::move(frame->pixels)};
+    if (!check(write_png((std::filesystem::path(out) / file).string(), img))) return 1;
+    index["images"].push_back({{"file", file}, {"camera", id}, {"phase", "calibration"}, {"name", "dot_grid"},
+                               {"lasers", nlohmann::json::array()}, {"frame_id", frame->frame_id},
+                               {"timestamp_ns", frame->timestamp_ns}});
+    ++written;
+  }
   if (!check(ctl.set_room_lights(true)) || !grab_all("calibration", "room", nlohmann::json::array())) return 1;
   if (!check(ctl.set_room_lights(false)) || !check(ctl.set_frame_lights(false)) ||
       !grab_all("calibration", "frame_lights_off", nlohmann::json::array()))

@@ -140,6 +140,32 @@ std::vector<float> Renderer::irradiance(const Scene& scene, const Lighting& ligh
   return out;
 }
 
+Frame expose(const std::vector<float>& irradiance, const CameraDescription& camera, const Exposure& exposure,
+             uint64_t seed) {
+  const int w = camera.width, h = camera.height;
+  Frame frame;
+  frame.width = w;
+  frame.height = h;
+  frame.format = exposure.format;
+  frame.exposure_us = exposure.exposure_us;
+  frame.gain_db = exposure.gain_db;
+  frame.pixels.resize(static_cast<size_t>(w) * h);
+  const double max_value = (1 << bits_per_pixel(exposure.format)) - 1;
+  const double electrons_per_unit = camera.full_well_e * exposure.exposure_us / kReferenceExposureUs;
+  const double dn_per_electron = std::pow(10.0, exposure.gain_db / 20.0) * max_value / camera.full_well_e;
+  tbb::parallel_for(0, h, [&](int y) {
+    std::mt19937_64 rng(mix(seed + static_cast<uint64_t>(y)));
+    std::normal_distribution<double> normal;
+    for (int x = 0; x < w; ++x) {
+      double e = irradiance[static_cast<size_t>(y) * w + x] * electrons_per_unit;
+      e += std::sqrt(std::max(e, 0.0)) * normal(rng) + camera.read_noise_e * normal(rng);
+      const double dn = std::round(e * dn_per_electron);
+      frame.pixels[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(std::clamp(dn, 0.0, max_value));
+    }
+  });
+  return frame;
+}
+
 Frame Renderer::render(const Scene& scene, const Lighting& lighting, const Exposure& exposure,
                        uint64_t frame_number) const {
   const int w = camera_.width, h = camera_.height;

@@ -30,6 +30,12 @@ struct Exposure {
   double gain_db = 0;
 };
 
+// Turns irradiance (fraction of full scale at the reference exposure of 10 ms, 0 dB)
+// into a frame: shot and read noise, gain, quantisation, saturation. Deterministic
+// for a seed.
+Frame expose(const std::vector<float>& irradiance, const CameraDescription& camera, const Exposure& exposure,
+             uint64_t seed);
+
 // One camera's renderer: keeps the camera's pixel rays (distortion inverted once).
 class Renderer {
  public:

@@ -117,9 +117,18 @@ class SimulatedRig::SimCamera : public Camera {
     ++answered_;
     const uint64_t id = ++frame_id_;
     const double time = static_cast<double>(id - 1) / rig_.rig_.simulation.frame_rate_hz;
-    std::lock_guard<std::mutex> lock(rig_.scene_mutex_);
-    rig_.scene_->set_time(time);
-    Frame f = rig_.renderers_[index_]->render(*rig_.scene_, rig_.lighting(), exposure_, id);
+    Frame f;
+    if (rig_.dot_grid_held_[index_]) {
+      CameraDescription d = rig_.rig_.cameras[index_];
+      d.pixel_format = exposure_.format;
+      d.exposure_us = exposure_.exposure_us;
+      d.gain_db = exposure_.gain_db;
+      f = render_dot_grid(d, rig_.rig_.simulation, rig_.dot_grids_[index_], id);
+    } else {
+      std::lock_guard<std::mutex> lock(rig_.scene_mutex_);
+      rig_.scene_->set_time(time);
+      f = rig_.renderers_[index_]->render(*rig_.scene_, rig_.lighting(), exposure_, id);
+    }
     f.frame_id = id;
     f.timestamp_ns = static_cast<int64_t>(time * 1e9);
     return f;
@@ -158,12 +167,18 @@ StatusOr<std::unique_ptr<SimulatedRig>> SimulatedRig::create(const RigDescriptio
   ASSIGN_OR_RETURN(r->scene_, Scene::create(r->rig_, subject));
   for (const CameraDescription& c : r->rig_.cameras) r->renderers_.push_back(std::make_unique<Renderer>(c, r->rig_.simulation));
   r->controller_ = std::make_unique<SimController>(r->rig_);
-  for (size_t i = 0; i < r->rig_.cameras.size(); ++i) r->cameras_.push_back(std::make_unique<SimCamera>(*r, i));
+  for (size_t i = 0; i < r->rig_.cameras.size(); ++i) {
+    r->cameras_.push_back(std::make_unique<SimCamera>(*r, i));
+    r->dot_grids_.push_back(dot_grid_for(r->renderers_[i]->model()));
+  }
+  r->dot_grid_held_.assign(r->rig_.cameras.size(), false);
   return r;
 }
 
 Controller& SimulatedRig::controller() { return *controller_; }
 Camera& SimulatedRig::camera(size_t i) { return *cameras_.at(i); }
+
+void SimulatedRig::hold_dot_grid(size_t i, bool held) { dot_grid_held_.at(i) = held; }
 
 void SimulatedRig::fail_camera_after(size_t i, uint64_t frames, StatusCode code) { cameras_.at(i)->fail_after(frames, code); }
 

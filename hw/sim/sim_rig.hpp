@@ -11,6 +11,7 @@
 
 #include "hw/camera.hpp"
 #include "hw/controller.hpp"
+#include "hw/sim/dot_grid.hpp"
 #include "hw/sim/renderer.hpp"
 #include "hw/sim/scene.hpp"
 
@@ -33,6 +34,11 @@ class SimulatedRig {
   const Scene& scene() const { return *scene_; }
   const Renderer& renderer(size_t camera) const { return *renderers_[camera]; }
 
+  // The operator holds the lens-calibration dot grid (dot_grid_for) in front of
+  // camera `i`: until taken away, that camera's frames show the board.
+  void hold_dot_grid(size_t i, bool held);
+  const DotGridTarget& dot_grid(size_t i) const { return dot_grids_.at(i); }
+
   // Fault injection: camera `i` answers `frames` more grabs, then fails every grab
   // with `code` (kDeadlineExceeded: stops answering; kUnavailable: unplugged).
   void fail_camera_after(size_t i, uint64_t frames, StatusCode code);
@@ -49,6 +55,8 @@ class SimulatedRig {
   std::vector<std::unique_ptr<Renderer>> renderers_;
   std::unique_ptr<SimController> controller_;
   std::vector<std::unique_ptr<SimCamera>> cameras_;
+  std::vector<DotGridTarget> dot_grids_;
+  std::vector<bool> dot_grid_held_;
   mutable std::mutex scene_mutex_;  // the scene is posed per grab
 };
 
