@@ -35,6 +35,20 @@ uint64_t mix(uint64_t x) {
   return x ^ (x >> 31);
 }
 
+// A standard normal deviate for a key: 2^16 fixed deviates drawn once, picked by a
+// hash of the key. Frames need millions per frame; drawing them afresh each time
+// cost more than the rest of the rendering.
+double standard_normal(uint64_t key) {
+  static const std::vector<float> table = [] {
+    std::vector<float> t(1 << 16);
+    std::mt19937_64 rng(20091);
+    std::normal_distribution<float> n;
+    for (float& v : t) v = n(rng);
+    return t;
+  }();
+  return table[mix(key) & 0xffff];
+}
+
 }  // namespace
 
 Renderer::Renderer(const CameraDescription& camera, const SimulationDescription& sim)
@@ -57,14 +71,36 @@ Hit Renderer::surface_at(const Scene& scene, const Vec2d& pixel) const {
 namespace {
 
 // The light reaching a surface point through pixel (x, y).
-Light light_at(const Scene& scene, const Lighting& lighting, const SimulationDescription& sim, const CameraModel& model,
-               const std::vector<Vec3f>& rays, int width, int height, int x, int y) {
+// An active laser's plane, worked out once per frame.
+struct LaserPlane {
+  const LaserDescription* laser;
+  Vec3d normal, aim;
+  double offset, sigma;
+};
+std::vector<LaserPlane> laser_planes(const Lighting& lighting) {
+  std::vector<LaserPlane> out;
+  for (const ActiveLaser& al : lighting.lasers) {
+    const LaserDescription& l = *al.laser;
+    out.push_back({&l, l.plane_normal(al.step),
+                   Eigen::AngleAxisd(al.step * l.step_angle_deg * M_PI / 180.0, l.axis) * l.aim,
+                   l.plane_offset(al.step), l.line_width_mm / 2.354820045});
+  }
+  return out;
+}
+
+template <typename CachedHit>
+Light light_at(const Scene& scene, const Lighting& lighting, const std::vector<LaserPlane>& lasers,
+               const SimulationDescription& sim, const CameraModel& model, const std::vector<Vec3f>& rays,
+               const CachedHit& cached, int width, int height, int x, int y) {
   Light out;
   const Vec3f& rf = rays[static_cast<size_t>(y) * width + x];
   if (rf.isZero()) return out;
   const Vec3d r = rf.cast<double>();
   const Vec3d& c = model.centre();
-  const Hit h = scene.intersect(c, r);
+  Hit h;
+  h.surface = cached.surface;
+  h.position = cached.position.template cast<double>();
+  h.normal = cached.normal.template cast<double>();
   const double ambient = lighting.room_lights ? sim.room_light : sim.ambient_light;
   if (h.surface == Surface::kNone) {
     out.base = 0.05 * ambient;  // the room beyond the rig
@@ -92,9 +128,14 @@ Light light_at(const Scene& scene, const Lighting& lighting, const SimulationDes
     }
   }
 
-  if (!lighting.lasers.empty()) {
+  if (!lasers.empty()) {
     // The pixel's footprint on the surface's tangent plane, for the stripe's
-    // profile integrated over the pixel.
+    // profile integrated over the pixel; needed only near a laser plane.
+    const double footprint =
+        (h.position - c).norm() / model.fx() / std::max(0.1, std::abs(h.normal.dot(r)));
+    bool near = false;
+    for (const LaserPlane& p : lasers) near = near || std::abs(p.normal.dot(h.position) - p.offset) < 4 * p.sigma + 4 * footprint;
+    if (!near) return out;
     auto neighbour = [&](int nx, int ny) -> Vec3d {
       nx = std::clamp(nx, 0, width - 1);
       ny = std::clamp(ny, 0, height - 1);
@@ -104,18 +145,17 @@ Light light_at(const Scene& scene, const Lighting& lighting, const SimulationDes
       return c + ((h.position - c).dot(h.normal) / den) * rn;
     };
     const Vec3d dx = neighbour(x + 1, y) - neighbour(x - 1, y), dy = neighbour(x, y + 1) - neighbour(x, y - 1);
-    for (const ActiveLaser& al : lighting.lasers) {
-      const LaserDescription& l = *al.laser;
-      const Vec3d n = l.plane_normal(al.step);
-      const double d = n.dot(h.position) - l.plane_offset(al.step);
-      const double sigma = l.line_width_mm / 2.354820045;
+    for (const LaserPlane& p : lasers) {
+      const LaserDescription& l = *p.laser;
+      const Vec3d& n = p.normal;
+      const double d = n.dot(h.position) - p.offset;
+      const double sigma = p.sigma;
       const double gx = 0.5 * n.dot(dx), gy = 0.5 * n.dot(dy);  // plane distance per pixel
       const double var = sigma * sigma + (gx * gx + gy * gy) / 12.0;
       if (d * d > 16 * var) continue;
       const Vec3d to_laser = l.position - h.position;
       const double dist = to_laser.norm();
-      const Vec3d aim = Eigen::AngleAxisd(al.step * l.step_angle_deg * M_PI / 180.0, l.axis) * l.aim;
-      if (aim.dot(-to_laser) <= 0) continue;  // behind the laser's fan
+      if (p.aim.dot(-to_laser) <= 0) continue;  // behind the laser's fan
       const Vec3d toward = to_laser / dist;
       const double incidence = h.normal.dot(toward);
       if (incidence <= 0) continue;  // the laser lights the other side
@@ -131,10 +171,13 @@ Light light_at(const Scene& scene, const Lighting& lighting, const SimulationDes
 std::vector<float> Renderer::irradiance(const Scene& scene, const Lighting& lighting) const {
   const int w = camera_.width, h = camera_.height;
   std::vector<float> out(static_cast<size_t>(w) * h);
+  const std::vector<CachedHit>& hit = hits(scene);
+  const std::vector<LaserPlane> planes = laser_planes(lighting);
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
-      const Light l = light_at(scene, lighting, sim_, model_, rays_, w, h, x, y);
-      out[static_cast<size_t>(y) * w + x] = static_cast<float>(l.base + l.laser);
+      const size_t i = static_cast<size_t>(y) * w + x;
+      const Light l = light_at(scene, lighting, planes, sim_, model_, rays_, hit[i], w, h, x, y);
+      out[i] = static_cast<float>(l.base + l.laser);
     }
   });
   return out;
@@ -154,11 +197,10 @@ Frame expose(const std::vector<float>& irradiance, const CameraDescription& came
   const double electrons_per_unit = camera.full_well_e * exposure.exposure_us / kReferenceExposureUs;
   const double dn_per_electron = std::pow(10.0, exposure.gain_db / 20.0) * max_value / camera.full_well_e;
   tbb::parallel_for(0, h, [&](int y) {
-    std::mt19937_64 rng(mix(seed + static_cast<uint64_t>(y)));
-    std::normal_distribution<double> normal;
     for (int x = 0; x < w; ++x) {
+      const uint64_t key = seed ^ mix(static_cast<uint64_t>(y) * static_cast<uint64_t>(w) + static_cast<uint64_t>(x));
       double e = irradiance[static_cast<size_t>(y) * w + x] * electrons_per_unit;
-      e += std::sqrt(std::max(e, 0.0)) * normal(rng) + camera.read_noise_e * normal(rng);
+      e += std::sqrt(std::max(e, 0.0)) * standard_normal(key) + camera.read_noise_e * standard_normal(key ^ 0x5bd1e995);
       const double dn = std::round(e * dn_per_electron);
       frame.pixels[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(std::clamp(dn, 0.0, max_value));
     }
@@ -169,31 +211,37 @@ Frame expose(const std::vector<float>& irradiance, const CameraDescription& came
 Frame Renderer::render(const Scene& scene, const Lighting& lighting, const Exposure& exposure,
                        uint64_t frame_number) const {
   const int w = camera_.width, h = camera_.height;
-  Frame frame;
-  frame.width = w;
-  frame.height = h;
-  frame.format = exposure.format;
-  frame.exposure_us = exposure.exposure_us;
-  frame.gain_db = exposure.gain_db;
-  frame.pixels.resize(static_cast<size_t>(w) * h);
-  const double max_value = (1 << bits_per_pixel(exposure.format)) - 1;
-  const double electrons_per_unit = camera_.full_well_e * exposure.exposure_us / kReferenceExposureUs;
-  const double dn_per_electron = std::pow(10.0, exposure.gain_db / 20.0) * max_value / camera_.full_well_e;
+  const std::vector<CachedHit>& hit = hits(scene);
+  const std::vector<LaserPlane> planes = laser_planes(lighting);
+  std::vector<float> irradiance(static_cast<size_t>(w) * h);
   const uint64_t seed = mix(sim_.seed ^ mix(frame_number) ^ mix(std::hash<std::string>()(camera_.id)));
   tbb::parallel_for(0, h, [&](int y) {
-    std::mt19937_64 rng(mix(seed + static_cast<uint64_t>(y)));
-    std::normal_distribution<double> normal;
     for (int x = 0; x < w; ++x) {
-      const Light l = light_at(scene, lighting, sim_, model_, rays_, w, h, x, y);
+      const size_t i = static_cast<size_t>(y) * w + x;
+      const Light l = light_at(scene, lighting, planes, sim_, model_, rays_, hit[i], w, h, x, y);
       double units = l.base;
-      if (l.laser > 0) units += l.laser * std::max(0.0, 1.0 + sim_.speckle_contrast * normal(rng));
-      double e = units * electrons_per_unit;
-      e += std::sqrt(std::max(e, 0.0)) * normal(rng) + camera_.read_noise_e * normal(rng);
-      const double dn = std::round(e * dn_per_electron);
-      frame.pixels[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(std::clamp(dn, 0.0, max_value));
+      if (l.laser > 0) units += l.laser * std::max(0.0, 1.0 + sim_.speckle_contrast * standard_normal(seed ^ mix(i)));
+      irradiance[i] = static_cast<float>(units);
     }
   });
-  return frame;
+  return expose(irradiance, camera_, exposure, seed);
+}
+
+const std::vector<Renderer::CachedHit>& Renderer::hits(const Scene& scene) const {
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  if (hits_version_ == scene.version() && !hits_.empty()) return hits_;
+  const int w = camera_.width, h = camera_.height;
+  hits_.assign(static_cast<size_t>(w) * h, CachedHit{});
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = static_cast<size_t>(y) * w + x;
+      if (rays_[i].isZero()) continue;
+      const Hit hh = scene.intersect(model_.centre(), rays_[i].cast<double>());
+      hits_[i] = {hh.position.cast<float>(), hh.normal.cast<float>(), hh.surface};
+    }
+  });
+  hits_version_ = scene.version();
+  return hits_;
 }
 
 }  // namespace bodyscan::hw::sim

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <mutex>
 #include <vector>
 
 #include "hw/camera.hpp"
@@ -53,10 +54,22 @@ class Renderer {
   Hit surface_at(const Scene& scene, const Vec2d& pixel) const;
 
  private:
+  // What each pixel's ray hits, cast once per scene version: a still scene is cast
+  // once for all its frames, and each frame only adds shadow rays near the stripes.
+  struct CachedHit {
+    Vec3f position = Vec3f::Zero();
+    Vec3f normal = Vec3f::Zero();
+    Surface surface = Surface::kNone;
+  };
+  const std::vector<CachedHit>& hits(const Scene& scene) const;
+
   CameraDescription camera_;
   SimulationDescription sim_;
   CameraModel model_;
   std::vector<Vec3f> rays_;  // per pixel, unit, world (zero where the lens model fails)
+  mutable std::mutex cache_mutex_;
+  mutable std::vector<CachedHit> hits_;
+  mutable uint64_t hits_version_ = 0;
 };
 
 }  // namespace bodyscan::hw::sim

@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -55,6 +56,8 @@ Scene::~Scene() = default;
 
 StatusOr<std::unique_ptr<Scene>> Scene::create(const RigDescription& rig, const TriangleMesh& subject) {
   std::unique_ptr<Scene> s(new Scene());
+  static std::atomic<uint64_t> next_version{1};
+  s->version_ = next_version.fetch_add(1ull << 32);  // each scene its own range
   s->rig_ = rig;
   s->rt_ = std::make_unique<Embree>();
   Embree& e = *s->rt_;
@@ -149,6 +152,7 @@ void Scene::set_time(double time_s) {
   rtcUpdateGeometryBuffer(rt_->subject, RTC_BUFFER_TYPE_VERTEX, 0);
   rtcCommitGeometry(rt_->subject);
   rtcCommitScene(rt_->scene);
+  ++version_;
 }
 
 Hit Scene::intersect(const Vec3d& origin, const Vec3d& dir, double t_min, double t_max) const {

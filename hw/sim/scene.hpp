@@ -35,6 +35,9 @@ class Scene {
   void set_time(double time_s);
   double time() const { return time_; }
   bool moves() const;
+  // Changes whenever the geometry does (a moving subject posed anew), so renderers
+  // can keep what they cast for a still scene. Distinct per Scene object.
+  uint64_t version() const { return version_; }
 
   // The nearest surface along origin + t dir, t in (t_min, t_max); dir unit.
   Hit intersect(const Vec3d& origin, const Vec3d& dir, double t_min = 1e-3, double t_max = 1e9) const;
@@ -56,6 +59,7 @@ class Scene {
   std::vector<float> breathing_weight_;  // per vertex, 0..1
   Vec3d body_axis_ = Vec3d::Zero();      // a point on the subject's vertical axis
   double time_ = 0;
+  uint64_t version_ = 0;
   std::vector<Vec3f> frame_vertices_;
   std::vector<Triangle> frame_triangles_;
 };
