@@ -38,7 +38,7 @@ uint64_t mix(uint64_t x) {
 // A standard normal deviate for a key: 2^16 fixed deviates drawn once, picked by a
 // hash of the key. Frames need millions per frame; drawing them afresh each time
 // cost more than the rest of the rendering.
-double standard_normal(uint64_t key) {
+const std::vector<float>& normal_table() {
   static const std::vector<float> table = [] {
     std::vector<float> t(1 << 16);
     std::mt19937_64 rng(20091);
@@ -46,8 +46,9 @@ double standard_normal(uint64_t key) {
     for (float& v : t) v = n(rng);
     return t;
   }();
-  return table[mix(key) & 0xffff];
+  return table;
 }
+double standard_normal(uint64_t key) { return normal_table()[mix(key) & 0xffff]; }
 
 }  // namespace
 
@@ -196,13 +197,18 @@ Frame expose(const std::vector<float>& irradiance, const CameraDescription& came
   const double max_value = (1 << bits_per_pixel(exposure.format)) - 1;
   const double electrons_per_unit = camera.full_well_e * exposure.exposure_us / kReferenceExposureUs;
   const double dn_per_electron = std::pow(10.0, exposure.gain_db / 20.0) * max_value / camera.full_well_e;
+  const float* table = normal_table().data();
+  const float epu = static_cast<float>(electrons_per_unit), dpe = static_cast<float>(dn_per_electron);
+  const float read = static_cast<float>(camera.read_noise_e), top = static_cast<float>(max_value);
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
-      const uint64_t key = seed ^ mix(static_cast<uint64_t>(y) * static_cast<uint64_t>(w) + static_cast<uint64_t>(x));
-      double e = irradiance[static_cast<size_t>(y) * w + x] * electrons_per_unit;
-      e += std::sqrt(std::max(e, 0.0)) * standard_normal(key) + camera.read_noise_e * standard_normal(key ^ 0x5bd1e995);
-      const double dn = std::round(e * dn_per_electron);
-      frame.pixels[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(std::clamp(dn, 0.0, max_value));
+      const size_t i = static_cast<size_t>(y) * w + x;
+      // One hash per pixel gives both deviates (shot and read noise).
+      const uint64_t key = mix(seed ^ (static_cast<uint64_t>(i) * 0x9e3779b97f4a7c15ULL));
+      float e = irradiance[i] * epu;
+      e += std::sqrt(std::max(e, 0.f)) * table[key & 0xffff] + read * table[(key >> 16) & 0xffff];
+      const float dn = std::clamp(std::nearbyint(e * dpe), 0.f, top);
+      frame.pixels[i] = static_cast<uint16_t>(dn);
     }
   });
   return frame;
@@ -213,18 +219,48 @@ Frame Renderer::render(const Scene& scene, const Lighting& lighting, const Expos
   const int w = camera_.width, h = camera_.height;
   const std::vector<CachedHit>& hit = hits(scene);
   const std::vector<LaserPlane> planes = laser_planes(lighting);
-  std::vector<float> irradiance(static_cast<size_t>(w) * h);
+  std::vector<float> irradiance = base_irradiance(scene, lighting);
   const uint64_t seed = mix(sim_.seed ^ mix(frame_number) ^ mix(std::hash<std::string>()(camera_.id)));
+  if (!planes.empty()) {
+    // Only pixels whose surface lies near a laser plane can take laser light; a
+    // dot product per pixel finds them (60 mm covers any pixel footprint here).
+    tbb::parallel_for(0, h, [&](int y) {
+      for (int x = 0; x < w; ++x) {
+        const size_t i = static_cast<size_t>(y) * w + x;
+        if (hit[i].surface == Surface::kNone) continue;
+        const Vec3d p = hit[i].position.cast<double>();
+        bool near = false;
+        for (const LaserPlane& lp : planes) near = near || std::abs(lp.normal.dot(p) - lp.offset) < 4 * lp.sigma + 60;
+        if (!near) continue;
+        const Light l = light_at(scene, lighting, planes, sim_, model_, rays_, hit[i], w, h, x, y);
+        if (l.laser > 0) {
+          irradiance[i] += static_cast<float>(l.laser * std::max(0.0, 1.0 + sim_.speckle_contrast * standard_normal(seed ^ mix(i))));
+        }
+      }
+    });
+  }
+  return expose(irradiance, camera_, exposure, seed);
+}
+
+const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Lighting& lighting) const {
+  const std::vector<CachedHit>& hit = hits(scene);
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  const int key = (lighting.room_lights ? 1 : 0) | (lighting.frame_lights ? 2 : 0);
+  BaseCache& cache = base_[key];
+  if (cache.version == scene.version() && !cache.irradiance.empty()) return cache.irradiance;
+  const int w = camera_.width, h = camera_.height;
+  Lighting no_lasers = lighting;
+  no_lasers.lasers.clear();
+  const std::vector<LaserPlane> none;
+  cache.irradiance.assign(static_cast<size_t>(w) * h, 0.f);
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const size_t i = static_cast<size_t>(y) * w + x;
-      const Light l = light_at(scene, lighting, planes, sim_, model_, rays_, hit[i], w, h, x, y);
-      double units = l.base;
-      if (l.laser > 0) units += l.laser * std::max(0.0, 1.0 + sim_.speckle_contrast * standard_normal(seed ^ mix(i)));
-      irradiance[i] = static_cast<float>(units);
+      cache.irradiance[i] = static_cast<float>(light_at(scene, no_lasers, none, sim_, model_, rays_, hit[i], w, h, x, y).base);
     }
   });
-  return expose(irradiance, camera_, exposure, seed);
+  cache.version = scene.version();
+  return cache.irradiance;
 }
 
 const std::vector<Renderer::CachedHit>& Renderer::hits(const Scene& scene) const {

@@ -62,6 +62,12 @@ class Renderer {
     Surface surface = Surface::kNone;
   };
   const std::vector<CachedHit>& hits(const Scene& scene) const;
+  // The irradiance without lasers, per room/frame light state, per scene version.
+  const std::vector<float>& base_irradiance(const Scene& scene, const Lighting& lighting) const;
+  struct BaseCache {
+    uint64_t version = 0;
+    std::vector<float> irradiance;
+  };
 
   CameraDescription camera_;
   SimulationDescription sim_;
@@ -70,6 +76,7 @@ class Renderer {
   mutable std::mutex cache_mutex_;
   mutable std::vector<CachedHit> hits_;
   mutable uint64_t hits_version_ = 0;
+  mutable BaseCache base_[4];
 };
 
 }  // namespace bodyscan::hw::sim
