@@ -1,5 +1,7 @@
 #include "hw/sim/sim_rig.hpp"
 
+#include "recon/io/ply.hpp"
+
 #include <gtest/gtest.h>
 
 namespace bodyscan::hw::sim {
@@ -108,6 +110,35 @@ TEST(SimulatedRig, CameraThatStopsAnsweringReportsIt) {
   ASSERT_FALSE(gone.ok());
   EXPECT_EQ(gone.status().code(), StatusCode::kUnavailable);
   EXPECT_TRUE(rig->camera(0).grab().ok());  // the others go on
+}
+
+TEST(SimulatedRig, ShippedRigsTakeAStandingAdultOfTwoMetres) {
+  // The demo body scaled to 2.0 m (arms abducted as shipped): it stands inside both
+  // shipped frames, clear of the tubing, and every camera sees all of it.
+  auto body = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
+  ASSERT_TRUE(body.ok());
+  float lo = 1e9f, hi = -1e9f;
+  for (const Vec3f& v : body->vertices) lo = std::min(lo, v.y()), hi = std::max(hi, v.y());
+  for (Vec3f& v : body->vertices) v *= 2000.f / (hi - lo);
+  for (const char* name : {"thesis", "square"}) {
+    auto desc = load_rig_description(*shipped_rig_path(name));
+    ASSERT_TRUE(desc.ok());
+    auto rig = SimulatedRig::create(*desc, *body);
+    ASSERT_TRUE(rig.ok()) << rig.status().message();
+    const FrameGeometry& f = desc->frame;
+    for (const Vec3f& v : (*rig)->scene().subject().vertices) {
+      ASSERT_LT(std::abs(v.x()), 0.5 * f.width - f.tube) << name;
+      ASSERT_LT(std::abs(v.z()), 0.5 * f.depth - f.tube) << name;
+      ASSERT_LT(v.y(), f.top_height - f.tube) << name;
+    }
+    for (size_t c = 0; c < (*rig)->num_cameras(); ++c) {
+      const CameraModel& m = (*rig)->renderer(c).model();
+      for (const Vec3f& v : (*rig)->scene().subject().vertices) {
+        const auto p = m.project(v.cast<double>());
+        ASSERT_TRUE(p && m.in_image(*p)) << name << " camera " << c;
+      }
+    }
+  }
 }
 
 TEST(SimulatedRig, SubjectStandsOnTheFloorAndBreathes) {
