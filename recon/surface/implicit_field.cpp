@@ -117,6 +117,7 @@ __attribute__((always_inline)) inline float exp_nonpositive(float x) {
 // (q < r2) and in the normal slab; the caller may pass any superset of those nodes
 // (whole 8-node chunks, so the vector loop needs no scalar tail) without changing
 // a single value.
+//
 // The sphere's sag from the paraboloid's: sag * 2 / (1 + sqrt(1 - x)), x = kx sag =
 // bend^2 r^2 <= 1. Kernels whose support keeps x <= 1/4 (every kernel of a densely
 // sampled surface) use that factor's series sum_n Catalan(n) (x / 4)^n to the fifth
