@@ -1,0 +1,69 @@
+#include "recon/scan/stripe.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace bodyscan {
+
+namespace {
+
+// max over the row of (f - b) saturated at 0. Plain loop with unsigned arithmetic
+// that GCC turns into saturating vector subtracts and maxima.
+__attribute__((target_clones("arch=haswell", "default"))) uint16_t row_peak(const uint16_t* __restrict f,
+                                                                           const uint16_t* __restrict b, int n) {
+  uint16_t m = 0;
+  for (int i = 0; i < n; ++i) {
+    const uint16_t d = f[i] > b[i] ? static_cast<uint16_t>(f[i] - b[i]) : 0;
+    m = d > m ? d : m;
+  }
+  return m;
+}
+
+}  // namespace
+
+StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const ImageView& base,
+                                                   const StripeOptions& options, int full_scale) {
+  if (frame.width != base.width || frame.height != base.height) {
+    return invalid_argument("stripe extraction: the frame is " + std::to_string(frame.width) + "x" +
+                            std::to_string(frame.height) + " but the base frame is " + std::to_string(base.width) +
+                            "x" + std::to_string(base.height));
+  }
+  if (frame.width <= 0 || frame.height <= 0 || !frame.pixels || !base.pixels) {
+    return invalid_argument("stripe extraction: empty image");
+  }
+  if (options.radius < 0 || options.radius > 64 || options.threshold < 1) {
+    return invalid_argument("stripe extraction: radius must be 0..64 and threshold at least 1");
+  }
+  const int w = frame.width, r = options.radius;
+  std::vector<StripeSample> per_row(static_cast<size_t>(frame.height));
+  std::vector<uint8_t> found(static_cast<size_t>(frame.height), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, frame.height, 16), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y) {
+      const uint16_t* f = frame.row(y);
+      const uint16_t* b = base.row(y);
+      const uint16_t peak = row_peak(f, b, w);
+      if (peak < options.threshold) continue;
+      int x0 = 0;
+      while (!(f[x0] > b[x0] && f[x0] - b[x0] == peak)) ++x0;  // the first brightest pixel
+      double sw = 0, sx = 0;
+      bool saturated = false;
+      for (int x = std::max(0, x0 - r); x <= std::min(w - 1, x0 + r); ++x) {
+        const int d = f[x] > b[x] ? f[x] - b[x] : 0;
+        sw += d;
+        sx += static_cast<double>(d) * x;
+        saturated = saturated || f[x] >= full_scale;
+      }
+      per_row[static_cast<size_t>(y)] = {y, static_cast<float>(sx / sw), peak, saturated};
+      found[static_cast<size_t>(y)] = 1;
+    }
+  });
+  std::vector<StripeSample> out;
+  for (int y = 0; y < frame.height; ++y)
+    if (found[static_cast<size_t>(y)]) out.push_back(per_row[static_cast<size_t>(y)]);
+  return out;
+}
+
+}  // namespace bodyscan

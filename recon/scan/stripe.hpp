@@ -1,0 +1,40 @@
+// Laser stripe extraction (thesis §3.1.4): per image row, the brightest pixel of the
+// frame minus the base frame (taken just before the laser came on), kept if it
+// passes a threshold, refined to sub-pixel by the intensity-weighted centroid within
+// a radius. This is the hot loop of a real-time scanner: the rows run in parallel
+// and the per-row maximum is a vectorised pass over 16-bit pixels.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "recon/core/status.hpp"
+
+namespace bodyscan {
+
+// A view of a 16-bit grayscale image (the Frame layout of hw/camera.hpp: values in
+// the low bits, row-major).
+struct ImageView {
+  const uint16_t* pixels = nullptr;
+  int width = 0, height = 0;
+  const uint16_t* row(int y) const { return pixels + static_cast<size_t>(y) * width; }
+};
+
+struct StripeOptions {
+  int threshold = 20;  // minimum peak of frame - base, in pixel values
+  int radius = 4;      // half-width of the centroid window (the thesis's r)
+};
+
+struct StripeSample {
+  int row = 0;
+  float column = 0;     // sub-pixel, image x (pixel centres at integers)
+  uint16_t peak = 0;    // frame - base at the brightest pixel
+  bool saturated = false;  // the frame itself hit full scale inside the window
+};
+
+// The stripe samples of one frame, one per row at most, in row order. Errors: the
+// frame and base differ in size, or the options are out of range.
+StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const ImageView& base,
+                                                   const StripeOptions& options = {}, int full_scale = 255);
+
+}  // namespace bodyscan

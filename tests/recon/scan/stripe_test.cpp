@@ -1,0 +1,81 @@
+#include "recon/scan/stripe.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace bodyscan {
+namespace {
+
+struct Image {
+  int w, h;
+  std::vector<uint16_t> px;
+  ImageView view() const { return {px.data(), w, h}; }
+};
+
+// A stripe with a Gaussian cross profile centred at x = c(y), over a flat base.
+Image stripe_image(int w, int h, double amplitude, double sigma, uint16_t base, double (*centre)(int)) {
+  Image im{w, h, std::vector<uint16_t>(static_cast<size_t>(w) * h, base)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double d = x - centre(y);
+      im.px[static_cast<size_t>(y) * w + x] =
+          static_cast<uint16_t>(std::min(255.0, std::round(base + amplitude * std::exp(-0.5 * d * d / (sigma * sigma)))));
+    }
+  return im;
+}
+
+TEST(StripeExtraction, FindsTheSubPixelCentreOfEachRow) {
+  auto centre = [](int y) { return 100.0 + 0.37 * y; };  // a slanted stripe
+  const Image frame = stripe_image(640, 200, 180, 1.2, 10, centre);
+  const Image base{640, 200, std::vector<uint16_t>(640 * 200, 10)};
+  auto s = extract_stripe(frame.view(), base.view());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->size(), 200u);
+  double worst = 0;
+  for (const StripeSample& p : *s) worst = std::max(worst, std::abs(p.column - centre(p.row)));
+  // Rounding the profile to integers is the only error.
+  EXPECT_LT(worst, 0.02);
+  EXPECT_EQ((*s)[0].peak, 180);
+  EXPECT_FALSE((*s)[0].saturated);
+}
+
+TEST(StripeExtraction, ThresholdBaseAndSaturation) {
+  auto centre = [](int) { return 50.0; };
+  Image frame = stripe_image(100, 10, 255, 1.5, 0, centre);  // saturated core
+  Image base{100, 10, std::vector<uint16_t>(1000, 0)};
+  // Ambient light in the base is subtracted: a bright lamp elsewhere in both frames
+  // does not win.
+  for (int y = 0; y < 10; ++y) {
+    frame.px[static_cast<size_t>(y) * 100 + 10] = 250;
+    base.px[static_cast<size_t>(y) * 100 + 10] = 250;
+  }
+  auto s = extract_stripe(frame.view(), base.view(), {.threshold = 20, .radius = 4});
+  ASSERT_TRUE(s.ok());
+  ASSERT_EQ(s->size(), 10u);
+  EXPECT_NEAR((*s)[3].column, 50.0, 0.01);
+  EXPECT_TRUE((*s)[3].saturated);
+  // Rows whose stripe is below the threshold give no sample.
+  const Image faint = stripe_image(100, 10, 15, 1.5, 5, centre);
+  const Image faint_base{100, 10, std::vector<uint16_t>(1000, 5)};
+  auto none = extract_stripe(faint.view(), faint_base.view(), {.threshold = 20, .radius = 4});
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->empty());
+  // A frame darker than its base everywhere (a light went out) gives nothing, not garbage.
+  auto dark = extract_stripe(faint_base.view(), faint.view());
+  ASSERT_TRUE(dark.ok());
+  EXPECT_TRUE(dark->empty());
+}
+
+TEST(StripeExtraction, BadInputIsAnError) {
+  const Image a{10, 10, std::vector<uint16_t>(100, 0)}, b{10, 9, std::vector<uint16_t>(90, 0)};
+  auto s = extract_stripe(a.view(), b.view());
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.status().message().find("10x9"), std::string::npos);
+  EXPECT_FALSE(extract_stripe(a.view(), a.view(), {.threshold = 0}).ok());
+  EXPECT_FALSE(extract_stripe(ImageView{}, ImageView{}).ok());
+}
+
+}  // namespace
+}  // namespace bodyscan
