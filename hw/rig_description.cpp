@@ -31,6 +31,16 @@ int bits_per_pixel(PixelFormat f) {
   return 8;
 }
 
+std::vector<Vec3d> visible_lights(const FrameGeometry& f, bool front) {
+  const double side = front ? 1.0 : -1.0;
+  const double near_z = side * (0.5 * f.depth + 0.5 * f.tube), far_z = -side * (0.5 * f.depth - 0.5 * f.tube);
+  std::vector<Vec3d> out;
+  for (double y : {0.0, f.top_height})
+    for (double z : {near_z, far_z})
+      for (double x : f.light_x) out.emplace_back(x, y, z);
+  return out;
+}
+
 CameraModel CameraDescription::model() const {
   return CameraModel::look_at(width, height, focal_mm, pixel_size_um * 1e-3, distortion, position, look_at);
 }
@@ -160,7 +170,10 @@ FrameGeometry read_frame(const Reader& r) {
       f.light_x.push_back(x.raw().get<double>());
     }
   }
-  if (f.light_x.size() != 4) r.fail("light_x must list 4 positions (4 lights per pole, thesis §2.1)");
+  if (f.light_x.size() != 2 || std::abs(f.light_x[0] - f.light_x[1]) < 2 * f.light_diameter) {
+    r.fail("light_x must list 2 distinct positions along the poles (each pole face carries 2 lights; a camera "
+           "sees 4 per frame, thesis §2.1)");
+  }
   for (double x : f.light_x) {
     if (std::abs(x) > 0.5 * f.width - f.tube) r.fail("a light lies beyond the pole's ends (|x| > width/2 - tube)");
   }

@@ -16,17 +16,25 @@ namespace bodyscan::hw {
 // Two equal rectangular frames of square white tubing, one on the floor (its light
 // centres in Y = 0) and one above it (light centres in Y = top_height). Each frame
 // has a front pole (Z = +depth/2) and a back pole (Z = -depth/2) running along X,
-// joined by side poles; the front pole carries lights facing +Z, the back pole
-// lights facing -Z, at the same X positions (thesis §2.1: a camera sees the eight
-// lights of one side, four per frame).
+// joined by side poles. Every front and back pole carries a light on its outer face
+// and one on its inner face at each of the two `light_x` positions. A camera on the
+// front side thus sees, per frame, the front pole's outer lights and the back pole's
+// inner ones: four lights at the corners of a rectangle in the frame's plane (thesis
+// §2.1, §3.1.2: eight per camera, four per frame), which is what a plane transform
+// needs - four lights along one pole would be collinear.
 struct FrameGeometry {
   double width = 1800;        // X distance between the side poles' centre lines, mm
   double depth = 1100;        // Z distance between the front and back poles' centre lines
   double top_height = 2300;   // Y of the top frame's light centres
   double tube = 40;           // side of the square tubing
-  std::vector<double> light_x = {-700, -250, 250, 700};  // along each front and back pole
+  std::vector<double> light_x = {-700, 700};  // along each front and back pole, both faces
   double light_diameter = 30;  // the diffuser disc
 };
+
+// The centres of the eight frame lights a camera on the front (front = true) or back
+// side sees: per frame (bottom first), the near pole's outer-face lights and the far
+// pole's inner-face lights, each in light_x order.
+std::vector<Vec3d> visible_lights(const FrameGeometry& frame, bool front);
 
 enum class PixelFormat { kMono8, kMono12, kMono16 };
 const char* to_string(PixelFormat f);

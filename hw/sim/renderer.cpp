@@ -112,10 +112,10 @@ Light light_at(const Scene& scene, const Lighting& lighting, const std::vector<L
 
   const FrameGeometry& f = scene.rig().frame;
   if (lighting.frame_lights && h.surface == Surface::kFrame && std::abs(h.normal.z()) > 0.99) {
-    // The lights sit on the poles' outer faces (front lights face +Z, back -Z).
-    const double side = h.normal.z() > 0 ? 1.0 : -1.0;
-    const double face_z = side * (0.5 * f.depth + 0.5 * f.tube);
-    if (std::abs(h.position.z() - face_z) < 1.0) {
+    // The lights sit on both Z faces of the front and back poles (not on the side
+    // poles, whose faces point along X and Y).
+    const double face = std::abs(std::abs(h.position.z()) - 0.5 * f.depth);
+    if (std::abs(face - 0.5 * f.tube) < 1.0) {
       const double radius = 0.5 * f.light_diameter;
       for (double ly : {0.0, f.top_height})
         for (double lx : f.light_x) {

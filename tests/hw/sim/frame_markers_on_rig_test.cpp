@@ -29,10 +29,11 @@ TEST(FrameMarkersOnRig, EveryThesisCameraFindsItsEightLights) {
     ASSERT_TRUE(ordered.ok()) << desc->cameras[i].id << ": " << ordered.status().message();
     // The truth, in the same image order.
     const CameraModel& m = rig.renderer(i).model();
-    const double side = desc->cameras[i].position.z() > 0 ? 1 : -1;
+    const std::vector<Vec3d> lights = visible_lights(f, desc->cameras[i].position.z() > 0);
     for (int frame = 0; frame < 2; ++frame) {
       std::vector<Vec2d> truth;
-      for (double x : f.light_x) truth.push_back(*m.project(Vec3d(x, frame == 0 ? f.top_height : 0.0, side * (0.5 * f.depth + 0.5 * f.tube))));
+      for (const Vec3d& l : lights)
+        if ((l.y() > 0) == (frame == 0)) truth.push_back(*m.project(l));
       std::sort(truth.begin(), truth.end(), [](const Vec2d& a, const Vec2d& b) { return a.x() < b.x(); });
       for (int k = 0; k < 4; ++k) {
         const Vec2d found = frame == 0 ? ordered->top[k] : ordered->bottom[k];

@@ -176,6 +176,7 @@ TEST(Renderer, FrameLightsAndNoiseAreDeterministic) {
   rig.frame.width = 1800;
   rig.frame.depth = 1100;
   rig.frame.top_height = 2300;
+  rig.frame.light_x = {-250, 250};
   // Looking down at the bottom frame's front pole.
   rig.cameras[0].position = Vec3d(0, 300, 2500);
   rig.cameras[0].look_at = Vec3d(0, 0, 570);

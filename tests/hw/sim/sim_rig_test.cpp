@@ -137,6 +137,13 @@ TEST(SimulatedRig, ShippedRigsTakeAStandingAdultOfTwoMetres) {
         const auto p = m.project(v.cast<double>());
         ASSERT_TRUE(p && m.in_image(*p)) << name << " camera " << c;
       }
+      // The body hides none of the eight frame lights the camera needs; the light
+      // faces sit tube/2 from the pole's centre line.
+      for (const Vec3d& light : visible_lights(f, desc->cameras[c].position.z() > 0)) {
+        const Vec3d to = light - m.centre();
+        EXPECT_FALSE((*rig)->scene().occluded(m.centre(), to.normalized(), to.norm() - 1.0))
+            << name << " camera " << desc->cameras[c].id << " light " << light.transpose();
+      }
     }
   }
 }
