@@ -136,32 +136,35 @@ int run_sim(int argc, char** argv) {
   }
   index["images"] = nlohmann::json::array();
   size_t written = 0;
-  // Grabs every camera and writes the frames; false after printing an error.
-  auto grab_all = [&](const std::string& phase, const std::string& name, const nlohmann::json& lasers) {
-    for (size_t c = 0; c < rig.num_cameras(); ++c) {
-      hw::Camera& cam = rig.camera(c);
-      auto frame = cam.grab();
-      if (!frame.ok()) {
-        std::fprintf(stderr, "bodyscan sim render: %s\n", frame.status().message().c_str());
-        return false;
-      }
-      const std::string file = phase + "/" + cam.info().id + "/" + name + ".png";
-      std::filesystem::create_directories(std::filesystem::path(out) / phase / cam.info().id, ec);
-      GrayImage img{frame->width, frame->height, hw::bits_per_pixel(frame->format) > 8 ? 16 : 8, std::move(frame->pixels)};
-      const Status w = write_png((std::filesystem::path(out) / file).string(), img);
-      if (!w.ok()) {
-        std::fprintf(stderr, "bodyscan sim render: %s\n", w.message().c_str());
-        return false;
-      }
-      index["images"].push_back({{"file", file},
-                                 {"camera", cam.info().id},
-                                 {"phase", phase},
-                                 {"name", name},
-                                 {"lasers", lasers},
-                                 {"frame_id", frame->frame_id},
-                                 {"timestamp_ns", frame->timestamp_ns}});
-      ++written;
+  // Grabs camera c and writes its frame; false after printing an error.
+  auto grab_one = [&](size_t c, const std::string& phase, const std::string& name, const nlohmann::json& lasers) {
+    hw::Camera& cam = rig.camera(c);
+    auto frame = cam.grab();
+    if (!frame.ok()) {
+      std::fprintf(stderr, "bodyscan sim render: %s\n", frame.status().message().c_str());
+      return false;
     }
+    const std::string file = phase + "/" + cam.info().id + "/" + name + ".png";
+    std::filesystem::create_directories(std::filesystem::path(out) / phase / cam.info().id, ec);
+    GrayImage img{frame->width, frame->height, hw::bits_per_pixel(frame->format) > 8 ? 16 : 8, std::move(frame->pixels)};
+    const Status w = write_png((std::filesystem::path(out) / file).string(), img);
+    if (!w.ok()) {
+      std::fprintf(stderr, "bodyscan sim render: %s\n", w.message().c_str());
+      return false;
+    }
+    index["images"].push_back({{"file", file},
+                               {"camera", cam.info().id},
+                               {"phase", phase},
+                               {"name", name},
+                               {"lasers", lasers},
+                               {"frame_id", frame->frame_id},
+                               {"timestamp_ns", frame->timestamp_ns}});
+    ++written;
+    return true;
+  };
+  auto grab_all = [&](const std::string& phase, const std::string& name, const nlohmann::json& lasers) {
+    for (size_t c = 0; c < rig.num_cameras(); ++c)
+      if (!grab_one(c, phase, name, lasers)) return false;
     return true;
   };
   auto check = [&](const Status& s) {
@@ -174,21 +177,9 @@ int run_sim(int argc, char** argv) {
   if (!check(ctl.set_room_lights(true))) return 1;
   for (size_t c = 0; c < rig.num_cameras(); ++c) {
     rig.hold_dot_grid(c, true);
-    auto frame = rig.camera(c).grab();
+    const bool ok = grab_one(c, "calibration", "dot_grid", nlohmann::json::array());
     rig.hold_dot_grid(c, false);
-    if (!frame.ok()) {
-      std::fprintf(stderr, "bodyscan sim render: %s\n", frame.status().message().c_str());
-      return 1;
-    }
-    const std::string id = rig.camera(c).info().id;
-    const std::string file = "calibration/" + id + "/dot_grid.png";
-    std::filesystem::create_directories(std::filesystem::path(out) / "calibration" / id, ec);
-    GrayImage img{frame->width, frame->height, hw::bits_per_pixel(frame->format) > 8 ? 16 : 8, std::move(frame->pixels)};
-    if (!check(write_png((std::filesystem::path(out) / file).string(), img))) return 1;
-    index["images"].push_back({{"file", file}, {"camera", id}, {"phase", "calibration"}, {"name", "dot_grid"},
-                               {"lasers", nlohmann::json::array()}, {"frame_id", frame->frame_id},
-                               {"timestamp_ns", frame->timestamp_ns}});
-    ++written;
+    if (!ok) return 1;
   }
   if (!check(ctl.set_room_lights(true)) || !grab_all("calibration", "room", nlohmann::json::array())) return 1;
   if (!check(ctl.set_room_lights(false)) || !check(ctl.set_frame_lights(false)) ||

@@ -2,16 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_image.hpp"
+
 #include <cmath>
 
 namespace bodyscan {
 namespace {
 
-struct Image {
-  int w, h;
-  std::vector<uint16_t> px;
-  ImageView view() const { return {px.data(), w, h}; }
-};
+using testing::Image;
 
 // Soft discs of radius r at the given centres on a flat background.
 Image discs(int w, int h, const std::vector<Eigen::Vector2d>& centres, double r, uint16_t bg) {

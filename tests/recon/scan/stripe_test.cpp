@@ -2,17 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/test_image.hpp"
+
 #include <cmath>
 #include <random>
 
 namespace bodyscan {
 namespace {
 
-struct Image {
-  int w, h;
-  std::vector<uint16_t> px;
-  ImageView view() const { return {px.data(), w, h}; }
-};
+using testing::Image;
 
 // A stripe with a Gaussian cross profile centred at x = c(y), over a flat base.
 Image stripe_image(int w, int h, double amplitude, double sigma, uint16_t base, double (*centre)(int)) {
