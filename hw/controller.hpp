@@ -17,7 +17,11 @@ class Controller {
   virtual int num_lasers() const = 0;  // lasers and their motors share an index
 
   virtual Status set_room_lights(bool on) = 0;
-  virtual Status set_frame_lights(bool on) = 0;
+  // The frame lights are wired in two circuits: the front poles' lights (both
+  // frames, both faces) and the back poles'. Switching one alone tells a camera
+  // which side of the frame it faces (thesis §3.1.2 asked for manual entry there).
+  virtual Status set_frame_light_circuits(bool front_poles, bool back_poles) = 0;
+  Status set_frame_lights(bool on) { return set_frame_light_circuits(on, on); }
   virtual Status set_laser(int laser, bool on) = 0;
   // Tries every laser even if one fails; returns the first error.
   virtual Status all_lasers_off() = 0;

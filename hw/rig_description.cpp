@@ -193,7 +193,7 @@ Distortion read_distortion(const Reader& r) {
 
 CameraDescription read_camera(const Reader& r) {
   r.only({"id", "position", "look_at", "focal_mm", "pixel_size_um", "width", "height", "distortion",
-          "pixel_format", "full_well_e", "read_noise_e", "exposure_us", "gain_db"});
+          "pixel_format", "full_well_e", "read_noise_e", "exposure_us", "gain_db", "blur_px"});
   CameraDescription c;
   c.id = r.text("id", "", true);
   if (c.id.empty()) r.fail("id must not be empty");
@@ -215,6 +215,7 @@ CameraDescription read_camera(const Reader& r) {
   else r.fail("pixel_format must be mono8, mono12 or mono16, got '" + fmt + "'");
   c.full_well_e = r.positive("full_well_e", c.full_well_e);
   c.read_noise_e = r.non_negative("read_noise_e", c.read_noise_e);
+  c.blur_px = r.non_negative("blur_px", c.blur_px);
   c.exposure_us = r.positive("exposure_us", c.exposure_us);
   c.gain_db = r.number("gain_db", c.gain_db);
   // The distortion must stay invertible over the whole sensor, or the model is
@@ -417,6 +418,7 @@ std::string to_json(const RigDescription& rig) {
                             {"pixel_format", to_string(c.pixel_format)},
                             {"full_well_e", c.full_well_e},
                             {"read_noise_e", c.read_noise_e},
+                            {"blur_px", c.blur_px},
                             {"exposure_us", c.exposure_us},
                             {"gain_db", c.gain_db}});
   }

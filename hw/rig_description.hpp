@@ -53,6 +53,11 @@ struct CameraDescription {
   // and the exposure in microseconds the camera starts with.
   double full_well_e = 10000;
   double read_noise_e = 12;
+  // The lens's blur (diffraction, residual focus): the Gaussian sigma of its point
+  // spread, pixels. Real machine-vision lenses at f/4 on 5 um pixels spread a point
+  // over about two pixels; a perfectly sharp image would let narrow features (a
+  // laser line) fall inside one pixel and lose their sub-pixel position.
+  double blur_px = 0.7;
   double exposure_us = 10000;
   double gain_db = 0;
 

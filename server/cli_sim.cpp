@@ -7,11 +7,10 @@
 #include <filesystem>
 #include <string>
 
-#include "hw/controller.hpp"
-#include "hw/sim/sim_rig.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/png_image.hpp"
-#include "recon/io/ply.hpp"
+#include "server/pipeline/acquire.hpp"
+#include "server/pipeline/sim_backend.hpp"
 
 namespace bodyscan::cli {
 
@@ -22,10 +21,10 @@ void usage(FILE* out) {
       "usage: bodyscan sim render --rig RIG --out DIR [options]\n"
       "\n"
       "Renders what the simulated rig's cameras see during one calibration (the\n"
-      "dot-grid target before each camera, room lights, frame lights off and on) and\n"
-      "one full scan (per laser group: a base frame with the lasers off, then every\n"
-      "step with the group's lasers on), as PNG images in DIR with DIR/index.json\n"
-      "listing them.\n"
+      "dot-grid target before each camera, room lights, frame lights off, on, front\n"
+      "poles only, each laser alone) and one full scan (per laser group: a base frame\n"
+      "with the lasers off, then every step with the group's lasers on), as PNG\n"
+      "images in DIR with DIR/index.json listing them.\n"
       "\n"
       "  --rig RIG        thesis, square, or a rig description file (JSON)\n"
       "  --body BODY.ply  the subject (default: the rig description's)\n"
@@ -93,30 +92,13 @@ int run_sim(int argc, char** argv) {
     usage(stderr);
     return 2;
   }
-  std::string rig_path = rig_arg;
-  if (rig_arg.find('/') == std::string::npos && rig_arg.find(".json") == std::string::npos) {
-    auto shipped = hw::shipped_rig_path(rig_arg == "sim" ? "thesis" : rig_arg);
-    if (!shipped.ok()) {
-      std::fprintf(stderr, "bodyscan sim render: %s\n", shipped.status().message().c_str());
-      return 1;
-    }
-    rig_path = *shipped;
-  }
-  auto desc = hw::load_rig_description(rig_path);
-  if (!desc.ok()) {
-    std::fprintf(stderr, "bodyscan sim render: %s\n", desc.status().message().c_str());
-    return 1;
-  }
-  StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> made = [&]() -> StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> {
-    if (body.empty()) return hw::sim::SimulatedRig::create(*desc);
-    ASSIGN_OR_RETURN(TriangleMesh mesh, read_ply_mesh(body));
-    return hw::sim::SimulatedRig::create(*desc, mesh);
-  }();
+  auto made = pipeline::open_simulated_rig(rig_arg, body);
   if (!made.ok()) {
     std::fprintf(stderr, "bodyscan sim render: %s\n", made.status().message().c_str());
     return 1;
   }
   hw::sim::SimulatedRig& rig = **made;
+  const hw::RigDescription& desc = rig.description();
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
   if (ec) {
@@ -124,10 +106,8 @@ int run_sim(int argc, char** argv) {
     return 1;
   }
 
-  hw::Controller& ctl = rig.controller();
-  hw::LasersOff lasers_off(ctl);  // whatever happens below
   nlohmann::json index;
-  index["rig"] = desc->name;
+  index["rig"] = desc.name;
   index["cameras"] = nlohmann::json::array();
   for (size_t c = 0; c < rig.num_cameras(); ++c) {
     index["cameras"].push_back({{"id", rig.camera(c).info().id},
@@ -136,87 +116,62 @@ int run_sim(int argc, char** argv) {
   }
   index["images"] = nlohmann::json::array();
   size_t written = 0;
-  // Grabs camera c and writes its frame; false after printing an error.
-  auto grab_one = [&](size_t c, const std::string& phase, const std::string& name, const nlohmann::json& lasers) {
-    hw::Camera& cam = rig.camera(c);
-    auto frame = cam.grab();
-    if (!frame.ok()) {
-      std::fprintf(stderr, "bodyscan sim render: %s\n", frame.status().message().c_str());
-      return false;
+  std::vector<size_t> identify_bases(rig.num_cameras(), 0);
+  // Every shot of the two sequences becomes a PNG and an index entry.
+  auto write_shot = [&](const std::string& phase, pipeline::Shot&& shot) -> Status {
+    const std::string& camera = rig.camera(shot.camera).info().id;
+    std::string name = pipeline::to_string(shot.kind);
+    nlohmann::json lasers = nlohmann::json::array();
+    for (const pipeline::LaserState& l : shot.lasers) {
+      lasers.push_back({{"id", desc.lasers[static_cast<size_t>(l.laser)].id}, {"step", l.step}});
     }
-    const std::string file = phase + "/" + cam.info().id + "/" + name + ".png";
-    std::filesystem::create_directories(std::filesystem::path(out) / phase / cam.info().id, ec);
-    GrayImage img{frame->width, frame->height, hw::bits_per_pixel(frame->format) > 8 ? 16 : 8, std::move(frame->pixels)};
-    const Status w = write_png((std::filesystem::path(out) / file).string(), img);
-    if (!w.ok()) {
-      std::fprintf(stderr, "bodyscan sim render: %s\n", w.message().c_str());
-      return false;
+    if (shot.kind == pipeline::ShotKind::kScanStep) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "group%d_step%04d", shot.group, shot.step_index);
+      name = buf;
+    } else if (shot.kind == pipeline::ShotKind::kLaserBase && shot.group >= 0) {
+      name = "group" + std::to_string(shot.group) + "_base";
+    } else if (!shot.lasers.empty()) {
+      name += "_" + desc.lasers[static_cast<size_t>(shot.lasers[0].laser)].id + "_step" + std::to_string(shot.lasers[0].step);
+    } else if (shot.kind == pipeline::ShotKind::kLaserBase) {
+      // Calibration takes one before each laser is identified, in laser order.
+      const size_t k = identify_bases[shot.camera]++;
+      name += "_" + (k < desc.lasers.size() ? desc.lasers[k].id : std::to_string(k));
     }
+    const std::string file = phase + "/" + camera + "/" + name + ".png";
+    std::filesystem::create_directories(std::filesystem::path(out) / phase / camera, ec);
+    hw::Frame& f = shot.frame;
+    GrayImage img{f.width, f.height, hw::bits_per_pixel(f.format) > 8 ? 16 : 8, std::move(f.pixels)};
+    RETURN_IF_ERROR(write_png((std::filesystem::path(out) / file).string(), img));
     index["images"].push_back({{"file", file},
-                               {"camera", cam.info().id},
+                               {"camera", camera},
                                {"phase", phase},
                                {"name", name},
                                {"lasers", lasers},
-                               {"frame_id", frame->frame_id},
-                               {"timestamp_ns", frame->timestamp_ns}});
+                               {"frame_id", f.frame_id},
+                               {"timestamp_ns", f.timestamp_ns}});
     ++written;
-    return true;
+    return {};
   };
-  auto grab_all = [&](const std::string& phase, const std::string& name, const nlohmann::json& lasers) {
-    for (size_t c = 0; c < rig.num_cameras(); ++c)
-      if (!grab_one(c, phase, name, lasers)) return false;
-    return true;
-  };
-  auto check = [&](const Status& s) {
-    if (!s.ok()) std::fprintf(stderr, "bodyscan sim render: %s\n", s.message().c_str());
-    return s.ok();
-  };
-
-  // Calibration: the dot grid held before each camera in turn (thesis §3.1.1), the
-  // room, then the frame lights off and on (thesis §3.1.2).
-  if (!check(ctl.set_room_lights(true))) return 1;
-  for (size_t c = 0; c < rig.num_cameras(); ++c) {
-    rig.hold_dot_grid(c, true);
-    const bool ok = grab_one(c, "calibration", "dot_grid", nlohmann::json::array());
-    rig.hold_dot_grid(c, false);
-    if (!ok) return 1;
+  const pipeline::Rig handle = pipeline::rig_handle(rig);
+  ProgressFn progress;
+  if (!quiet) {
+    progress = [](std::string_view stage, double fraction) {
+      std::fprintf(stderr, "\r  %-28.*s %3d%%", static_cast<int>(stage.size()), stage.data(),
+                   static_cast<int>(fraction * 100));
+      return true;
+    };
   }
-  if (!check(ctl.set_room_lights(true)) || !grab_all("calibration", "room", nlohmann::json::array())) return 1;
-  if (!check(ctl.set_room_lights(false)) || !check(ctl.set_frame_lights(false)) ||
-      !grab_all("calibration", "frame_lights_off", nlohmann::json::array()))
+  Status s = pipeline::acquire_calibration(
+      handle, [&](pipeline::Shot&& shot) { return write_shot("calibration", std::move(shot)); }, progress);
+  if (s.ok()) {
+    s = pipeline::acquire_scan(
+        handle, [&](pipeline::Shot&& shot) { return write_shot("scan", std::move(shot)); }, every, progress);
+  }
+  if (!quiet) std::fprintf(stderr, "\n");
+  if (!s.ok()) {
+    std::fprintf(stderr, "bodyscan sim render: %s\n", s.message().c_str());
     return 1;
-  if (!check(ctl.set_frame_lights(true)) || !grab_all("calibration", "frame_lights_on", nlohmann::json::array())) return 1;
-  if (!check(ctl.set_frame_lights(false))) return 1;
-
-  // The scan: per group, a base frame, then the group's lasers stepping together.
-  for (size_t g = 0; g < desc->laser_groups.size(); ++g) {
-    std::vector<int> ids;
-    int steps = 0;
-    for (const std::string& id : desc->laser_groups[g]) {
-      for (size_t i = 0; i < desc->lasers.size(); ++i)
-        if (desc->lasers[i].id == id) ids.push_back(static_cast<int>(i));
-    }
-    for (int i : ids) {
-      if (!check(ctl.home(i))) return 1;
-      steps = std::max(steps, desc->lasers[static_cast<size_t>(i)].max_step - desc->lasers[static_cast<size_t>(i)].min_step + 1);
-    }
-    const std::string group = "group" + std::to_string(g);
-    if (!check(ctl.all_lasers_off()) || !grab_all("scan", group + "_base", nlohmann::json::array())) return 1;
-    for (int k = 0; k < steps; k += every) {
-      nlohmann::json lasers = nlohmann::json::array();
-      for (int i : ids) {
-        const hw::LaserDescription& l = desc->lasers[static_cast<size_t>(i)];
-        const int step = std::min(l.max_step, l.min_step + k);
-        if (!check(ctl.move_to(i, step)) || !check(ctl.set_laser(i, true))) return 1;
-        lasers.push_back({{"id", l.id}, {"step", step}});
-      }
-      char name[64];
-      std::snprintf(name, sizeof name, "%s_step%04d", group.c_str(), k);
-      if (!grab_all("scan", name, lasers)) return 1;
-      if (!quiet) std::fprintf(stderr, "\r  %s: %d/%d steps", group.c_str(), k + 1, steps);
-    }
-    if (!check(ctl.all_lasers_off())) return 1;
-    if (!quiet) std::fprintf(stderr, "\n");
   }
   const Status w = write_file_atomically((std::filesystem::path(out) / "index.json").string(), index.dump(2));
   if (!w.ok()) {

@@ -87,6 +87,7 @@ Frame render_dot_grid(const CameraDescription& camera, const SimulationDescripti
   e.format = camera.pixel_format;
   e.exposure_us = camera.exposure_us;
   e.gain_db = camera.gain_db;
+  blur(irradiance, camera.width, camera.height, camera.blur_px);
   return expose(irradiance, camera, e, sim.seed * 7919 + frame_number);
 }
 

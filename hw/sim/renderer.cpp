@@ -89,6 +89,33 @@ std::vector<LaserPlane> laser_planes(const Lighting& lighting) {
   return out;
 }
 
+// What a frame light emits toward the camera at a surface point, as a fraction of full
+// scale (0 off the lights). With `margin` > 0, any point within that many mm of a
+// light counts (returns 1): a test for pixels that need sub-pixel sampling.
+double frame_light_emission(const FrameGeometry& f, const Lighting& lighting, const SimulationDescription& sim,
+                            const Hit& h, double margin) {
+  if (h.surface != Surface::kFrame || std::abs(h.normal.z()) <= 0.99) return 0;
+  if (!(h.position.z() > 0 ? lighting.front_frame_lights : lighting.back_frame_lights)) return 0;
+  // The lights sit on both Z faces of the front and back poles (not on the side
+  // poles, whose faces point along X and Y).
+  const double face = std::abs(std::abs(h.position.z()) - 0.5 * f.depth);
+  if (std::abs(face - 0.5 * f.tube) >= 1.0) return 0;
+  const double radius = 0.5 * f.light_diameter;
+  double out = 0;
+  for (double ly : {0.0, f.top_height})
+    for (double lx : f.light_x) {
+      const double rho = std::hypot(h.position.x() - lx, h.position.y() - ly);
+      if (margin > 0) {
+        if (rho < radius + margin) return 1;
+      } else if (rho < radius) {
+        // A diffuser: even in the middle, falling off over its outer fifth.
+        const double edge = std::clamp((radius - rho) / (0.2 * radius), 0.0, 1.0);
+        out += sim.frame_light * edge * edge * (3 - 2 * edge);
+      }
+    }
+  return out;
+}
+
 template <typename CachedHit>
 Light light_at(const Scene& scene, const Lighting& lighting, const std::vector<LaserPlane>& lasers,
                const SimulationDescription& sim, const CameraModel& model, const std::vector<Vec3f>& rays,
@@ -110,23 +137,18 @@ Light light_at(const Scene& scene, const Lighting& lighting, const std::vector<L
   const double a = albedo(h.surface);
   out.base = a * ambient * (0.35 + 0.65 * std::abs(h.normal.dot(r)));
 
-  const FrameGeometry& f = scene.rig().frame;
-  if (lighting.frame_lights && h.surface == Surface::kFrame && std::abs(h.normal.z()) > 0.99) {
-    // The lights sit on both Z faces of the front and back poles (not on the side
-    // poles, whose faces point along X and Y).
-    const double face = std::abs(std::abs(h.position.z()) - 0.5 * f.depth);
-    if (std::abs(face - 0.5 * f.tube) < 1.0) {
-      const double radius = 0.5 * f.light_diameter;
-      for (double ly : {0.0, f.top_height})
-        for (double lx : f.light_x) {
-          const double rho = std::hypot(h.position.x() - lx, h.position.y() - ly);
-          if (rho < radius) {
-            // A diffuser: even in the middle, falling off over its outer fifth.
-            const double edge = std::clamp((radius - rho) / (0.2 * radius), 0.0, 1.0);
-            out.base += sim.frame_light * edge * edge * (3 - 2 * edge);
-          }
-        }
-    }
+  // Frame lights: a sensor pixel integrates over its area, so pixels near a light
+  // average 4 x 4 sub-pixel rays (point samples would put the lights' centroids off
+  // by a tenth of a pixel).
+  if (h.surface == Surface::kFrame && frame_light_emission(scene.rig().frame, lighting, sim, h, 10.0) > 0) {
+    double sum = 0;
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const auto sub = model.ray(Vec2d(x - 0.375 + 0.25 * i, y - 0.375 + 0.25 * j));
+        if (!sub) continue;
+        sum += frame_light_emission(scene.rig().frame, lighting, sim, scene.intersect(c, *sub), 0.0);
+      }
+    out.base += sum / 16;
   }
 
   if (!lasers.empty()) {
@@ -184,6 +206,35 @@ std::vector<float> Renderer::irradiance(const Scene& scene, const Lighting& ligh
   return out;
 }
 
+void blur(std::vector<float>& img, int w, int h, double sigma) {
+  if (sigma <= 0) return;
+  const int r = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
+  std::vector<float> k(static_cast<size_t>(2 * r + 1));
+  float sum = 0;
+  for (int i = -r; i <= r; ++i) sum += k[static_cast<size_t>(i + r)] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
+  for (float& v : k) v /= sum;
+  std::vector<float> tmp(img.size());
+  // Rows, then columns; edges clamp.
+  tbb::parallel_for(0, h, [&](int y) {
+    const float* in = img.data() + static_cast<size_t>(y) * w;
+    float* out = tmp.data() + static_cast<size_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      float acc = 0;
+      for (int i = -r; i <= r; ++i) acc += k[static_cast<size_t>(i + r)] * in[std::clamp(x + i, 0, w - 1)];
+      out[x] = acc;
+    }
+  });
+  tbb::parallel_for(0, h, [&](int y) {
+    float* out = img.data() + static_cast<size_t>(y) * w;
+    for (int x = 0; x < w; ++x) out[x] = 0;
+    for (int i = -r; i <= r; ++i) {
+      const float* in = tmp.data() + static_cast<size_t>(std::clamp(y + i, 0, h - 1)) * w;
+      const float kk = k[static_cast<size_t>(i + r)];
+      for (int x = 0; x < w; ++x) out[x] += kk * in[x];
+    }
+  });
+}
+
 Frame expose(const std::vector<float>& irradiance, const CameraDescription& camera, const Exposure& exposure,
              uint64_t seed) {
   const int w = camera.width, h = camera.height;
@@ -239,13 +290,14 @@ Frame Renderer::render(const Scene& scene, const Lighting& lighting, const Expos
       }
     });
   }
+  blur(irradiance, w, h, camera_.blur_px);
   return expose(irradiance, camera_, exposure, seed);
 }
 
 const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Lighting& lighting) const {
   const std::vector<CachedHit>& hit = hits(scene);
   std::lock_guard<std::mutex> lock(cache_mutex_);
-  const int key = (lighting.room_lights ? 1 : 0) | (lighting.frame_lights ? 2 : 0);
+  const int key = (lighting.room_lights ? 1 : 0) | (lighting.front_frame_lights ? 2 : 0) | (lighting.back_frame_lights ? 4 : 0);
   BaseCache& cache = base_[key];
   if (cache.version == scene.version() && !cache.irradiance.empty()) return cache.irradiance;
   const int w = camera_.width, h = camera_.height;

@@ -21,7 +21,8 @@ struct ActiveLaser {
 
 struct Lighting {
   bool room_lights = false;
-  bool frame_lights = false;
+  bool front_frame_lights = false;  // the front poles' lights (Z > 0)
+  bool back_frame_lights = false;
   std::vector<ActiveLaser> lasers;  // the lasers that are on, at their steps
 };
 
@@ -30,6 +31,10 @@ struct Exposure {
   double exposure_us = 10000;
   double gain_db = 0;
 };
+
+// The lens's point spread: a separable Gaussian of `sigma` pixels over the
+// irradiance (nothing when sigma is 0).
+void blur(std::vector<float>& irradiance, int width, int height, double sigma);
 
 // Turns irradiance (fraction of full scale at the reference exposure of 10 ms, 0 dB)
 // into a frame: shot and read noise, gain, quantisation, saturation. Deterministic
@@ -76,7 +81,7 @@ class Renderer {
   mutable std::mutex cache_mutex_;
   mutable std::vector<CachedHit> hits_;
   mutable uint64_t hits_version_ = 0;
-  mutable BaseCache base_[4];
+  mutable BaseCache base_[8];  // by room, front and back frame lights
 };
 
 }  // namespace bodyscan::hw::sim

@@ -16,8 +16,9 @@ class SimulatedRig::SimController : public Controller {
     room_ = on;
     return {};
   }
-  Status set_frame_lights(bool on) override {
-    frame_ = on;
+  Status set_frame_light_circuits(bool front_poles, bool back_poles) override {
+    front_ = front_poles;
+    back_ = back_poles;
     return {};
   }
   Status set_laser(int laser, bool on) override {
@@ -58,7 +59,8 @@ class SimulatedRig::SimController : public Controller {
   }
 
   bool room() const { return room_; }
-  bool frame() const { return frame_; }
+  bool front_lights() const { return front_; }
+  bool back_lights() const { return back_; }
   int step(size_t i) const { return step_[i]; }
 
  private:
@@ -69,7 +71,7 @@ class SimulatedRig::SimController : public Controller {
     return {};
   }
   const RigDescription& rig_;
-  bool room_ = false, frame_ = false;
+  bool room_ = false, front_ = false, back_ = false;
   std::vector<bool> laser_on_;
   std::vector<int> step_;
   std::vector<bool> homed_;
@@ -185,7 +187,8 @@ void SimulatedRig::fail_camera_after(size_t i, uint64_t frames, StatusCode code)
 Lighting SimulatedRig::lighting() const {
   Lighting l;
   l.room_lights = controller_->room();
-  l.frame_lights = controller_->frame();
+  l.front_frame_lights = controller_->front_lights();
+  l.back_frame_lights = controller_->back_lights();
   for (size_t i = 0; i < rig_.lasers.size(); ++i) {
     if (controller_->laser_on(static_cast<int>(i))) l.lasers.push_back({&rig_.lasers[i], controller_->step(i)});
   }

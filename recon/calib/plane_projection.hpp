@@ -17,6 +17,13 @@
 
 namespace bodyscan {
 
+// The projective transform (h(2,2) = 1) taking `from` to `to`, by least squares over
+// >= 4 correspondences in general position (normalised DLT). Errors: too few points,
+// three of four in a line, non-finite or degenerate input.
+StatusOr<Eigen::Matrix3d> fit_homography(const std::vector<Eigen::Vector2d>& from,
+                                         const std::vector<Eigen::Vector2d>& to);
+Eigen::Vector2d apply_homography(const Eigen::Matrix3d& h, const Eigen::Vector2d& p);
+
 class PlaneProjection {
  public:
   PlaneProjection() = default;

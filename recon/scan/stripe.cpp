@@ -45,7 +45,8 @@ __attribute__((target_clones("arch=haswell", "default"))) uint16_t row_peak(cons
 }  // namespace
 
 StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const ImageView& base,
-                                                   const StripeOptions& options, int full_scale) {
+                                                   const StripeOptions& options, int full_scale,
+                                                   const std::vector<ColumnRange>* windows) {
   if (frame.width != base.width || frame.height != base.height) {
     return invalid_argument("stripe extraction: the frame is " + std::to_string(frame.width) + "x" +
                             std::to_string(frame.height) + " but the base frame is " + std::to_string(base.width) +
@@ -57,6 +58,10 @@ StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const
   if (options.radius < 0 || options.radius > 64 || options.threshold < 1) {
     return invalid_argument("stripe extraction: radius must be 0..64 and threshold at least 1");
   }
+  if (windows && windows->size() != static_cast<size_t>(frame.height)) {
+    return invalid_argument("stripe extraction: " + std::to_string(windows->size()) + " row windows for " +
+                            std::to_string(frame.height) + " rows");
+  }
   const int w = frame.width, r = options.radius;
   std::vector<StripeSample> per_row(static_cast<size_t>(frame.height));
   std::vector<uint8_t> found(static_cast<size_t>(frame.height), 0);
@@ -64,14 +69,20 @@ StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const
     for (int y = rows.begin(); y != rows.end(); ++y) {
       const uint16_t* f = frame.row(y);
       const uint16_t* b = base.row(y);
+      int lo = 0, hi = w;
+      if (windows) {
+        lo = std::max(0, (*windows)[static_cast<size_t>(y)].begin);
+        hi = std::min(w, (*windows)[static_cast<size_t>(y)].end);
+        if (hi <= lo) continue;
+      }
       int chunk = 0;
-      const uint16_t peak = row_peak(f, b, w, &chunk);
+      const uint16_t peak = row_peak(f + lo, b + lo, hi - lo, &chunk);
       if (peak < options.threshold) continue;
-      int x0 = chunk;
+      int x0 = lo + chunk;
       while (!(f[x0] > b[x0] && f[x0] - b[x0] == peak)) ++x0;  // the first brightest pixel
       double sw = 0, sx = 0;
       bool saturated = false;
-      for (int x = std::max(0, x0 - r); x <= std::min(w - 1, x0 + r); ++x) {
+      for (int x = std::max(lo, x0 - r); x <= std::min(hi - 1, x0 + r); ++x) {
         const int d = f[x] > b[x] ? f[x] - b[x] : 0;
         sw += d;
         sx += static_cast<double>(d) * x;

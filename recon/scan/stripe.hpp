@@ -32,9 +32,18 @@ struct StripeSample {
   bool saturated = false;  // the frame itself hit full scale inside the window
 };
 
-// The stripe samples of one frame, one per row at most, in row order. Errors: the
-// frame and base differ in size, or the options are out of range.
+// Columns [begin, end) of one row; an empty range skips the row.
+struct ColumnRange {
+  int begin = 0, end = 0;
+};
+
+// The stripe samples of one frame, one per row at most, in row order. With
+// `windows` (one range per row), each row is searched inside its range only: where
+// the laser plane can meet the subject, so another laser's stripe or a reflection
+// elsewhere in the row cannot win. Errors: the frame and base differ in size, the
+// windows do not match the rows, or the options are out of range.
 StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const ImageView& base,
-                                                   const StripeOptions& options = {}, int full_scale = 255);
+                                                   const StripeOptions& options = {}, int full_scale = 255,
+                                                   const std::vector<ColumnRange>* windows = nullptr);
 
 }  // namespace bodyscan

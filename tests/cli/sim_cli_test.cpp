@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "recon/io/png_image.hpp"
@@ -19,8 +20,12 @@ TEST(SimCli, RendersCalibrationAndScanFramesWithAnIndex) {
   const nlohmann::json index = nlohmann::json::parse(slurp(dir + "/render/index.json"));
   EXPECT_EQ(index["rig"], "thesis");
   ASSERT_EQ(index["cameras"].size(), 3u);
-  // Per camera: dot grid, room, frame lights off and on; per group: base + 2 steps.
-  EXPECT_EQ(index["images"].size(), 3u * 4 + 2u * 3 * 3);
+  // Per camera: dot grid, room, frame lights off, on, front poles only, and per laser
+  // (4) a base and the laser lit at both ends of its sweep; per group: base + 2 steps.
+  EXPECT_EQ(index["images"].size(), 3u * (5 + 3 * 4) + 2u * 3 * 3);
+  std::set<std::string> files;
+  for (const auto& img : index["images"]) files.insert(img["file"].get<std::string>());
+  EXPECT_EQ(files.size(), index["images"].size()) << "every image has its own file";
   uint64_t last_id = 0;
   for (const auto& img : index["images"]) {
     const std::string file = dir + "/render/" + img["file"].get<std::string>();

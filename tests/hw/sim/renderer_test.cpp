@@ -185,7 +185,7 @@ TEST(Renderer, FrameLightsAndNoiseAreDeterministic) {
   ASSERT_TRUE(scene.ok());
   const Renderer r(rig.cameras[0], rig.simulation);
   Lighting lights;
-  lights.frame_lights = true;
+  lights.front_frame_lights = lights.back_frame_lights = true;
   const Frame a = r.render(**scene, lights, {}, 7), b = r.render(**scene, lights, {}, 7), c = r.render(**scene, lights, {}, 8);
   EXPECT_EQ(a.pixels, b.pixels);
   EXPECT_NE(a.pixels, c.pixels);  // noise differs frame to frame

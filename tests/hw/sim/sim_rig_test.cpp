@@ -17,6 +17,7 @@ std::unique_ptr<SimulatedRig> thesis_rig(int scale_down = 4) {
     c.width /= scale_down;
     c.height /= scale_down;
     c.pixel_size_um *= scale_down;
+    c.blur_px /= scale_down;  // the same lens on bigger pixels
   }
   auto rig = SimulatedRig::create(*desc);
   EXPECT_TRUE(rig.ok()) << rig.status().message();

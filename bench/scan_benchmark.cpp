@@ -1,0 +1,259 @@
+// The scan pipeline on the simulated rig against its ground truth: calibration
+// residuals (lens, markers, camera centres, laser planes), the point cloud's distance
+// to the true body surface with both triangulation methods, coverage (and where the
+// holes are), and the processing time from frames to points.
+//
+//   scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N]
+//
+// Defaults: both shipped rigs, the rig's own demo body, every step.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "recon/calib/plane_projection.hpp"
+#include "recon/geometry/mesh_distance.hpp"
+#include "recon/geometry/sample_surface.hpp"
+#include "recon/spatial/knn_index.hpp"
+#include "server/pipeline/scan.hpp"
+#include "server/pipeline/sim_backend.hpp"
+
+using namespace bodyscan;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double secs(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Distance between an estimated and the true laser plane over the part where a body
+// stands (|x| < 400, |z| < 300, 0 < y < 1900): the largest of the corners'.
+double plane_error(const LaserPlane& p, const hw::LaserDescription& l, int step) {
+  const Eigen::Vector3d n = l.plane_normal(step);
+  const double d = l.plane_offset(step);
+  double worst = 0;
+  for (double y : {0.0, 1900.0})
+    for (double z : {-300.0, 300.0}) {
+      // The point of the estimated plane at (y, z) along its normal's main axis (x).
+      const double x = (p.offset - p.normal.y() * y - p.normal.z() * z) / p.normal.x();
+      if (std::abs(x) > 2000) continue;
+      worst = std::max(worst, std::abs(n.dot(Eigen::Vector3d(x, y, z)) - d));
+    }
+  return worst;
+}
+
+struct Quantiles {
+  double mean = 0, p95 = 0, max = 0;
+};
+Quantiles quantiles(std::vector<double> v) {
+  Quantiles q;
+  if (v.empty()) return q;
+  std::sort(v.begin(), v.end());
+  for (double x : v) q.mean += x / static_cast<double>(v.size());
+  q.p95 = v[static_cast<size_t>(0.95 * static_cast<double>(v.size() - 1))];
+  q.max = v.back();
+  return q;
+}
+
+int run(const std::string& rig_name, const std::string& body, int every) {
+  auto sim = pipeline::open_simulated_rig(rig_name, body);
+  if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
+  hw::sim::SimulatedRig& rig = **sim;
+  const hw::RigDescription& desc = rig.description();
+  const pipeline::Rig handle = pipeline::rig_handle(rig);
+  std::printf("\n== rig %s, body %s, every %d step(s)\n", desc.name.c_str(),
+              body.empty() ? desc.simulation.subject.c_str() : body.c_str(), every);
+
+  // Calibration.
+  auto t0 = Clock::now();
+  pipeline::CalibrationBuilder builder(desc);
+  double calib_acquire = 0;
+  {
+    const Status s = pipeline::acquire_calibration(handle, [&](pipeline::Shot&& shot) { return builder.consume(std::move(shot)); });
+    if (!s.ok()) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+    calib_acquire = secs(t0);
+  }
+  auto cal = builder.finish();
+  if (!cal.ok()) return std::fprintf(stderr, "%s\n", cal.status().message().c_str()), 1;
+  std::printf("calibration: acquisition (rendering) %.1f s, processing %.2f s\n", calib_acquire, cal->processing_seconds);
+  for (size_t g = 0; g < cal->group_separation_mm.size(); ++g) {
+    std::printf("group %zu:", g);
+    for (int l : pipeline::group_lasers(desc, g))
+      std::printf(" %s%s", desc.lasers[static_cast<size_t>(l)].id.c_str(), cal->sweep_reversed[static_cast<size_t>(l)] ? " (reversed)" : "");
+    std::printf(", planes at least %.0f mm apart at the sweep ends\n", cal->group_separation_mm[g]);
+  }
+  std::printf("%-12s %5s %6s %9s %9s %9s %9s %9s %9s\n", "camera", "side", "dots", "held-out", "lens-rms", "lens-max",
+              "marker", "centre", "rays");
+  std::printf("%-12s %5s %6s %9s %9s %9s %9s %9s %9s\n", "", "", "", "px", "px", "px", "px", "mm", "mm");
+  for (size_t c = 0; c < cal->cameras.size(); ++c) {
+    const CameraCalibration& cc = cal->cameras[c];
+    const hw::CameraModel model = desc.cameras[c].model();
+    // Lens against the truth: corrected vs the true pinhole image, up to a homography,
+    // over the image on a 32-pixel grid.
+    std::vector<Eigen::Vector2d> corrected, pinhole;
+    for (int y = 0; y < model.height(); y += 32)
+      for (int x = 0; x < model.width(); x += 32) {
+        const auto u = model.undistort({(x - model.cx()) / model.fx(), (y - model.cy()) / model.fy()});
+        if (!u) continue;
+        corrected.push_back(cc.lens.correct({double(x), double(y)}));
+        pinhole.emplace_back(model.fx() * u->x() + model.cx(), model.fy() * u->y() + model.cy());
+      }
+    const Eigen::Matrix3d h = *fit_homography(corrected, pinhole);
+    std::vector<double> lens_err;
+    for (size_t i = 0; i < corrected.size(); ++i) lens_err.push_back((apply_homography(h, corrected[i]) - pinhole[i]).norm());
+    double lens_ss = 0;
+    for (double e : lens_err) lens_ss += e * e;
+    // Markers against the lights' true images.
+    double marker_worst = 0;
+    for (Pole p : kPoles)
+      for (int i = 0; i < 2; ++i) {
+        const auto truth = model.project(cc.frame.light(p, cc.side, i));
+        marker_worst = std::max(marker_worst, (cc.lens.distort(cc.markers[static_cast<size_t>(p)][static_cast<size_t>(i)]) - *truth).norm());
+      }
+    std::printf("%-12s %5s %6d %9.3f %9.3f %9.3f %9.3f %9.2f %9.2f\n", cc.camera_id.c_str(), to_string(cc.side),
+                cc.lens.dots_used(), cc.lens.held_out_rms_px(), std::sqrt(lens_ss / lens_err.size()),
+                quantiles(lens_err).max, marker_worst, (cc.centre - model.centre()).norm(), cc.ray_spread_mm);
+  }
+
+  // The scan, processed four times from the same frames: planes from the sweep fit
+  // or from each frame's poles, pixels to 3-D by the two-plane ray or the thesis's
+  // image-to-laser-plane transform. The first is the default.
+  std::vector<std::unique_ptr<pipeline::ScanProcessor>> processors;
+  std::vector<std::string> names;
+  for (pipeline::PlaneSource ps : {pipeline::PlaneSource::kSweepFit, pipeline::PlaneSource::kPerFrame})
+    for (TriangulationMethod m : {TriangulationMethod::kTwoPlaneRay, TriangulationMethod::kLaserHomography}) {
+      pipeline::ScanOptions o;
+      o.planes = ps;
+      o.triangulate.method = m;
+      processors.push_back(std::make_unique<pipeline::ScanProcessor>(*cal, o));
+      names.push_back(std::string(pipeline::to_string(ps)) + ", " + to_string(m));
+    }
+  std::vector<LaserPlaneFinder> finders;
+  for (const CameraCalibration& cc : cal->cameras) finders.emplace_back(cc);
+  std::vector<std::vector<hw::Frame>> bases(desc.laser_groups.size(), std::vector<hw::Frame>(cal->cameras.size()));
+  std::vector<double> plane_errors;
+  t0 = Clock::now();
+  const Status s = pipeline::acquire_scan(
+      handle,
+      [&](pipeline::Shot&& shot) -> Status {
+        if (shot.kind == pipeline::ShotKind::kLaserBase) bases[static_cast<size_t>(shot.group)][shot.camera] = shot.frame;
+        if (shot.kind == pipeline::ShotKind::kScanStep) {
+          // The plane against the true plane of the laser this camera sees.
+          const auto& seen = cal->lasers_seen[shot.camera];
+          for (const pipeline::LaserState& l : shot.lasers) {
+            if (std::find(seen.begin(), seen.end(), l.laser) == seen.end()) continue;
+            auto plane = finders[shot.camera].find(pipeline::view(shot.frame),
+                                                   pipeline::view(bases[static_cast<size_t>(shot.group)][shot.camera]));
+            if (plane.ok()) plane_errors.push_back(plane_error(*plane, desc.lasers[static_cast<size_t>(l.laser)], l.step));
+          }
+        }
+        for (size_t k = 1; k < processors.size(); ++k) {
+          pipeline::Shot copy = shot;
+          RETURN_IF_ERROR(processors[k]->consume(std::move(copy)));
+        }
+        return processors[0]->consume(std::move(shot));
+      },
+      every, {}, cal->sweep_reversed);
+  if (!s.ok()) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+  const double scan_total = secs(t0);
+  std::vector<PointCloud> clouds;
+  for (auto& p : processors) {
+    auto c = p->finish();
+    if (!c.ok()) return std::fprintf(stderr, "%s\n", c.status().message().c_str()), 1;
+    clouds.push_back(std::move(*c));
+  }
+  const pipeline::ScanStats stats = processors[0]->stats();
+  const Quantiles pe = quantiles(plane_errors);
+  std::printf("scan: %zu frames per camera-step, %zu without a plane, far bottom estimated in %zu; acquisition + "
+              "processing %.1f s, processing (frames -> points, one method) %.2f s = %.2f ms per frame\n",
+              stats.frames, stats.frames_without_plane, stats.far_bottom_estimated, scan_total,
+              stats.processing_seconds, 1e3 * stats.processing_seconds / std::max<size_t>(1, stats.frames));
+  std::printf("laser planes vs truth (worst corner of the body's box): mean %.3f mm, p95 %.3f, max %.3f over %zu; "
+              "fourth pole point off the other three's plane: RMS %.3f mm\n",
+              pe.mean, pe.p95, pe.max, plane_errors.size(), stats.fourth_point_rms_mm);
+
+  // Against the body's true surface.
+  const TriangleMesh& truth = rig.scene().subject();
+  const MeshDistance distance(truth);
+  for (const pipeline::LaserSweepReport& r : stats.sweeps) {
+    const hw::LaserDescription& l = desc.lasers[static_cast<size_t>(r.laser)];
+    // The true axis: the line through the laser's position along its axis.
+    const Eigen::Vector3d d = r.axis_point - l.position;
+    const double axis_off = (d - d.dot(l.axis.normalized()) * l.axis.normalized()).norm();
+    std::printf("laser %-12s sweep %s: %zu pole points (%zu rejected) %.3f mm RMS from their planes; %.5f deg/step "
+                "(true %.5f), axis %.2f mm from the true one\n",
+                l.id.c_str(), r.fitted ? "fitted" : r.error.c_str(), r.points_used, r.points_rejected, r.rms_mm,
+                r.degrees_per_step, l.step_angle_deg, axis_off);
+  }
+  for (size_t k = 0; k < processors.size(); ++k) {
+    const PointCloud& cloud = clouds[k];
+    const std::vector<float> d = distance.distances(cloud.positions);
+    std::vector<double> dd(d.begin(), d.end());
+    const Quantiles q = quantiles(dd);
+    size_t far = 0;
+    for (double x : dd) far += x > 5;
+    std::printf("%-36s %8zu points: distance to the true surface mean %.3f mm, p95 %.3f, max %.1f (%zu beyond 5 mm)\n",
+                names[k].c_str(), cloud.size(), q.mean, q.p95, q.max, far);
+    for (size_t c = 0; c < cal->cameras.size(); ++c) {
+      std::vector<double> dc;
+      for (size_t i = 0; i < dd.size(); ++i)
+        if (cloud.camera[i] == static_cast<int>(c)) dc.push_back(dd[i]);
+      const Quantiles qc = quantiles(dc);
+      std::printf("    camera %-12s %8zu points: mean %.3f mm, p95 %.3f\n", cal->cameras[c].camera_id.c_str(), dc.size(),
+                  qc.mean, qc.p95);
+    }
+    if (k != 0) continue;
+    // Coverage: the share of the body's area within 5 mm of a point, and where the rest is.
+    const PointCloud samples = sample_mesh_uniform(truth, 400000, 7, true);
+    const KnnIndex index(cloud.positions);
+    size_t covered = 0;
+    std::map<std::string, size_t> holes;
+    for (size_t i = 0; i < samples.size(); ++i) {
+      uint32_t nn;
+      float d2;
+      if (index.knn(samples.positions[i], 1, &nn, &d2) == 1 && d2 <= 25.f) {
+        ++covered;
+        continue;
+      }
+      const Vec3f& x = samples.positions[i];
+      const Vec3f& n = samples.normals[i];
+      const char* band = x.y() < 80 ? "feet" : x.y() < 800 ? "legs" : x.y() < 1450 ? "trunk" : "head/neck";
+      const char* facing = n.y() > 0.7f ? "up" : n.y() < -0.7f ? "down" : std::abs(n.x()) > std::abs(n.z()) ? "side" : n.z() > 0 ? "front" : "back";
+      holes[std::string(band) + " facing " + facing]++;
+    }
+    std::printf("coverage within 5 mm: %.1f %% of the body's area; uncovered:", 100.0 * covered / samples.size());
+    std::vector<std::pair<size_t, std::string>> by_size;
+    for (const auto& [k, v] : holes) by_size.emplace_back(v, k);
+    std::sort(by_size.rbegin(), by_size.rend());
+    for (size_t i = 0; i < std::min<size_t>(6, by_size.size()); ++i)
+      std::printf("%s %s %.1f %%", i ? "," : "", by_size[i].second.c_str(), 100.0 * by_size[i].first / samples.size());
+    std::printf("\n");
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> rigs, bodies;
+  int every = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
+    else if (a == "--body" && i + 1 < argc) bodies.push_back(argv[++i]);
+    else if (a == "--every" && i + 1 < argc) every = std::max(1, std::atoi(argv[++i]));
+    else {
+      std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N]\n");
+      return 2;
+    }
+  }
+  if (rigs.empty()) rigs = {"thesis", "square"};
+  if (bodies.empty()) bodies = {""};
+  for (const std::string& r : rigs)
+    for (const std::string& b : bodies)
+      if (const int rc = run(r, b, every); rc != 0) return rc;
+  return 0;
+}

@@ -1,0 +1,142 @@
+// `bodyscan scan`: calibrate the simulated rig, scan the body, build the surface, and
+// write the results - the very pipeline the server runs.
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "server/pipeline/scan_job.hpp"
+#include "server/pipeline/sim_backend.hpp"
+
+namespace bodyscan::cli {
+
+namespace {
+
+void usage(FILE* out) {
+  std::fputs(
+      "usage: bodyscan scan --rig RIG --out DIR [options]\n"
+      "\n"
+      "Calibrates the rig from what its cameras see (dot grid, frame lights, lasers on\n"
+      "the frame's poles), scans the subject, turns the laser stripes into one point\n"
+      "cloud and reconstructs a closed surface. Writes DIR/points.ply, DIR/mesh.ply,\n"
+      "DIR/calibration.json and DIR/scan.json.\n"
+      "\n"
+      "  --rig RIG        sim (the thesis rig and the demo body), thesis, square,\n"
+      "                   or a rig description file (JSON)\n"
+      "  --body BODY.ply  the subject (mm, Y up; default: the rig description's)\n"
+      "  --out DIR        output folder (created)\n"
+      "  --every N        scan every Nth laser step only (default 1: all)\n"
+      "  --method M       ray (default: the two-plane ray met with the laser plane)\n"
+      "                   or homography (the thesis's image-to-laser-plane transform)\n"
+      "  --no-surface     stop at the point cloud\n"
+      "  -q, --quiet      print only errors\n",
+      out);
+}
+
+}  // namespace
+
+int run_scan(int argc, char** argv) {
+  std::string rig_arg, body, out;
+  pipeline::ScanJobOptions options;
+  bool quiet = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "bodyscan scan: %s needs a value\n", a.c_str());
+        return nullptr;
+      }
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      usage(stdout);
+      return 0;
+    } else if (a == "--rig" || a == "--body" || a == "--out" || a == "--every" || a == "--method") {
+      const char* v = value();
+      if (!v) return 2;
+      if (a == "--rig") rig_arg = v;
+      if (a == "--body") body = v;
+      if (a == "--out") out = v;
+      if (a == "--every") {
+        options.every = std::atoi(v);
+        if (options.every < 1) {
+          std::fprintf(stderr, "bodyscan scan: --every expects a positive integer, got '%s'\n", v);
+          return 2;
+        }
+      }
+      if (a == "--method") {
+        const std::string m = v;
+        if (m == "ray") options.scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
+        else if (m == "homography") options.scan.triangulate.method = TriangulationMethod::kLaserHomography;
+        else {
+          std::fprintf(stderr, "bodyscan scan: --method is ray or homography, not '%s'\n", v);
+          return 2;
+        }
+      }
+    } else if (a == "--no-surface") {
+      options.reconstruct = false;
+    } else if (a == "-q" || a == "--quiet") {
+      quiet = true;
+    } else {
+      std::fprintf(stderr, "bodyscan scan: unknown option '%s'\n", a.c_str());
+      usage(stderr);
+      return 2;
+    }
+  }
+  if (rig_arg.empty() || out.empty()) {
+    std::fprintf(stderr, "bodyscan scan: --rig and --out are required\n");
+    usage(stderr);
+    return 2;
+  }
+  auto sim = pipeline::open_simulated_rig(rig_arg, body);
+  if (!sim.ok()) {
+    std::fprintf(stderr, "bodyscan scan: %s\n", sim.status().message().c_str());
+    return 1;
+  }
+  std::string last_stage;
+  int last_percent = -1;
+  if (!quiet) {
+    options.progress = [&](std::string_view stage, double fraction) {
+      const int percent = static_cast<int>(fraction * 100);
+      if (stage != last_stage) {
+        if (!last_stage.empty()) std::fprintf(stderr, "\n");
+        last_stage = std::string(stage);
+        last_percent = -1;
+      }
+      if (percent != last_percent) {
+        std::fprintf(stderr, "\r  %-28s %3d%%", last_stage.c_str(), percent);
+        last_percent = percent;
+      }
+      return true;
+    };
+  }
+  auto result = pipeline::run_scan_job(pipeline::rig_handle(**sim), options);
+  if (!quiet && !last_stage.empty()) std::fprintf(stderr, "\n");
+  if (!result.ok()) {
+    std::fprintf(stderr, "bodyscan scan: %s\n", result.status().message().c_str());
+    return 1;
+  }
+  const Status w = pipeline::write_scan_results(*result, out);
+  if (!w.ok()) {
+    std::fprintf(stderr, "bodyscan scan: %s\n", w.message().c_str());
+    return 1;
+  }
+  if (!quiet) {
+    for (const CameraCalibration& c : result->calibration.cameras) {
+      std::printf("camera %-12s %s side, centre (%.0f, %.0f, %.0f) mm, lens held-out %.3f px, rays meet within %.2f mm\n",
+                  c.camera_id.c_str(), to_string(c.side), c.centre.x(), c.centre.y(), c.centre.z(),
+                  c.lens.held_out_rms_px(), c.ray_spread_mm);
+    }
+    std::printf("scan: %zu points from %zu frames (%zu without a laser plane), processing %.2f s\n",
+                result->cloud.size(), result->scan.frames, result->scan.frames_without_plane,
+                result->scan.processing_seconds);
+    if (!result->mesh.triangles.empty()) {
+      std::printf("surface: %zu vertices, %zu triangles in %.1f s\n", result->mesh.vertices.size(),
+                  result->mesh.triangles.size(), result->surface.total_seconds());
+    }
+    std::printf("wrote %s/points.ply%s, calibration.json, scan.json\n", out.c_str(),
+                result->mesh.triangles.empty() ? "" : ", mesh.ply");
+  }
+  return 0;
+}
+
+}  // namespace bodyscan::cli

@@ -1,0 +1,88 @@
+#include "server/pipeline/scan_job.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+
+#include "recon/io/atomic_file.hpp"
+#include "recon/io/ply.hpp"
+
+namespace bodyscan::pipeline {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& options) {
+  ScanJobResult out;
+  auto t0 = std::chrono::steady_clock::now();
+  ASSIGN_OR_RETURN(out.calibration, calibrate_rig(rig, options.calibrate, options.progress));
+  out.calibration_seconds = seconds_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  ScanProcessor processor(out.calibration, options.scan);
+  RETURN_IF_ERROR(acquire_scan(
+      rig, [&](Shot&& s) { return processor.consume(std::move(s)); }, options.every, options.progress,
+      out.calibration.sweep_reversed));
+  ASSIGN_OR_RETURN(out.cloud, processor.finish());
+  out.scan = processor.stats();
+  out.scan_seconds = seconds_since(t0);
+  if (out.cloud.size() < 1000) {
+    return failed_precondition("the scan gave " + std::to_string(out.cloud.size()) +
+                               " points: is someone standing in the frame, and are the lasers on? " +
+                               (out.scan.first_plane_error.empty() ? "" : "(first frame error: " +
+                                                                             out.scan.first_plane_error + ")"));
+  }
+  if (options.reconstruct) {
+    ReconstructOptions ro = options.surface;
+    if (!ro.progress) ro.progress = options.progress;
+    ASSIGN_OR_RETURN(ReconstructResult r, reconstruct_surface(out.cloud, ro));
+    out.mesh = std::move(r.mesh);
+    out.surface = r.stats;
+  }
+  return out;
+}
+
+Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return io_error("cannot create '" + dir + "': " + ec.message());
+  const std::filesystem::path d(dir);
+  RETURN_IF_ERROR(write_file_atomically((d / "calibration.json").string(), to_json(r.calibration).dump(2)));
+  RETURN_IF_ERROR(write_ply((d / "points.ply").string(), r.cloud));
+  if (!r.mesh.triangles.empty()) RETURN_IF_ERROR(write_ply((d / "mesh.ply").string(), r.mesh));
+  nlohmann::json j;
+  j["points"] = r.cloud.size();
+  j["frames"] = r.scan.frames;
+  j["frames_unseen"] = r.scan.frames_unseen;
+  j["frames_without_plane"] = r.scan.frames_without_plane;
+  j["far_bottom_estimated"] = r.scan.far_bottom_estimated;
+  j["fourth_point_rms_mm"] = r.scan.fourth_point_rms_mm;
+  j["processing_seconds"] = r.scan.processing_seconds;
+  j["lasers"] = nlohmann::json::array();
+  for (const LaserSweepReport& s : r.scan.sweeps) {
+    j["lasers"].push_back({{"id", r.calibration.laser_ids[static_cast<size_t>(s.laser)]},
+                           {"sweep_fitted", s.fitted},
+                           {"error", s.error},
+                           {"pole_point_rms_mm", s.rms_mm},
+                           {"pole_points_used", s.points_used},
+                           {"pole_points_rejected", s.points_rejected},
+                           {"degrees_per_step", s.degrees_per_step},
+                           {"axis_point_mm", {s.axis_point.x(), s.axis_point.y(), s.axis_point.z()}},
+                           {"axis_direction", {s.axis_direction.x(), s.axis_direction.y(), s.axis_direction.z()}}});
+  }
+  j["calibration_seconds"] = r.calibration_seconds;
+  j["scan_seconds"] = r.scan_seconds;
+  if (!r.mesh.triangles.empty()) {
+    j["mesh"] = {{"vertices", r.mesh.vertices.size()},
+                 {"triangles", r.mesh.triangles.size()},
+                 {"holes_filled", r.surface.holes_filled},
+                 {"seconds", r.surface.total_seconds()}};
+  }
+  return write_file_atomically((d / "scan.json").string(), j.dump(2));
+}
+
+}  // namespace bodyscan::pipeline
