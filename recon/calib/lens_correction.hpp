@@ -40,7 +40,7 @@ struct DotOptions {
 };
 
 // The dots of a dot-grid image, in raster order of their first pixel. Blobs within
-// eight pixels of the image border are left out: part of their dot may be cut off,
+// six pixels of the image border are left out: part of their dot may be cut off,
 // and their background cannot be measured all round. Errors: an empty image or
 // options out of range.
 StatusOr<std::vector<Dot>> find_dots(const ImageView& image, const DotOptions& options = {});
@@ -77,7 +77,7 @@ struct LensOptions {
   // Thin-plate spline smoothing: added to the kernel matrix's diagonal, with the dots'
   // coordinates scaled to unit RMS radius. 0 interpolates the centroids, noise and
   // all; the default, tuned on the simulated thesis rig (held-out error 0.017 px),
-  // trims the error between dots by a tenth.
+  // trims the error between dots by a sixth.
   double smoothing = 0.01;
   // Degree of the splines' polynomial part, 1..5. 1 is the thesis's (affine); 5 takes
   // in a lens's radial distortion up to r^5 (Brown-Conrady k1, k2), so the kernels
@@ -106,7 +106,7 @@ class LensCorrection {
   // spline beyond.
   Eigen::Vector2d correct(const Eigen::Vector2d& captured) const;
   // Ideal pixel -> captured pixel: the inverse splines, tabulated the same way, then
-  // a Newton step on correct(), so that the two agree to ~1e-4 pixel.
+  // a Newton step on correct(), so that the two agree to ~1e-5 pixel.
   Eigen::Vector2d distort(const Eigen::Vector2d& ideal) const;
   // The same from the splines themselves, O(dots) per call.
   Eigen::Vector2d correct_exact(const Eigen::Vector2d& captured) const;

@@ -77,11 +77,12 @@ struct Board {
 };
 
 // Calibrates thesis cameras (all, or the one named) on a board and checks each
-// against its true lens.
-void check_board(const Board& b, double max_rms, double max_worst, const std::string& only = "") {
-  // Beyond the outermost dots (a band of about one dot spacing) the splines
-  // extrapolate: a looser bound, still far below the distortion itself.
-  constexpr double kMaxWorstAnywhere = 1.0;
+// against its true lens: between dots to `max_rms` and `max_worst`, and anywhere in
+// the image to `max_worst_anywhere` - beyond the outermost dots (a band about one
+// dot spacing wide, more where the board leaves a corner bare) the splines
+// extrapolate, which still takes out all but a few percent of the distortion.
+void check_board(const Board& b, double max_rms, double max_worst, double max_worst_anywhere,
+                 const std::string& only = "") {
   auto desc = load_rig_description(*shipped_rig_path("thesis"));
   ASSERT_TRUE(desc.ok()) << desc.status().message();
   for (const CameraDescription& cam : desc->cameras) {
@@ -101,7 +102,7 @@ void check_board(const Board& b, double max_rms, double max_worst, const std::st
     EXPECT_LT(r.worst, max_worst) << cam.id;
     // Uncorrected, the same check fails by pixels: it is a real one.
     EXPECT_GT(none.rms, 20 * max_rms) << cam.id;
-    EXPECT_LT(anywhere.worst, kMaxWorstAnywhere) << cam.id;
+    EXPECT_LT(anywhere.worst, max_worst_anywhere) << cam.id;
     std::printf(
         "[ lens ] %-11s board %4.0f mm, %2d cols, turn %2.0f deg: dots %d found / %d used, fit %.4f px, held-out "
         "%.4f px; truth between dots (%d px) RMS %.4f max %.4f px, anywhere (%d px) RMS %.4f max %.4f px "
@@ -112,14 +113,15 @@ void check_board(const Board& b, double max_rms, double max_worst, const std::st
   }
 }
 
-// Measured: RMS 0.009-0.011 px, worst 0.05-0.09 px (uncorrected 6-9 px, worst 25-34).
-TEST(LensOnRig, EveryThesisCameraIsCorrectedToAPinhole) { check_board({800, 4, 25}, 0.025, 0.15); }
+// Measured: between dots RMS 0.009-0.011 px, worst 0.031-0.047 px; anywhere worst
+// 0.33-0.62 px (uncorrected RMS 6-9 px, worst 25-34 px).
+TEST(LensOnRig, EveryThesisCameraIsCorrectedToAPinhole) { check_board({800, 4, 25}, 0.025, 0.1, 1.0); }
 
 // The other boards on the camera with the strongest distortion (k1 = -0.13).
-TEST(LensOnRig, BoardTurnedThirtyDegrees) { check_board({800, 30, 25}, 0.025, 0.15, "back"); }
+TEST(LensOnRig, BoardTurnedThirtyDegrees) { check_board({800, 30, 25}, 0.025, 0.1, 2.5, "back"); }
 
 // Farther, with more and smaller dots (17 px across instead of 23).
-TEST(LensOnRig, FartherBoardWithSmallerDots) { check_board({1200, 4, 33}, 0.025, 0.15, "back"); }
+TEST(LensOnRig, FartherBoardWithSmallerDots) { check_board({1200, 4, 33}, 0.025, 0.1, 1.0, "back"); }
 
 }  // namespace
 }  // namespace bodyscan::hw::sim
