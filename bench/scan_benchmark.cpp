@@ -58,6 +58,11 @@ Quantiles quantiles(std::vector<double> v) {
   return q;
 }
 
+double g_min_angle = 10;
+int g_smooth = 3;
+int g_threshold = 0;
+float g_redundant = 3;
+
 int run(const std::string& rig_name, const std::string& body, int every) {
   auto sim = pipeline::open_simulated_rig(rig_name, body);
   if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
@@ -124,10 +129,14 @@ int run(const std::string& rig_name, const std::string& body, int every) {
   std::vector<std::unique_ptr<pipeline::ScanProcessor>> processors;
   std::vector<std::string> names;
   for (pipeline::PlaneSource ps : {pipeline::PlaneSource::kSweepFit, pipeline::PlaneSource::kPerFrame})
-    for (TriangulationMethod m : {TriangulationMethod::kTwoPlaneRay, TriangulationMethod::kLaserHomography}) {
+    for (TriangulationMethod m : {TriangulationMethod::kLaserHomography, TriangulationMethod::kTwoPlaneRay}) {
       pipeline::ScanOptions o;
       o.planes = ps;
       o.triangulate.method = m;
+      o.triangulate.min_angle_deg = g_min_angle;
+      o.triangulate.smooth_rows = g_smooth;
+      if (g_threshold > 0) o.triangulate.stripe.threshold = g_threshold;
+      o.redundant_radius_mm = g_redundant;
       processors.push_back(std::make_unique<pipeline::ScanProcessor>(*cal, o));
       names.push_back(std::string(pipeline::to_string(ps)) + ", " + to_string(m));
     }
@@ -167,6 +176,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
   }
   const pipeline::ScanStats stats = processors[0]->stats();
   const Quantiles pe = quantiles(plane_errors);
+  std::printf("redundant points dropped (a point with twice the confidence within %.1f mm): %zu\n", g_redundant,
+              stats.points_redundant);
   std::printf("scan: %zu frames per camera-step, %zu without a plane, far bottom estimated in %zu; acquisition + "
               "processing %.1f s, processing (frames -> points, one method) %.2f s = %.2f ms per frame\n",
               stats.frames, stats.frames_without_plane, stats.far_bottom_estimated, scan_total,
@@ -206,6 +217,14 @@ int run(const std::string& rig_name, const std::string& body, int every) {
                   qc.mean, qc.p95);
     }
     if (k != 0) continue;
+    // By confidence (contrast and triangulation angle).
+    for (double lo : {0.0, 0.25, 0.5, 0.75}) {
+      std::vector<double> dc;
+      for (size_t i = 0; i < dd.size(); ++i)
+        if (cloud.confidence[i] >= lo && cloud.confidence[i] < lo + 0.25 + 1e-6) dc.push_back(dd[i]);
+      const Quantiles qc = quantiles(dc);
+      std::printf("    confidence %.2f-%.2f %8zu points: mean %.3f mm, p95 %.3f\n", lo, lo + 0.25, dc.size(), qc.mean, qc.p95);
+    }
     // Coverage: the share of the body's area within 5 mm of a point, and where the rest is.
     const PointCloud samples = sample_mesh_uniform(truth, 400000, 7, true);
     const KnnIndex index(cloud.positions);
@@ -245,6 +264,10 @@ int main(int argc, char** argv) {
     if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
     else if (a == "--body" && i + 1 < argc) bodies.push_back(argv[++i]);
     else if (a == "--every" && i + 1 < argc) every = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--min-angle" && i + 1 < argc) g_min_angle = std::atof(argv[++i]);
+    else if (a == "--smooth" && i + 1 < argc) g_smooth = std::atoi(argv[++i]);
+    else if (a == "--threshold" && i + 1 < argc) g_threshold = std::atoi(argv[++i]);
+    else if (a == "--redundant" && i + 1 < argc) g_redundant = static_cast<float>(std::atof(argv[++i]));
     else {
       std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N]\n");
       return 2;

@@ -25,8 +25,9 @@ void usage(FILE* out) {
       "  --body BODY.ply  the subject (mm, Y up; default: the rig description's)\n"
       "  --out DIR        output folder (created)\n"
       "  --every N        scan every Nth laser step only (default 1: all)\n"
-      "  --method M       ray (default: the two-plane ray met with the laser plane)\n"
-      "                   or homography (the thesis's image-to-laser-plane transform)\n"
+      "  --method M       homography (default: the thesis's image-to-laser-plane\n"
+      "                   transform, eq. 3.6) or ray (the pixel's two-plane ray met\n"
+      "                   with the laser plane)\n"
       "  --no-surface     stop at the point cloud\n"
       "  -q, --quiet      print only errors\n",
       out);

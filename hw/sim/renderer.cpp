@@ -105,6 +105,10 @@ double frame_light_emission(const FrameGeometry& f, const Lighting& lighting, co
   for (double ly : {0.0, f.top_height})
     for (double lx : f.light_x) {
       const double rho = std::hypot(h.position.x() - lx, h.position.y() - ly);
+      bool dead = false;
+      for (const Vec3d& d : lighting.dead_lights)
+        dead = dead || (std::abs(d.x() - lx) < 1 && std::abs(d.y() - ly) < 1 && std::abs(d.z() - h.position.z()) < 1);
+      if (dead) continue;
       if (margin > 0) {
         if (rho < radius + margin) return 1;
       } else if (rho < radius) {
@@ -119,7 +123,7 @@ double frame_light_emission(const FrameGeometry& f, const Lighting& lighting, co
 template <typename CachedHit>
 Light light_at(const Scene& scene, const Lighting& lighting, const std::vector<LaserPlane>& lasers,
                const SimulationDescription& sim, const CameraModel& model, const std::vector<Vec3f>& rays,
-               const CachedHit& cached, int width, int height, int x, int y) {
+               const CachedHit& cached, int width, int height, int x, int y, double psf_px) {
   Light out;
   const Vec3f& rf = rays[static_cast<size_t>(y) * width + x];
   if (rf.isZero()) return out;
@@ -174,7 +178,10 @@ Light light_at(const Scene& scene, const Lighting& lighting, const std::vector<L
       const double d = n.dot(h.position) - p.offset;
       const double sigma = p.sigma;
       const double gx = 0.5 * n.dot(dx), gy = 0.5 * n.dot(dy);  // plane distance per pixel
-      const double var = sigma * sigma + (gx * gx + gy * gy) / 12.0;
+      // The profile across the plane, widened by the pixel's footprint (a box) and
+      // the lens's point spread (the frame's blur leaves the stripe alone, so that it
+      // is spread before it is sampled, as in a camera).
+      const double var = sigma * sigma + (gx * gx + gy * gy) * (1.0 / 12.0 + psf_px * psf_px);
       if (d * d > 16 * var) continue;
       const Vec3d to_laser = l.position - h.position;
       const double dist = to_laser.norm();
@@ -193,14 +200,14 @@ Light light_at(const Scene& scene, const Lighting& lighting, const std::vector<L
 
 std::vector<float> Renderer::irradiance(const Scene& scene, const Lighting& lighting) const {
   const int w = camera_.width, h = camera_.height;
-  std::vector<float> out(static_cast<size_t>(w) * h);
+  std::vector<float> out = base_irradiance(scene, lighting);
   const std::vector<CachedHit>& hit = hits(scene);
   const std::vector<LaserPlane> planes = laser_planes(lighting);
+  if (planes.empty()) return out;
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const size_t i = static_cast<size_t>(y) * w + x;
-      const Light l = light_at(scene, lighting, planes, sim_, model_, rays_, hit[i], w, h, x, y);
-      out[i] = static_cast<float>(l.base + l.laser);
+      out[i] += static_cast<float>(light_at(scene, lighting, planes, sim_, model_, rays_, hit[i], w, h, x, y, camera_.blur_px).laser);
     }
   });
   return out;
@@ -283,14 +290,13 @@ Frame Renderer::render(const Scene& scene, const Lighting& lighting, const Expos
         bool near = false;
         for (const LaserPlane& lp : planes) near = near || std::abs(lp.normal.dot(p) - lp.offset) < 4 * lp.sigma + 60;
         if (!near) continue;
-        const Light l = light_at(scene, lighting, planes, sim_, model_, rays_, hit[i], w, h, x, y);
+        const Light l = light_at(scene, lighting, planes, sim_, model_, rays_, hit[i], w, h, x, y, camera_.blur_px);
         if (l.laser > 0) {
           irradiance[i] += static_cast<float>(l.laser * std::max(0.0, 1.0 + sim_.speckle_contrast * standard_normal(seed ^ mix(i))));
         }
       }
     });
   }
-  blur(irradiance, w, h, camera_.blur_px);
   return expose(irradiance, camera_, exposure, seed);
 }
 
@@ -308,11 +314,17 @@ const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Li
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const size_t i = static_cast<size_t>(y) * w + x;
-      cache.irradiance[i] = static_cast<float>(light_at(scene, no_lasers, none, sim_, model_, rays_, hit[i], w, h, x, y).base);
+      cache.irradiance[i] = static_cast<float>(light_at(scene, no_lasers, none, sim_, model_, rays_, hit[i], w, h, x, y, camera_.blur_px).base);
     }
   });
+  blur(cache.irradiance, w, h, camera_.blur_px);
   cache.version = scene.version();
   return cache.irradiance;
+}
+
+void Renderer::forget_lights() {
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  for (BaseCache& c : base_) c.irradiance.clear();
 }
 
 const std::vector<Renderer::CachedHit>& Renderer::hits(const Scene& scene) const {

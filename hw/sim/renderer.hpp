@@ -23,6 +23,7 @@ struct Lighting {
   bool room_lights = false;
   bool front_frame_lights = false;  // the front poles' lights (Z > 0)
   bool back_frame_lights = false;
+  std::vector<Vec3d> dead_lights;  // frame lights (centres) that stay dark when switched on
   std::vector<ActiveLaser> lasers;  // the lasers that are on, at their steps
 };
 
@@ -57,6 +58,8 @@ class Renderer {
 
   // Ground truth: the surface point seen through a (sub-)pixel, if any.
   Hit surface_at(const Scene& scene, const Vec2d& pixel) const;
+  // Drops the cached lights-only images (the lights themselves changed).
+  void forget_lights();
 
  private:
   // What each pixel's ray hits, cast once per scene version: a still scene is cast

@@ -184,11 +184,18 @@ void SimulatedRig::hold_dot_grid(size_t i, bool held) { dot_grid_held_.at(i) = h
 
 void SimulatedRig::fail_camera_after(size_t i, uint64_t frames, StatusCode code) { cameras_.at(i)->fail_after(frames, code); }
 
+void SimulatedRig::break_frame_light(const Vec3d& centre) {
+  std::lock_guard<std::mutex> lock(scene_mutex_);
+  dead_lights_.push_back(centre);
+  for (auto& r : renderers_) r->forget_lights();
+}
+
 Lighting SimulatedRig::lighting() const {
   Lighting l;
   l.room_lights = controller_->room();
   l.front_frame_lights = controller_->front_lights();
   l.back_frame_lights = controller_->back_lights();
+  l.dead_lights = dead_lights_;
   for (size_t i = 0; i < rig_.lasers.size(); ++i) {
     if (controller_->laser_on(static_cast<int>(i))) l.lasers.push_back({&rig_.lasers[i], controller_->step(i)});
   }

@@ -42,6 +42,8 @@ class SimulatedRig {
   // Fault injection: camera `i` answers `frames` more grabs, then fails every grab
   // with `code` (kDeadlineExceeded: stops answering; kUnavailable: unplugged).
   void fail_camera_after(size_t i, uint64_t frames, StatusCode code);
+  // Fault injection: the frame light centred at `centre` (visible_lights) stays dark.
+  void break_frame_light(const Vec3d& centre);
 
  private:
   SimulatedRig() = default;
@@ -57,6 +59,7 @@ class SimulatedRig {
   std::vector<std::unique_ptr<SimCamera>> cameras_;
   std::vector<DotGridTarget> dot_grids_;
   std::vector<bool> dot_grid_held_;
+  std::vector<Vec3d> dead_lights_;
   mutable std::mutex scene_mutex_;  // the scene is posed per grab
 };
 

@@ -98,4 +98,31 @@ StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const
   return out;
 }
 
+void smooth_stripe(std::vector<StripeSample>& samples, int half_window, double max_step) {
+  const size_t n = samples.size();
+  std::vector<float> out(n);
+  for (size_t i = 0; i < n; ++i) {
+    out[i] = samples[i].column;
+    // Walk out from sample i each way while the stripe continues.
+    double s1 = 1, sr = 0, srr = 0, sc = samples[i].column, src = 0;
+    for (int dir : {-1, 1}) {
+      size_t prev = i;
+      for (long j = static_cast<long>(i) + dir; j >= 0 && j < static_cast<long>(n); j += dir) {
+        const StripeSample& a = samples[static_cast<size_t>(j)];
+        const int dr = a.row - samples[i].row;
+        if (std::abs(dr) > half_window) break;
+        const int step = std::abs(a.row - samples[prev].row);
+        if (std::abs(a.column - samples[prev].column) > max_step * step) break;
+        s1 += 1, sr += dr, srr += double(dr) * dr, sc += a.column, src += dr * double(a.column);
+        prev = static_cast<size_t>(j);
+      }
+    }
+    if (s1 < 3) continue;
+    const double det = s1 * srr - sr * sr;
+    if (det <= 0) continue;
+    out[i] = static_cast<float>((sc * srr - sr * src) / det);  // the line's value at dr = 0
+  }
+  for (size_t i = 0; i < n; ++i) samples[i].column = out[i];
+}
+
 }  // namespace bodyscan

@@ -46,4 +46,13 @@ StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const
                                                    const StripeOptions& options = {}, int full_scale = 255,
                                                    const std::vector<ColumnRange>* windows = nullptr);
 
+// Smooths a frame's samples along the stripe: each column becomes the value at its
+// row of the straight line fitted to the samples within `half_window` rows that
+// continue the stripe (each within `max_step` pixels per row of the one before).
+// The stripe is a curve across rows while speckle and sensor noise are independent
+// from row to row, so this averages the noise of 2 * half_window + 1 samples for a
+// bias of the stripe's curvature over the window. Samples without two neighbours on
+// the stripe keep their column.
+void smooth_stripe(std::vector<StripeSample>& samples, int half_window = 2, double max_step = 1.5);
+
 }  // namespace bodyscan

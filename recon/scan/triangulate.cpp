@@ -80,7 +80,13 @@ StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration
                                                          const ImageView& frame, const ImageView& base, int full_scale,
                                                          const TriangulateOptions& options) {
   const std::vector<ColumnRange> windows = stripe_windows(cal, plane, scan_volume(cal.frame), options.window_pad_px);
-  return extract_stripe(frame, base, options.stripe, full_scale, &windows);
+  ASSIGN_OR_RETURN(std::vector<StripeSample> samples, extract_stripe(frame, base, options.stripe, full_scale, &windows));
+  if (options.smooth_rows > 0) smooth_stripe(samples, options.smooth_rows);
+  return samples;
+}
+
+float angle_confidence(double angle_deg, double full_angle_deg) {
+  return static_cast<float>(std::clamp(std::sin(angle_deg * M_PI / 180) / std::sin(full_angle_deg * M_PI / 180), 0.0, 1.0));
 }
 
 size_t triangulate_samples(const CameraCalibration& cal, const LaserPlane& plane,
@@ -93,8 +99,10 @@ size_t triangulate_samples(const CameraCalibration& cal, const LaserPlane& plane
     const Eigen::Vector2d corrected = cal.lens.correct({s.column, static_cast<double>(s.row)});
     const Eigen::Vector3d p = plane.triangulate(cal, corrected, options.method);
     if (!p.allFinite() || !volume.contains(p)) continue;
+    const Ray3 r = cal.ray(corrected);
+    const double angle = std::asin(std::min(1.0, std::abs(r.direction.dot(plane.normal)))) * 180 / M_PI;
+    if (angle < options.min_angle_deg) continue;
     if (!others.empty()) {
-      const Ray3 r = cal.ray(corrected);
       if (r.direction.y() < 0) {
         const Eigen::Vector3d q = r.origin + (floor_y - r.origin.y()) / r.direction.y() * r.direction;
         bool ghost = false;
@@ -104,7 +112,8 @@ size_t triangulate_samples(const CameraCalibration& cal, const LaserPlane& plane
     }
     cloud->positions.push_back(p.cast<float>());
     cloud->intensity.push_back(static_cast<float>(s.peak) / static_cast<float>(full_scale));
-    cloud->confidence.push_back(std::max(0.05f, stripe_confidence(s, options.stripe.threshold)));
+    cloud->confidence.push_back(std::max(0.05f, stripe_confidence(s, options.stripe.threshold)) *
+                                std::max(0.05f, angle_confidence(angle, options.full_angle_deg)));
     cloud->camera.push_back(source.camera);
     cloud->laser.push_back(source.laser);
     cloud->frame.push_back(source.frame);

@@ -33,9 +33,15 @@ std::vector<ColumnRange> stripe_windows(const CameraCalibration& cal, const Lase
 
 struct TriangulateOptions {
   StripeOptions stripe;
-  TriangulationMethod method = TriangulationMethod::kTwoPlaneRay;
+  TriangulationMethod method = TriangulationMethod::kLaserHomography;
   int window_pad_px = 8;
-  double floor_line_mm = 3;  // a sample whose floor point is this near another lit laser's plane is that laser's
+  int smooth_rows = 3;  // smooth_stripe's half window (0: off)
+  double floor_line_mm = 3;
+  // The angle between a pixel's ray and the laser plane: the depth error is the
+  // stripe's error over its sine. Points seen at less than min_angle_deg are dropped;
+  // confidence falls in proportion to the sine below full_angle_deg.
+  double min_angle_deg = 10;
+  double full_angle_deg = 30;  // a sample whose floor point is this near another lit laser's plane is that laser's
 };
 
 // Where a frame's points came from, stored with each point.
@@ -46,6 +52,8 @@ struct PointSource {
 // Confidence of a stripe sample from its contrast: 0 at the threshold, 1 from four
 // thresholds up.
 float stripe_confidence(const StripeSample& s, int threshold);
+// Confidence from the triangulation angle (between the ray and the laser plane).
+float angle_confidence(double angle_deg, double full_angle_deg);
 
 // The frame's stripe samples where `plane` can meet the subject (stripe_windows).
 StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration& cal, const LaserPlane& plane,

@@ -92,7 +92,8 @@ Status calibration_sequence(const Rig& rig, const ShotSink& sink, const Progress
     const int l = static_cast<int>(i);
     RETURN_IF_ERROR(ctl.home(l));
     RETURN_IF_ERROR(grab_all(rig, shot(ShotKind::kLaserBase), sink));
-    for (int step : {desc.lasers[i].min_step, desc.lasers[i].max_step}) {
+    const int home = std::clamp(0, desc.lasers[i].min_step, desc.lasers[i].max_step);
+    for (int step : {desc.lasers[i].min_step, home, desc.lasers[i].max_step}) {
       RETURN_IF_ERROR(ctl.move_to(l, step));
       RETURN_IF_ERROR(ctl.set_laser(l, true));
       RETURN_IF_ERROR(grab_all(rig, shot(ShotKind::kLaserIdentify, -1, -1, {{l, step}}), sink));

@@ -37,7 +37,7 @@ enum class ShotKind {
   kFrameLights,     // both frame-light circuits on
   kFrontLights,     // the front poles' circuit only (which side a camera faces)
   kLaserBase,       // lasers off, just before a laser or a group comes on
-  kLaserIdentify,   // one laser alone at an end of its sweep (which camera sees which laser)
+  kLaserIdentify,   // one laser alone at an end or the middle of its sweep (which camera sees which laser)
   kScanStep,        // a group's lasers on at a step
 };
 const char* to_string(ShotKind k);
@@ -60,8 +60,8 @@ struct Shot {
 using ShotSink = std::function<Status(Shot&&)>;
 
 // Calibration: the dot grid before each camera; lights off, all frame lights on,
-// the front circuit alone; then each laser alone at both ends of its sweep after a
-// base frame, seen by every camera.
+// the front circuit alone; then each laser alone at both ends and the middle (step
+// 0) of its sweep after a base frame, seen by every camera.
 Status acquire_calibration(const Rig& rig, const ShotSink& sink, const ProgressFn& progress = {});
 
 // A scan: per laser group, a base frame (lasers off), then the group's lasers

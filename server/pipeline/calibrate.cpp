@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 
 namespace bodyscan::pipeline {
@@ -96,6 +97,15 @@ StatusOr<RigCalibration> CalibrationBuilder::finish() {
     const std::string& id = rig_.cameras[i].id;
     for (const hw::Frame* f : {&c.dot_grid, &c.lights_off, &c.frame_lights, &c.front_lights}) {
       if (f->pixels.empty()) return failed_precondition("camera '" + id + "': a calibration frame is missing");
+    }
+    // A black picture (a capped lens, a dead light) would only find noise.
+    std::vector<uint16_t> sorted(c.dot_grid.pixels);
+    const size_t p99 = sorted.size() * 99 / 100;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(p99), sorted.end());
+    if (sorted[p99] < c.dot_grid.max_value() / 10) {
+      return failed_precondition("camera '" + id + "': the dot-grid image is black (99 % of its pixels at or below " +
+                                 std::to_string(sorted[p99]) + " of " + std::to_string(c.dot_grid.max_value()) +
+                                 "): is the lens capped, the exposure too short, or the room light off?");
     }
     auto lens = calibrate_lens(view(c.dot_grid), options_.lens);
     if (!lens.ok()) {

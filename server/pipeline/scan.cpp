@@ -60,21 +60,28 @@ Status ScanProcessor::consume(Shot&& shot) {
     return {};
   }
   const ImageView f = view(shot.frame), b = view(base);
+  r.frame = frame_counter_ - 1;
+  r.full_scale = shot.frame.max_value();
   auto plane = finders_[shot.camera].find(f, b);
   if (!plane.ok()) {
+    // Past the poles' reach (or a pole hidden): the sweep fit will give this step's
+    // plane; keep every row's stripe until then.
     if (stats_.first_plane_error.empty()) stats_.first_plane_error = plane.status().message();
     ++stats_.frames_without_plane;
+    ASSIGN_OR_RETURN(r.samples, extract_stripe(f, b, options_.triangulate.stripe, r.full_scale));
+    if (options_.triangulate.smooth_rows > 0) smooth_stripe(r.samples, options_.triangulate.smooth_rows);
+    stats_.samples += r.samples.size();
+    records_.push_back(std::move(r));
     stats_.processing_seconds += seconds_since(t0);
     return {};
   }
+  r.has_plane = true;
   if (plane->poles[static_cast<size_t>(Pole::kFarBottom)].estimated) ++stats_.far_bottom_estimated;
   if (plane->fourth_point_mm >= 0) {
     fourth_ss_ += plane->fourth_point_mm * plane->fourth_point_mm;
     ++fourth_n_;
     stats_.fourth_point_rms_mm = std::sqrt(fourth_ss_ / static_cast<double>(fourth_n_));
   }
-  r.frame = frame_counter_ - 1;
-  r.full_scale = shot.frame.max_value();
   ASSIGN_OR_RETURN(r.samples, extract_plane_stripe(cal_.cameras[shot.camera], *plane, f, b, r.full_scale,
                                                    options_.triangulate));
   r.plane = std::move(*plane);
@@ -91,6 +98,7 @@ StatusOr<PointCloud> ScanProcessor::finish() {
   std::map<int, std::vector<SweepPoint>> points;
   std::map<int, std::vector<std::pair<int, SweepPlane>>> planes;
   for (const FrameRecord& r : records_) {
+    if (!r.has_plane) continue;
     for (const PoleStripe& p : r.plane.poles)
       if (p.found && p.used && !p.estimated) points[r.laser].push_back({r.step, p.world});
     planes[r.laser].push_back({r.step, {r.plane.normal, r.plane.offset}});
@@ -123,25 +131,38 @@ StatusOr<PointCloud> ScanProcessor::finish() {
     const FrameRecord& r = records_[i];
     const CameraCalibration& cam = cal_.cameras[r.camera];
     LaserPlane plane = r.plane;
-    if (use_sweeps) {
-      const auto it = sweeps.find(r.laser);
-      if (it != sweeps.end()) {
-        const SweepPlane sp = it->second.plane(r.step);
-        // The fitted plane replaces the frame's; its pole points follow from it.
-        for (PoleStripe& p : plane.poles) p.used = false;
-        errors[i] = complete_plane(cam, sp.normal, sp.offset, &plane);
-        if (!errors[i].ok()) return;
+    const auto it = sweeps.find(r.laser);
+    if (!r.has_plane && it == sweeps.end()) return;  // counted below
+    if (it != sweeps.end() && (use_sweeps || !r.has_plane)) {
+      const SweepPlane sp = it->second.plane(r.step);
+      // The fitted plane replaces the frame's; its pole points follow from it.
+      plane = LaserPlane{};
+      errors[i] = complete_plane(cam, sp.normal, sp.offset, &plane);
+      if (!errors[i].ok()) return;
+    }
+    std::vector<StripeSample> kept;
+    const std::vector<StripeSample>* samples = &r.samples;
+    if (!r.has_plane) {
+      // Searched along whole rows: keep what lies where this plane meets the subject.
+      const std::vector<ColumnRange> w =
+          stripe_windows(cam, plane, scan_volume(cam.frame), options_.triangulate.window_pad_px);
+      for (const StripeSample& s : r.samples) {
+        const ColumnRange& c = w[static_cast<size_t>(s.row)];
+        if (s.column >= c.begin && s.column < c.end) kept.push_back(s);
       }
+      samples = &kept;
     }
     std::vector<SweepPlane> others;
     for (const LaserState& o : r.others) {
       const auto it = sweeps.find(o.laser);
       if (it != sweeps.end()) others.push_back(it->second.plane(o.step));
     }
-    triangulate_samples(cam, plane, r.samples, r.full_scale,
+    triangulate_samples(cam, plane, *samples, r.full_scale,
                         {static_cast<int>(r.camera), r.laser, r.frame}, options_.triangulate, others, &parts[i]);
   });
   for (const Status& s : errors) RETURN_IF_ERROR(s);
+  stats_.frames_dropped = 0;
+  for (const FrameRecord& r : records_) stats_.frames_dropped += !r.has_plane && !sweeps.count(r.laser);
   PointCloud cloud;
   size_t total = 0;
   for (const PointCloud& p : parts) total += p.size();
@@ -156,6 +177,9 @@ StatusOr<PointCloud> ScanProcessor::finish() {
   }
   for (const CameraCalibration& c : cal_.cameras) cloud.camera_centres.push_back(c.centre.cast<float>());
   records_.clear();
+  if (options_.redundant_radius_mm > 0) {
+    stats_.points_redundant = drop_redundant_points(cloud, options_.redundant_radius_mm, options_.redundant_ratio);
+  }
   stats_.points = cloud.size();
   stats_.processing_seconds += seconds_since(t0);
   return cloud;

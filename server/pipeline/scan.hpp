@@ -12,6 +12,7 @@
 
 #include "recon/geometry/point_cloud.hpp"
 #include "recon/scan/laser_sweep.hpp"
+#include "recon/scan/redundancy.hpp"
 #include "recon/scan/triangulate.hpp"
 #include "server/pipeline/calibrate.hpp"
 
@@ -28,6 +29,9 @@ struct ScanOptions {
   TriangulateOptions triangulate;
   LaserPlaneOptions laser_plane;
   PlaneSource planes = PlaneSource::kSweepFit;
+  // drop_redundant_points: radius (mm; 0: keep every point) and confidence ratio.
+  float redundant_radius_mm = 3.f;
+  float redundant_ratio = 2.f;
 };
 
 struct LaserSweepReport {
@@ -43,11 +47,13 @@ struct LaserSweepReport {
 struct ScanStats {
   size_t frames = 0;                // step frames (per camera)
   size_t frames_unseen = 0;         // the camera sees none of the step's lasers
-  size_t frames_without_plane = 0;  // the stripe missed too many poles: no points
+  size_t frames_without_plane = 0;  // the stripe missed too many poles: the sweep fit gives the plane
+  size_t frames_dropped = 0;        // ... and there was no sweep fit either: no points
   size_t far_bottom_estimated = 0;  // frames whose far bottom pole point was hidden
   double fourth_point_rms_mm = 0;   // over frames with all four pole points measured
   size_t samples = 0;               // stripe samples kept for triangulation
   size_t points = 0;
+  size_t points_redundant = 0;      // dropped for a better point nearby
   std::vector<LaserSweepReport> sweeps;
   double processing_seconds = 0;    // frames to points, acquisition excluded
   std::string first_plane_error;    // the first frame without a plane, for the log
@@ -67,6 +73,7 @@ class ScanProcessor {
     size_t camera = 0;
     int laser = 0, step = 0, frame = 0;
     int full_scale = 255;
+    bool has_plane = false;             // the stripe crossed enough poles
     LaserPlane plane;                   // from this frame's poles
     std::vector<LaserState> others;     // the other lasers lit
     std::vector<StripeSample> samples;

@@ -21,8 +21,9 @@ TEST(SimCli, RendersCalibrationAndScanFramesWithAnIndex) {
   EXPECT_EQ(index["rig"], "thesis");
   ASSERT_EQ(index["cameras"].size(), 3u);
   // Per camera: dot grid, room, frame lights off, on, front poles only, and per laser
-  // (4) a base and the laser lit at both ends of its sweep; per group: base + 2 steps.
-  EXPECT_EQ(index["images"].size(), 3u * (5 + 3 * 4) + 2u * 3 * 3);
+  // (4) a base and the laser lit at both ends and the middle of its sweep; per laser
+  // group (4, one laser each): base + 2 steps.
+  EXPECT_EQ(index["images"].size(), 3u * (5 + 4 * 4) + 4u * 3 * 3);
   std::set<std::string> files;
   for (const auto& img : index["images"]) files.insert(img["file"].get<std::string>());
   EXPECT_EQ(files.size(), index["images"].size()) << "every image has its own file";
@@ -39,9 +40,10 @@ TEST(SimCli, RendersCalibrationAndScanFramesWithAnIndex) {
   ASSERT_TRUE(lit.ok()) << lit.status().message();
   EXPECT_EQ(lit->width, 1280);
   EXPECT_EQ(lit->height, 1024);
-  // Two lasers of group 0 at step 200 from their first.
-  const auto& last = index["images"][index["images"].size() - 4];
-  EXPECT_EQ(last["lasers"].size(), 2u);
+  // The last group's laser at step 200 from its first.
+  const auto& last = index["images"][index["images"].size() - 1];
+  ASSERT_EQ(last["lasers"].size(), 1u);
+  EXPECT_EQ(last["lasers"][0]["step"], -175 + 200);
 }
 
 TEST(SimCli, BadRigIsAClearError) {

@@ -1,0 +1,86 @@
+// The most a rig layout can cover of a body, without rendering: the share of the
+// body's area that some camera sees while a laser that camera works with (one on
+// its side of the frame) lights it within its sweep, at an incidence and a
+// triangulation angle the scan can use. For choosing where cameras and lasers go.
+//
+//   rig_coverage [--rig thesis|square|FILE]... [--body BODY.ply] [--min-angle DEG]
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+
+#include "recon/geometry/sample_surface.hpp"
+#include "server/pipeline/sim_backend.hpp"
+
+using namespace bodyscan;
+
+int main(int argc, char** argv) {
+  std::vector<std::string> rigs;
+  std::string body;
+  double min_angle = 8, min_incidence = 0.1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
+    else if (a == "--body" && i + 1 < argc) body = argv[++i];
+    else if (a == "--min-angle" && i + 1 < argc) min_angle = std::atof(argv[++i]);
+    else return std::fprintf(stderr, "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG]\n"), 2;
+  }
+  if (rigs.empty()) rigs = {"thesis", "square"};
+  for (const std::string& name : rigs) {
+    auto sim = pipeline::open_simulated_rig(name, body);
+    if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
+    const hw::RigDescription& desc = (*sim)->description();
+    const hw::sim::Scene& scene = (*sim)->scene();
+    std::vector<hw::CameraModel> cams;
+    for (const auto& c : desc.cameras) cams.push_back(c.model());
+    const PointCloud s = sample_mesh_uniform(scene.subject(), 60000, 3, true);
+    size_t covered = 0, seen = 0, lit = 0;
+    std::map<std::string, size_t> holes;
+    for (size_t i = 0; i < s.size(); ++i) {
+      const Eigen::Vector3d p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
+      const Eigen::Vector3d q = p + 0.2 * n;
+      bool any_seen = false, any_lit = false, ok = false;
+      for (size_t c = 0; c < cams.size() && !ok; ++c) {
+        const Eigen::Vector3d to_cam = cams[c].centre() - p;
+        if (n.dot(to_cam) <= 0) continue;
+        const auto px = cams[c].project(p);
+        if (!px || !cams[c].in_image(*px) || scene.occluded(q, to_cam.normalized(), to_cam.norm())) continue;
+        any_seen = true;
+        const bool front_camera = cams[c].centre().z() > 0;
+        for (const hw::LaserDescription& l : desc.lasers) {
+          if ((l.position.z() > 0) != front_camera) continue;  // the camera sees only its side's lasers on the poles
+          const Eigen::Vector3d to_laser = l.position - p;
+          const double incidence = n.dot(to_laser.normalized());
+          if (incidence < min_incidence || scene.occluded(q, to_laser.normalized(), to_laser.norm())) continue;
+          // Within the sweep: the plane through the point contains the axis; its angle from the aim.
+          const Eigen::Vector3d axis = l.axis.normalized();
+          Eigen::Vector3d d = p - l.position;
+          d -= d.dot(axis) * axis;
+          const double angle = std::atan2(l.aim.cross(d).dot(axis), l.aim.dot(d)) * 180 / M_PI;
+          if (angle < l.min_step * l.step_angle_deg || angle > l.max_step * l.step_angle_deg) continue;
+          any_lit = true;
+          const Eigen::Vector3d plane_n = axis.cross(d.normalized());
+          const double tri = std::asin(std::min(1.0, std::abs(plane_n.dot(to_cam.normalized())))) * 180 / M_PI;
+          if (tri >= min_angle) ok = true;
+        }
+      }
+      seen += any_seen;
+      lit += any_lit;
+      covered += ok;
+      if (!ok) {
+        const char* band = p.y() < 80 ? "feet" : p.y() < 800 ? "legs" : p.y() < 1450 ? "trunk" : "head/neck";
+        const char* facing = n.y() > 0.7 ? "up" : n.y() < -0.7 ? "down" : std::abs(n.x()) > std::abs(n.z()) ? "side" : n.z() > 0 ? "front" : "back";
+        holes[std::string(band) + " facing " + facing + (any_seen ? (any_lit ? " (angle)" : " (unlit)") : " (unseen)")]++;
+      }
+    }
+    std::printf("%s: covered %.1f %% of the body's area (seen by a camera %.1f %%); missing:", desc.name.c_str(),
+                100.0 * covered / s.size(), 100.0 * seen / s.size());
+    std::vector<std::pair<size_t, std::string>> by;
+    for (const auto& [k, v] : holes) by.emplace_back(v, k);
+    std::sort(by.rbegin(), by.rend());
+    for (size_t k = 0; k < std::min<size_t>(8, by.size()); ++k)
+      std::printf("%s %s %.1f %%", k ? "," : "", by[k].second.c_str(), 100.0 * by[k].first / s.size());
+    std::printf("\n");
+  }
+}

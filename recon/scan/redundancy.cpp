@@ -1,0 +1,51 @@
+#include "recon/scan/redundancy.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <vector>
+
+#include "recon/spatial/knn_index.hpp"
+
+namespace bodyscan {
+
+namespace {
+template <typename T>
+void keep(std::vector<T>& v, const std::vector<uint8_t>& drop) {
+  if (v.empty()) return;
+  size_t k = 0;
+  for (size_t i = 0; i < v.size(); ++i)
+    if (!drop[i]) v[k++] = v[i];
+  v.resize(k);
+}
+}  // namespace
+
+size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio) {
+  if (cloud.confidence.size() != cloud.size() || cloud.empty()) return 0;
+  const KnnIndex index(cloud.positions);
+  std::vector<uint8_t> drop(cloud.size(), 0);
+  const bool frames = cloud.frame.size() == cloud.size(), cameras = cloud.camera.size() == cloud.size();
+  tbb::parallel_for(size_t{0}, cloud.size(), [&](size_t i) {
+    const float need = ratio * cloud.confidence[i];
+    if (need > 1.f) return;  // nothing can be that much better
+    for (const auto& [j, d2] : index.within_radius(cloud.positions[i], radius)) {
+      if (j == i || cloud.confidence[j] < need) continue;
+      const bool other = (frames && cloud.frame[j] != cloud.frame[i]) || (cameras && cloud.camera[j] != cloud.camera[i]);
+      if (other) {
+        drop[i] = 1;
+        return;
+      }
+    }
+  });
+  size_t n = 0;
+  for (uint8_t d : drop) n += d;
+  keep(cloud.positions, drop);
+  keep(cloud.normals, drop);
+  keep(cloud.intensity, drop);
+  keep(cloud.confidence, drop);
+  keep(cloud.camera, drop);
+  keep(cloud.laser, drop);
+  keep(cloud.frame, drop);
+  return n;
+}
+
+}  // namespace bodyscan
