@@ -1,6 +1,8 @@
-// How fast the simulated rig renders a full scan: every laser group of a shipped
-// rig swept step by step, every camera grabbing each step (the frames are made and
-// dropped, as a scan streams them), plus the calibration frames.
+// How fast the simulated rig renders a full scan: the scan sequence of
+// server/pipeline/acquire (every laser group swept step by step, every camera
+// grabbing each step; the frames are made and dropped, as a scan streams them), and
+// separately the calibration sequence (the dot grid before each camera, the frame
+// lights, each laser alone).
 //
 //   render_benchmark [--rig thesis|square|FILE] [--every N]
 //
@@ -10,10 +12,10 @@
 #include <cstdlib>
 #include <string>
 
-#include "hw/sim/sim_rig.hpp"
+#include "server/pipeline/acquire.hpp"
+#include "server/pipeline/sim_backend.hpp"
 
 using namespace bodyscan;
-using namespace bodyscan::hw;
 
 int main(int argc, char** argv) {
   std::string rig_name = "thesis";
@@ -27,67 +29,39 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  auto path = rig_name.find(".json") != std::string::npos ? StatusOr<std::string>(rig_name) : shipped_rig_path(rig_name);
-  if (!path.ok()) return std::fprintf(stderr, "%s\n", path.status().message().c_str()), 1;
-  auto desc = load_rig_description(*path);
-  if (!desc.ok()) return std::fprintf(stderr, "%s\n", desc.status().message().c_str()), 1;
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  auto made = sim::SimulatedRig::create(*desc);
-  if (!made.ok()) return std::fprintf(stderr, "%s\n", made.status().message().c_str()), 1;
-  sim::SimulatedRig& rig = **made;
-  Controller& ctl = rig.controller();
-  LasersOff off(ctl);
-  const auto t1 = Clock::now();
+  auto sim = pipeline::open_simulated_rig(rig_name, "");
+  if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
+  const pipeline::Rig rig = pipeline::rig_handle(**sim);
+  const hw::RigDescription& desc = *rig.description;
   size_t frames = 0;
   uint64_t checksum = 0;
-  auto grab_all = [&] {
-    for (size_t c = 0; c < rig.num_cameras(); ++c) {
-      auto f = rig.camera(c).grab();
-      if (!f.ok()) {
-        std::fprintf(stderr, "%s\n", f.status().message().c_str());
-        std::exit(1);
-      }
-      checksum += f->pixels[f->pixels.size() / 2];
-      ++frames;
-    }
+  const pipeline::ShotSink count = [&](pipeline::Shot&& s) {
+    checksum += s.frame.pixels[s.frame.pixels.size() / 2];
+    ++frames;
+    return Status();
   };
-  (void)ctl.set_room_lights(true);
-  grab_all();
-  (void)ctl.set_room_lights(false);
-  grab_all();
-  (void)ctl.set_frame_lights(true);
-  grab_all();
-  (void)ctl.set_frame_lights(false);
-  for (const auto& group : desc->laser_groups) {
-    std::vector<int> ids;
-    int steps = 0;
-    for (const std::string& id : group)
-      for (size_t i = 0; i < desc->lasers.size(); ++i)
-        if (desc->lasers[i].id == id) {
-          ids.push_back(static_cast<int>(i));
-          (void)ctl.home(static_cast<int>(i));
-          steps = std::max(steps, desc->lasers[i].max_step - desc->lasers[i].min_step + 1);
-        }
-    (void)ctl.all_lasers_off();
-    grab_all();
-    for (int k = 0; k < steps; k += every) {
-      for (int i : ids) {
-        const LaserDescription& l = desc->lasers[static_cast<size_t>(i)];
-        (void)ctl.move_to(i, std::min(l.max_step, l.min_step + k));
-        (void)ctl.set_laser(i, true);
-      }
-      grab_all();
-    }
-  }
+  const auto t1 = Clock::now();
+  Status s = pipeline::acquire_calibration(rig, count);
+  if (!s.ok()) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+  const size_t calibration_frames = frames;
   const auto t2 = Clock::now();
-  const double setup = std::chrono::duration<double>(t1 - t0).count();
-  const double scan = std::chrono::duration<double>(t2 - t1).count();
-  const auto& cam = desc->cameras[0];
-  std::printf("rig %s: %zu cameras of %dx%d, %zu lasers in %zu groups\n", desc->name.c_str(), desc->cameras.size(),
-              cam.width, cam.height, desc->lasers.size(), desc->laser_groups.size());
-  std::printf("set-up (subject, scene, pixel rays) %.2f s\n", setup);
-  std::printf("%zu frames in %.2f s: %.1f frames/s, %.1f Mpixel/s (checksum %llu)\n", frames, scan, frames / scan,
-              frames * cam.width * cam.height / scan / 1e6, static_cast<unsigned long long>(checksum));
+  s = pipeline::acquire_scan(rig, count, every);
+  if (!s.ok()) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
+  const auto t3 = Clock::now();
+  auto secs = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  const size_t scan_frames = frames - calibration_frames;
+  const auto& cam = desc.cameras[0];
+  std::printf("rig %s: %zu cameras of %dx%d, %zu lasers in %zu groups, %.0f frames/s cameras\n", desc.name.c_str(),
+              desc.cameras.size(), cam.width, cam.height, desc.lasers.size(), desc.laser_groups.size(),
+              desc.simulation.frame_rate_hz);
+  std::printf("set-up (subject, scene, pixel rays) %.2f s\n", secs(t0, t1));
+  std::printf("calibration: %zu frames in %.2f s (dot grids at 4 x 4 rays per pixel)\n", calibration_frames, secs(t1, t2));
+  std::printf("scan: %zu frames in %.2f s: %.1f frames/s, %.1f Mpixel/s; the cameras take %.1f s (checksum %llu)\n",
+              scan_frames, secs(t2, t3), scan_frames / secs(t2, t3),
+              scan_frames * cam.width * cam.height / secs(t2, t3) / 1e6,
+              scan_frames / static_cast<double>(desc.cameras.size()) / desc.simulation.frame_rate_hz,
+              static_cast<unsigned long long>(checksum));
   return 0;
 }

@@ -61,7 +61,8 @@ Quantiles quantiles(std::vector<double> v) {
 double g_min_angle = 10;
 int g_smooth = 3;
 int g_threshold = 0;
-float g_redundant = 3;
+float g_redundant = 4;
+float g_weak = -1;
 
 int run(const std::string& rig_name, const std::string& body, int every) {
   auto sim = pipeline::open_simulated_rig(rig_name, body);
@@ -137,6 +138,7 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       o.triangulate.smooth_rows = g_smooth;
       if (g_threshold > 0) o.triangulate.stripe.threshold = g_threshold;
       o.redundant_radius_mm = g_redundant;
+      if (g_weak >= 0) o.redundant_weak = g_weak;
       processors.push_back(std::make_unique<pipeline::ScanProcessor>(*cal, o));
       names.push_back(std::string(pipeline::to_string(ps)) + ", " + to_string(m));
     }
@@ -268,6 +270,7 @@ int main(int argc, char** argv) {
     else if (a == "--smooth" && i + 1 < argc) g_smooth = std::atoi(argv[++i]);
     else if (a == "--threshold" && i + 1 < argc) g_threshold = std::atoi(argv[++i]);
     else if (a == "--redundant" && i + 1 < argc) g_redundant = static_cast<float>(std::atof(argv[++i]));
+    else if (a == "--weak" && i + 1 < argc) g_weak = static_cast<float>(std::atof(argv[++i]));
     else {
       std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N]\n");
       return 2;

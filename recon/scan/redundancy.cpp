@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <cmath>
 #include <vector>
 
 #include "recon/spatial/knn_index.hpp"
@@ -19,13 +20,14 @@ void keep(std::vector<T>& v, const std::vector<uint8_t>& drop) {
 }
 }  // namespace
 
-size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio) {
+size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio, float weak) {
   if (cloud.confidence.size() != cloud.size() || cloud.empty()) return 0;
   const KnnIndex index(cloud.positions);
   std::vector<uint8_t> drop(cloud.size(), 0);
   const bool frames = cloud.frame.size() == cloud.size(), cameras = cloud.camera.size() == cloud.size();
   tbb::parallel_for(size_t{0}, cloud.size(), [&](size_t i) {
-    const float need = ratio * cloud.confidence[i];
+    const float c = cloud.confidence[i];
+    const float need = c < weak ? std::nextafter(c, 2.f) : ratio * c;
     if (need > 1.f) return;  // nothing can be that much better
     for (const auto& [j, d2] : index.within_radius(cloud.positions[i], radius)) {
       if (j == i || cloud.confidence[j] < need) continue;

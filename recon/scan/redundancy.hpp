@@ -13,7 +13,8 @@
 namespace bodyscan {
 
 // Returns how many points were dropped. Needs confidence; frame and camera (when
-// present) tell measurements apart. Every attribute is kept in step.
-size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio = 2.f);
+// present) tell measurements apart. Every attribute is kept in step. A weak point
+// (confidence below `weak`) goes for any more confident point nearby.
+size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio = 2.f, float weak = 0.f);
 
 }  // namespace bodyscan

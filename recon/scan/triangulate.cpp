@@ -7,7 +7,9 @@ namespace bodyscan {
 
 ScanVolume scan_volume(const ReferenceFrame& f) {
   ScanVolume v;
-  const double x = 0.5 * f.width - f.tube, z = 0.5 * f.depth - f.tube;
+  // Two tubes in from the poles' centre lines: a stripe on a pole's face, a few
+  // millimetres off by the plane's error at the frame's edge, stays out.
+  const double x = 0.5 * f.width - 2 * f.tube, z = 0.5 * f.depth - 2 * f.tube;
   // The floor is the bottom frame's underside; points within 3 mm of it are floor.
   v.lo = {-x, -0.5 * f.tube + 3, -z};
   v.hi = {x, f.top_height - 0.5 * f.tube, z};

@@ -16,8 +16,9 @@
 
 namespace bodyscan {
 
-// The box inside the frames where a subject stands: between the poles' inner faces,
-// from just above the floor (the bottom frame stands on it) to the top frame.
+// The box inside the frames where a subject stands: a tube's width inside the poles'
+// inner faces, from just above the floor (the bottom frame stands on it) to the top
+// frame.
 struct ScanVolume {
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
   bool contains(const Eigen::Vector3d& p) const {

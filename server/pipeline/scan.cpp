@@ -178,7 +178,8 @@ StatusOr<PointCloud> ScanProcessor::finish() {
   for (const CameraCalibration& c : cal_.cameras) cloud.camera_centres.push_back(c.centre.cast<float>());
   records_.clear();
   if (options_.redundant_radius_mm > 0) {
-    stats_.points_redundant = drop_redundant_points(cloud, options_.redundant_radius_mm, options_.redundant_ratio);
+    stats_.points_redundant = drop_redundant_points(cloud, options_.redundant_radius_mm, options_.redundant_ratio,
+                                                    options_.redundant_weak);
   }
   stats_.points = cloud.size();
   stats_.processing_seconds += seconds_since(t0);

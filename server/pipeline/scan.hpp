@@ -30,8 +30,9 @@ struct ScanOptions {
   LaserPlaneOptions laser_plane;
   PlaneSource planes = PlaneSource::kSweepFit;
   // drop_redundant_points: radius (mm; 0: keep every point) and confidence ratio.
-  float redundant_radius_mm = 3.f;
+  float redundant_radius_mm = 4.f;
   float redundant_ratio = 2.f;
+  float redundant_weak = 0.4f;
 };
 
 struct LaserSweepReport {

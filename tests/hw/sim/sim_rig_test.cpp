@@ -128,8 +128,8 @@ TEST(SimulatedRig, ShippedRigsTakeAStandingAdultOfTwoMetres) {
     ASSERT_TRUE(rig.ok()) << rig.status().message();
     const FrameGeometry& f = desc->frame;
     for (const Vec3f& v : (*rig)->scene().subject().vertices) {
-      ASSERT_LT(std::abs(v.x()), 0.5 * f.width - f.tube) << name;
-      ASSERT_LT(std::abs(v.z()), 0.5 * f.depth - f.tube) << name;
+      ASSERT_LT(std::abs(v.x()), 0.5 * f.width - 2 * f.tube) << name;
+      ASSERT_LT(std::abs(v.z()), 0.5 * f.depth - 2 * f.tube) << name;  // the scan volume (recon/scan/triangulate.hpp)
       ASSERT_LT(v.y(), f.top_height - f.tube) << name;
     }
     for (size_t c = 0; c < (*rig)->num_cameras(); ++c) {
