@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "recon/calib/components.hpp"
+
 namespace bodyscan {
 
 StatusOr<std::vector<Marker>> find_markers(const ImageView& on, const ImageView& off, const MarkerOptions& o) {
@@ -15,42 +17,18 @@ StatusOr<std::vector<Marker>> find_markers(const ImageView& on, const ImageView&
     const int d = static_cast<int>(on.row(y)[x]) - static_cast<int>(off.row(y)[x]);
     return d > 0 ? d : 0;
   };
-  // Two-pass connected components (4-connected) with union-find on run labels.
-  std::vector<int> label(static_cast<size_t>(w) * h, -1);
-  std::vector<int> parent;
-  auto find = [&](int a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      if (diff(x, y) < o.threshold) continue;
-      const int left = x > 0 ? label[static_cast<size_t>(y) * w + x - 1] : -1;
-      const int up = y > 0 ? label[static_cast<size_t>(y - 1) * w + x] : -1;
-      int l;
-      if (left < 0 && up < 0) {
-        l = static_cast<int>(parent.size());
-        parent.push_back(l);
-      } else if (left >= 0 && up >= 0) {
-        l = find(left);
-        const int u = find(up);
-        if (u != l) parent[std::max(u, l)] = std::min(u, l), l = std::min(u, l);
-      } else {
-        l = left >= 0 ? left : up;
-      }
-      label[static_cast<size_t>(y) * w + x] = l;
-    }
-  std::vector<Marker> blobs(parent.size());
-  std::vector<Eigen::Vector2d> moment(parent.size(), Eigen::Vector2d::Zero());
+  int count = 0;
+  const std::vector<int> label = label_components(w, h, [&](int x, int y) { return diff(x, y) >= o.threshold; }, &count);
+  std::vector<Marker> blobs(static_cast<size_t>(count));
+  std::vector<Eigen::Vector2d> moment(static_cast<size_t>(count), Eigen::Vector2d::Zero());
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const int l = label[static_cast<size_t>(y) * w + x];
       if (l < 0) continue;
-      const int r = find(l);
       const double d = diff(x, y);
-      blobs[r].area += 1;
-      blobs[r].mass += d;
-      moment[r] += d * Eigen::Vector2d(x, y);
+      blobs[static_cast<size_t>(l)].area += 1;
+      blobs[static_cast<size_t>(l)].mass += d;
+      moment[static_cast<size_t>(l)] += d * Eigen::Vector2d(x, y);
     }
   std::vector<Marker> out;
   for (size_t i = 0; i < blobs.size(); ++i) {

@@ -10,6 +10,8 @@
 #include <deque>
 #include <numeric>
 #include <optional>
+
+#include "recon/calib/components.hpp"
 #include <string>
 #include <tuple>
 #include <unordered_map>
@@ -275,45 +277,19 @@ StatusOr<std::vector<Dot>> find_dots(const ImageView& image, const DotOptions& o
     }
   });
 
-  // Two-pass connected components (4-connected), union-find on labels.
-  std::vector<int> label(static_cast<size_t>(w) * h, -1);
-  std::vector<int> parent;
-  auto find = [&](int a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const size_t i = static_cast<size_t>(y) * w + x;
-      if (!dark[i]) continue;
-      const int left = x > 0 ? label[i - 1] : -1, up = y > 0 ? label[i - w] : -1;
-      int l;
-      if (left < 0 && up < 0) {
-        l = static_cast<int>(parent.size());
-        parent.push_back(l);
-      } else if (left >= 0 && up >= 0) {
-        l = find(left);
-        const int u = find(up);
-        if (u != l) parent[std::max(u, l)] = std::min(u, l), l = std::min(u, l);
-      } else {
-        l = left >= 0 ? left : up;
-      }
-      label[i] = l;
-    }
-  // Labels only ever join a smaller one, so one pass in order points every label
-  // at its root.
-  for (size_t l = 0; l < parent.size(); ++l) parent[l] = parent[parent[l]];
+  int count = 0;
+  const std::vector<int> label =
+      label_components(w, h, [&](int x, int y) { return dark[static_cast<size_t>(y) * w + x] != 0; }, &count);
   struct Blob {
     int area = 0, x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
     double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
   };
-  std::vector<Blob> blobs(parent.size());
+  std::vector<Blob> blobs(static_cast<size_t>(count));
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      int& l = label[static_cast<size_t>(y) * w + x];
+      const int l = label[static_cast<size_t>(y) * w + x];
       if (l < 0) continue;
-      l = parent[l];
-      Blob& b = blobs[l];
+      Blob& b = blobs[static_cast<size_t>(l)];
       ++b.area;
       b.x0 = std::min(b.x0, x), b.x1 = std::max(b.x1, x), b.y0 = std::min(b.y0, y), b.y1 = std::max(b.y1, y);
       b.sx += x, b.sy += y, b.sxx += double(x) * x, b.sxy += double(x) * y, b.syy += double(y) * y;
@@ -328,7 +304,7 @@ StatusOr<std::vector<Dot>> find_dots(const ImageView& image, const DotOptions& o
   std::vector<Dot> dots;
   for (size_t l = 0; l < blobs.size(); ++l) {
     const Blob& b = blobs[l];
-    if (parent[l] != static_cast<int>(l) || b.area < o.min_area || b.area > max_area) continue;
+    if (b.area < o.min_area || b.area > max_area) continue;
     const int x0 = b.x0 - kRim, y0 = b.y0 - kRim, x1 = b.x1 + kRim, y1 = b.y1 + kRim;
     if (x0 - kRing < 0 || y0 - kRing < 0 || x1 + kRing >= w || y1 + kRing >= h) continue;
     const double mx = b.sx / b.area, my = b.sy / b.area;

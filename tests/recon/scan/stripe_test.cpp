@@ -75,5 +75,46 @@ TEST(StripeExtraction, BadInputIsAnError) {
   EXPECT_FALSE(extract_stripe(ImageView{}, ImageView{}).ok());
 }
 
+TEST(StripeExtraction, WindowsKeepTheSearchWhereTheyAllow) {
+  // Two stripes per row; the brighter one at x = 300 lies outside the window.
+  Image frame{400, 20, std::vector<uint16_t>(400 * 20, 5)};
+  for (int y = 0; y < 20; ++y) {
+    frame.px[static_cast<size_t>(y) * 400 + 100] = 120;
+    frame.px[static_cast<size_t>(y) * 400 + 300] = 250;
+  }
+  const Image base{400, 20, std::vector<uint16_t>(400 * 20, 5)};
+  std::vector<ColumnRange> windows(20, ColumnRange{50, 200});
+  windows[7] = {0, 0};  // a row with nothing to search
+  auto s = extract_stripe(frame.view(), base.view(), {}, 255, &windows);
+  ASSERT_TRUE(s.ok());
+  ASSERT_EQ(s->size(), 19u);
+  for (const StripeSample& p : *s) {
+    EXPECT_NEAR(p.column, 100, 1e-6);
+    EXPECT_NE(p.row, 7);
+  }
+  std::vector<ColumnRange> wrong(3);
+  EXPECT_FALSE(extract_stripe(frame.view(), base.view(), {}, 255, &wrong).ok());
+}
+
+TEST(StripeSmoothing, AveragesNoiseAlongTheStripeAndStopsAtItsEnds) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0, 0.1);
+  std::vector<StripeSample> s;
+  auto truth = [](int y) { return y < 60 ? 200.0 + 0.3 * y : 400.0; };  // a jump at row 60
+  for (int y = 0; y < 100; ++y) s.push_back({y, static_cast<float>(truth(y) + noise(rng)), 100, false});
+  const std::vector<StripeSample> raw = s;
+  smooth_stripe(s, 3);
+  double raw_ss = 0, smooth_ss = 0;
+  for (size_t i = 0; i < s.size(); ++i) {
+    raw_ss += std::pow(raw[i].column - truth(raw[i].row), 2);
+    smooth_ss += std::pow(s[i].column - truth(s[i].row), 2);
+  }
+  // Seven samples per line fit: the noise falls by about sqrt(7 / 2) at worst (ends).
+  EXPECT_LT(std::sqrt(smooth_ss / s.size()), 0.6 * std::sqrt(raw_ss / s.size()));
+  // The jump is not smeared: each side keeps its own level.
+  EXPECT_NEAR(s[59].column, truth(59), 0.3);
+  EXPECT_NEAR(s[60].column, 400, 0.3);
+}
+
 }  // namespace
 }  // namespace bodyscan
