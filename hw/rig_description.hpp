@@ -121,9 +121,10 @@ StatusOr<RigDescription> load_rig_description(const std::string& path);
 // The description as JSON (what parse_rig_description reads back unchanged).
 std::string to_json(const RigDescription& rig);
 
-// The shipped layouts: "thesis" (thesis fig. 2.2: 3 cameras, 4 lasers, two at a time)
-// and "square" (thesis fig. 6.1: 4 cameras, 4 lasers). Their files live in
-// hw/rigs/; this returns the path for a name, or an error listing the names.
+// The shipped layouts: "thesis" (thesis fig. 2.2: 3 cameras, 4 lasers, run one at a
+// time - docs/rig-description.md says why) and "square" (thesis fig. 6.1: 4 cameras,
+// 4 lasers). Their files live in hw/rigs/; this returns the path for a name, or an
+// error listing the names.
 StatusOr<std::string> shipped_rig_path(const std::string& name);
 
 }  // namespace bodyscan::hw

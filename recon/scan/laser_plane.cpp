@@ -16,9 +16,7 @@ Eigen::Vector3d LaserPlane::triangulate(const CameraCalibration& cal, const Eige
     const Eigen::Vector2d ab = apply_homography(image_to_plane, corrected);
     return origin + ab.x() * axis_a + ab.y() * axis_b;
   }
-  const Ray3 r = cal.ray(corrected);
-  const double t = (offset - normal.dot(r.origin)) / normal.dot(r.direction);
-  return r.origin + t * r.direction;
+  return intersect(cal.ray(corrected));
 }
 
 Eigen::Vector2d LaserPlane::to_image(const Eigen::Vector3d& p) const {

@@ -52,6 +52,10 @@ struct LaserPlane {
 
   Eigen::Vector3d triangulate(const CameraCalibration& cal, const Eigen::Vector2d& corrected,
                               TriangulationMethod method) const;
+  // Where a ray meets the plane.
+  Eigen::Vector3d intersect(const Ray3& r) const {
+    return r.origin + (offset - normal.dot(r.origin)) / normal.dot(r.direction) * r.direction;
+  }
   // The lens-corrected pixel of a point of the plane (inverse of eq. 3.6).
   Eigen::Vector2d to_image(const Eigen::Vector3d& on_plane) const;
 };

@@ -99,9 +99,11 @@ size_t triangulate_samples(const CameraCalibration& cal, const LaserPlane& plane
   size_t added = 0;
   for (const StripeSample& s : samples) {
     const Eigen::Vector2d corrected = cal.lens.correct({s.column, static_cast<double>(s.row)});
-    const Eigen::Vector3d p = plane.triangulate(cal, corrected, options.method);
-    if (!p.allFinite() || !volume.contains(p)) continue;
     const Ray3 r = cal.ray(corrected);
+    const Eigen::Vector3d p = options.method == TriangulationMethod::kTwoPlaneRay
+                                  ? plane.intersect(r)
+                                  : plane.triangulate(cal, corrected, options.method);
+    if (!p.allFinite() || !volume.contains(p)) continue;
     const double angle = std::asin(std::min(1.0, std::abs(r.direction.dot(plane.normal)))) * 180 / M_PI;
     if (angle < options.min_angle_deg) continue;
     if (!others.empty()) {

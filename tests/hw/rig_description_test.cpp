@@ -78,7 +78,9 @@ TEST(RigDescription, EveryShippedLaserSweepCrossesThePolesOverMostOfItsSteps) {
           // x where the plane meets the pole z = const (any height: the plane is vertical).
           const double x = (l.plane_offset(step) - n.z() * z) / n.x();
           both = both && std::abs(x) < half_w;
-          if (step == 0) EXPECT_LT(std::abs(x), half_w) << name << " " << l.id << " pole z " << z;
+          if (step == 0) {
+            EXPECT_LT(std::abs(x), half_w) << name << " " << l.id << " pole z " << z;
+          }
         }
         crossing += both;
       }

@@ -107,7 +107,7 @@ TEST(Renderer, BoxBeforeAWallCastsALaserShadowAndHidesTheWall) {
   RigDescription rig = test_rig();
   TriangleMesh m = wall(0);
   // A 200 mm box 600 mm in front of the wall, between it and the laser.
-  const float z0 = 500, z1 = 700, x0 = -50, x1 = 150, y0 = 800, y1 = 1100;
+  const float z1 = 700, x0 = -50, x1 = 150, y0 = 800, y1 = 1100;
   add_quad(m, {x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1});  // front face (+z)
   auto scene = Scene::create(rig, m);
   ASSERT_TRUE(scene.ok());
