@@ -10,6 +10,7 @@
 #include <map>
 #include <string>
 
+#include "bench/body_region.hpp"
 #include "recon/geometry/sample_surface.hpp"
 #include "server/pipeline/sim_backend.hpp"
 
@@ -69,9 +70,7 @@ int main(int argc, char** argv) {
       lit += any_lit;
       covered += ok;
       if (!ok) {
-        const char* band = p.y() < 80 ? "feet" : p.y() < 800 ? "legs" : p.y() < 1450 ? "trunk" : "head/neck";
-        const char* facing = n.y() > 0.7 ? "up" : n.y() < -0.7 ? "down" : std::abs(n.x()) > std::abs(n.z()) ? "side" : n.z() > 0 ? "front" : "back";
-        holes[std::string(band) + " facing " + facing + (any_seen ? (any_lit ? " (angle)" : " (unlit)") : " (unseen)")]++;
+        holes[bench::body_region(p, n) + (any_seen ? (any_lit ? " (angle)" : " (unlit)") : " (unseen)")]++;
       }
     }
     std::printf("%s: covered %.1f %% of the body's area (seen by a camera %.1f %%); missing:", desc.name.c_str(),

@@ -15,6 +15,7 @@
 #include <memory>
 #include <string>
 
+#include "bench/body_region.hpp"
 #include "recon/calib/plane_projection.hpp"
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/geometry/sample_surface.hpp"
@@ -241,9 +242,7 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       }
       const Vec3f& x = samples.positions[i];
       const Vec3f& n = samples.normals[i];
-      const char* band = x.y() < 80 ? "feet" : x.y() < 800 ? "legs" : x.y() < 1450 ? "trunk" : "head/neck";
-      const char* facing = n.y() > 0.7f ? "up" : n.y() < -0.7f ? "down" : std::abs(n.x()) > std::abs(n.z()) ? "side" : n.z() > 0 ? "front" : "back";
-      holes[std::string(band) + " facing " + facing]++;
+      holes[bench::body_region(x.cast<double>(), n.cast<double>())]++;
     }
     std::printf("coverage within 5 mm: %.1f %% of the body's area; uncovered:", 100.0 * covered / samples.size());
     std::vector<std::pair<size_t, std::string>> by_size;

@@ -78,11 +78,13 @@ float stripe_confidence(const StripeSample& s, int threshold) {
   return std::clamp((static_cast<float>(s.peak) - threshold) / (3.0f * threshold), 0.0f, 1.0f);
 }
 
-StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration& cal, const LaserPlane& plane,
+StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration& cal, const LaserPlane* plane,
                                                          const ImageView& frame, const ImageView& base, int full_scale,
                                                          const TriangulateOptions& options) {
-  const std::vector<ColumnRange> windows = stripe_windows(cal, plane, scan_volume(cal.frame), options.window_pad_px);
-  ASSIGN_OR_RETURN(std::vector<StripeSample> samples, extract_stripe(frame, base, options.stripe, full_scale, &windows));
+  std::vector<ColumnRange> windows;
+  if (plane) windows = stripe_windows(cal, *plane, scan_volume(cal.frame), options.window_pad_px);
+  ASSIGN_OR_RETURN(std::vector<StripeSample> samples,
+                   extract_stripe(frame, base, options.stripe, full_scale, plane ? &windows : nullptr));
   if (options.smooth_rows > 0) smooth_stripe(samples, options.smooth_rows);
   return samples;
 }

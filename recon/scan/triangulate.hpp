@@ -56,8 +56,9 @@ float stripe_confidence(const StripeSample& s, int threshold);
 // Confidence from the triangulation angle (between the ray and the laser plane).
 float angle_confidence(double angle_deg, double full_angle_deg);
 
-// The frame's stripe samples where `plane` can meet the subject (stripe_windows).
-StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration& cal, const LaserPlane& plane,
+// The frame's stripe samples where `plane` can meet the subject (stripe_windows), or
+// along whole rows when there is no plane yet; smoothed along the stripe.
+StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration& cal, const LaserPlane* plane,
                                                          const ImageView& frame, const ImageView& base, int full_scale,
                                                          const TriangulateOptions& options);
 

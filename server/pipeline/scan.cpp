@@ -68,8 +68,8 @@ Status ScanProcessor::consume(Shot&& shot) {
     // plane; keep every row's stripe until then.
     if (stats_.first_plane_error.empty()) stats_.first_plane_error = plane.status().message();
     ++stats_.frames_without_plane;
-    ASSIGN_OR_RETURN(r.samples, extract_stripe(f, b, options_.triangulate.stripe, r.full_scale));
-    if (options_.triangulate.smooth_rows > 0) smooth_stripe(r.samples, options_.triangulate.smooth_rows);
+    ASSIGN_OR_RETURN(r.samples,
+                     extract_plane_stripe(cal_.cameras[shot.camera], nullptr, f, b, r.full_scale, options_.triangulate));
     stats_.samples += r.samples.size();
     records_.push_back(std::move(r));
     stats_.processing_seconds += seconds_since(t0);
@@ -82,7 +82,7 @@ Status ScanProcessor::consume(Shot&& shot) {
     ++fourth_n_;
     stats_.fourth_point_rms_mm = std::sqrt(fourth_ss_ / static_cast<double>(fourth_n_));
   }
-  ASSIGN_OR_RETURN(r.samples, extract_plane_stripe(cal_.cameras[shot.camera], *plane, f, b, r.full_scale,
+  ASSIGN_OR_RETURN(r.samples, extract_plane_stripe(cal_.cameras[shot.camera], &*plane, f, b, r.full_scale,
                                                    options_.triangulate));
   r.plane = std::move(*plane);
   stats_.samples += r.samples.size();
