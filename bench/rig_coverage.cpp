@@ -2,6 +2,9 @@
 // body's area that some camera sees while a laser that camera works with (one on
 // its side of the frame) lights it within its sweep, at an incidence and a
 // triangulation angle the scan can use. For choosing where cameras and lasers go.
+// It also reports how close the body comes to hiding a frame light from a camera
+// (calibration needs all eight unobstructed; a half-hidden light moves its centroid):
+// the smallest clearance, in mm around the light's centre, that every camera has.
 //
 //   rig_coverage [--rig thesis|square|FILE]... [--body BODY.ply] [--min-angle DEG]
 #include <cmath>
@@ -20,11 +23,13 @@ int main(int argc, char** argv) {
   std::vector<std::string> rigs;
   std::string body;
   double min_angle = 8, min_incidence = 0.1;
+  bool cross = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
     else if (a == "--body" && i + 1 < argc) body = argv[++i];
     else if (a == "--min-angle" && i + 1 < argc) min_angle = std::atof(argv[++i]);
+    else if (a == "--cross") cross = true;
     else return std::fprintf(stderr, "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG]\n"), 2;
   }
   if (rigs.empty()) rigs = {"thesis", "square"};
@@ -50,7 +55,7 @@ int main(int argc, char** argv) {
         any_seen = true;
         const bool front_camera = cams[c].centre().z() > 0;
         for (const hw::LaserDescription& l : desc.lasers) {
-          if ((l.position.z() > 0) != front_camera) continue;  // the camera sees only its side's lasers on the poles
+          if (!cross && (l.position.z() > 0) != front_camera) continue;  // the camera sees only its side's lasers on the poles
           const Eigen::Vector3d to_laser = l.position - p;
           const double incidence = n.dot(to_laser.normalized());
           if (incidence < min_incidence || scene.occluded(q, to_laser.normalized(), to_laser.norm())) continue;
@@ -73,8 +78,36 @@ int main(int argc, char** argv) {
         holes[bench::body_region(p, n) + (any_seen ? (any_lit ? " (angle)" : " (unlit)") : " (unseen)")]++;
       }
     }
-    std::printf("%s: covered %.1f %% of the body's area (seen by a camera %.1f %%); missing:", desc.name.c_str(),
-                100.0 * covered / s.size(), 100.0 * seen / s.size());
+    // Light clearance: the largest radius (to 100 mm, in 5 mm steps) around each
+    // light's centre, in the plane of its face, that the body hides from no camera.
+    double clearance = 1e9;
+    std::string tightest;
+    for (size_t c = 0; c < cams.size(); ++c) {
+      const Eigen::Vector3d o = cams[c].centre();
+      for (const Eigen::Vector3d& light : hw::visible_lights(desc.frame, o.z() > 0)) {
+        double clear = 0;
+        for (double r = 5; r <= 100; r += 5) {
+          bool hidden = false;
+          for (int k = 0; k < 24 && !hidden; ++k) {
+            const double a = 2 * M_PI * k / 24;
+            const Eigen::Vector3d rim = light + r * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+            const Eigen::Vector3d to = rim - o;
+            hidden = scene.intersect(o, to.normalized(), 1e-3, to.norm()).surface == hw::sim::Surface::kSubject;
+          }
+          if (hidden) break;
+          clear = r;
+        }
+        if (clear < clearance) {
+          clearance = clear;
+          char buf[160];
+          std::snprintf(buf, sizeof buf, "camera %s, light (%.0f, %.0f, %.0f)", desc.cameras[c].id.c_str(), light.x(),
+                        light.y(), light.z());
+          tightest = buf;
+        }
+      }
+    }
+    std::printf("%s: covered %.1f %% of the body's area (seen by a camera %.1f %%); lights clear by %.0f mm (tightest: %s); missing:",
+                desc.name.c_str(), 100.0 * covered / s.size(), 100.0 * seen / s.size(), clearance, tightest.c_str());
     std::vector<std::pair<size_t, std::string>> by;
     for (const auto& [k, v] : holes) by.emplace_back(v, k);
     std::sort(by.rbegin(), by.rend());

@@ -84,12 +84,34 @@ StatusOr<LaserSweep> LaserSweep::fit(const std::vector<SweepPoint>& points,
     return failed_precondition("the laser's planes do not share an axis");
   }
 
-  // Gauss-Newton on the points' distances to their step's plane, twice: on all, then
-  // on those the first fit does not reject.
+  // Gauss-Newton on the points' distances to their step's plane. First with Huber
+  // weights (a pole point caught on the wrong face or a stray reflection pulls no
+  // harder than one a few robust sigmas off), keeping the points within `reject_mm`
+  // or 4 robust sigmas of the fit and refitting until that set settles (a point
+  // wrongly left out early comes back); then plain least squares on the kept points.
+  // A step that raises the cost is halved.
   std::vector<const SweepPoint*> use;
   for (const SweepPoint& p : points) use.push_back(&p);
-  for (int round = 0; round < 2; ++round) {
-    for (int iter = 0; iter < 8; ++iter) {
+  const auto robust_sigma = [&](const Frame& fr) {
+    std::vector<double> abs_r;
+    abs_r.reserve(use.size());
+    for (const SweepPoint* q : use) abs_r.push_back(std::abs(fr.residual(*q)));
+    return 1.4826 * median(abs_r);
+  };
+  constexpr int kRobustRounds = 6;
+  for (int round = 0; round <= kRobustRounds; ++round) {
+    const bool robust = round < kRobustRounds;
+    for (int iter = 0; iter < 12; ++iter) {
+      const double c = robust ? std::max(0.5 * reject_mm, 2 * robust_sigma(f)) : 0;
+      const auto weight = [c](double r) { return c > 0 && std::abs(r) > c ? c / std::abs(r) : 1.0; };
+      const auto cost = [&](const Frame& fr) {
+        double sum = 0;
+        for (const SweepPoint* q : use) {
+          const double r = std::abs(fr.residual(*q));
+          sum += c > 0 && r > c ? c * (2 * r - c) : r * r;  // Huber
+        }
+        return sum;
+      };
       Eigen::Matrix<double, 6, 6> jtj = Eigen::Matrix<double, 6, 6>::Zero();
       Eigen::Matrix<double, 6, 1> jtr = Eigen::Matrix<double, 6, 1>::Zero();
       const double h[6] = {1e-6, 1e-6, 1e-3, 1e-3, 1e-6, 1e-8};
@@ -101,24 +123,32 @@ StatusOr<LaserSweep> LaserSweep::fit(const std::vector<SweepPoint>& points,
       }
       for (const SweepPoint* q : use) {
         const double r = f.residual(*q);
+        const double w = weight(r);
         Eigen::Matrix<double, 6, 1> j;
         for (int k = 0; k < 6; ++k) j(k) = (plus[k].residual(*q) - r) / h[k];
-        jtj += j * j.transpose();
-        jtr += j * r;
+        jtj += w * j * j.transpose();
+        jtr += w * j * r;
       }
-      const Eigen::Matrix<double, 6, 1> step = -jtj.ldlt().solve(jtr);
+      Eigen::Matrix<double, 6, 1> step = -jtj.ldlt().solve(jtr);
       if (!step.allFinite()) break;
-      f = f.perturbed(step);
+      const double before = cost(f);
+      Frame next = f.perturbed(step);
+      for (int halve = 0; halve < 6 && cost(next) > before; ++halve) {
+        step *= 0.5;
+        next = f.perturbed(step);
+      }
+      if (cost(next) > before) break;
+      f = next;
       if (step.cwiseAbs().maxCoeff() < 1e-12) break;
     }
-    if (round == 1) break;
-    std::vector<double> abs_r;
-    for (const SweepPoint* q : use) abs_r.push_back(std::abs(f.residual(*q)));
-    const double limit = std::max(reject_mm, 4 * 1.4826 * median(abs_r));
+    if (!robust) break;
+    const double limit = std::max(reject_mm, 4 * robust_sigma(f));
     std::vector<const SweepPoint*> kept;
-    for (const SweepPoint* q : use)
-      if (std::abs(f.residual(*q)) <= limit) kept.push_back(q);
+    for (const SweepPoint& q : points)
+      if (std::abs(f.residual(q)) <= limit) kept.push_back(&q);
+    const bool settled = kept == use;
     use.swap(kept);
+    if (settled) round = kRobustRounds - 1;  // straight to the plain fit
   }
   LaserSweep out;
   out.u_ = f.u, out.e1_ = f.e1, out.e2_ = f.e2, out.a_ = f.a, out.theta0_ = f.theta0, out.dtheta_ = f.dtheta;

@@ -65,6 +65,44 @@ TEST(LaserSweep, RecoversTheAxisAndTheStepAngleFromNoisyPolePoints) {
   EXPECT_GT(std::abs(fit->axis_direction().dot(truth.u)), 0.9999);
 }
 
+TEST(LaserSweep, GrossOutliersAndAShortArcOfPolePointsStillGiveEveryPlane) {
+  // A laser far to the side: its planes cross both poles over only part of its
+  // sweep, one pole point in six is caught on the wrong face or a reflection
+  // (50-400 mm off), and some frames' own planes, the fit's start, are badly wrong.
+  const TrueSweep truth;
+  std::mt19937 rng(9);
+  std::normal_distribution<double> noise(0, 0.2);
+  std::uniform_real_distribution<double> gross(50, 400);
+  std::vector<SweepPoint> points;
+  std::vector<std::pair<int, SweepPlane>> planes;
+  size_t spoiled = 0;
+  for (int step = -100; step <= 20; ++step) {
+    for (double y : {0.0, 2300.0})
+      for (double z : {570.0, -530.0}) {
+        Eigen::Vector3d p = truth.point(step, y, z);
+        p.x() += noise(rng);
+        if (points.size() % 6 == 3) p.x() += gross(rng), ++spoiled;
+        points.push_back({step, p});
+      }
+    Eigen::Vector3d n = truth.normal(step);
+    if (step % 7 == 0) n = Eigen::AngleAxisd(0.08, Eigen::Vector3d::UnitY()) * n;  // 4.6 degrees off
+    planes.push_back({step, {n, n.dot(truth.a) + (step % 5 == 0 ? 40.0 : 0.0)}});
+  }
+  auto fit = LaserSweep::fit(points, planes);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_NEAR(std::abs(fit->degrees_per_step()), 0.1, 2e-4);
+  EXPECT_EQ(fit->points_rejected(), spoiled);
+  // Planes where the body stands, within the arc and extrapolated 150 steps past it.
+  for (int step : {-175, -60, 0, 100, 175}) {
+    const SweepPlane p = fit->plane(step);
+    for (double y : {200.0, 1700.0})
+      for (double z : {-200.0, 200.0}) {
+        const Eigen::Vector3d q = truth.point(step, y, z);
+        EXPECT_LT(std::abs(p.normal.dot(q) - p.offset), 0.3) << "step " << step;
+      }
+  }
+}
+
 TEST(LaserSweep, TooFewStepsIsAnError) {
   const TrueSweep truth;
   std::vector<SweepPoint> points = {{0, truth.point(0, 0, 570)}, {1, truth.point(1, 0, 570)}};
