@@ -220,13 +220,23 @@ int run(const std::string& rig_name, const std::string& body, int every) {
                   qc.mean, qc.p95);
     }
     if (k != 0) continue;
+    // The far points' share of the mean, and where they are.
+    {
+      double far_sum = 0;
+      size_t very_far = 0;
+      for (double x : dd) far_sum += x > 5 ? x : 0, very_far += x > 50;
+      std::printf("    beyond 5 mm: %zu points (%zu beyond 50 mm) add %.3f mm to the mean\n", far, very_far,
+                  far_sum / static_cast<double>(std::max<size_t>(dd.size(), 1)));
+    }
     // By confidence (contrast and triangulation angle).
-    for (double lo : {0.0, 0.25, 0.5, 0.75}) {
+    const double bins[] = {0.0, 0.1, 0.25, 0.5, 0.75, 1.0 + 1e-6};
+    for (size_t b = 0; b + 1 < std::size(bins); ++b) {
       std::vector<double> dc;
       for (size_t i = 0; i < dd.size(); ++i)
-        if (cloud.confidence[i] >= lo && cloud.confidence[i] < lo + 0.25 + 1e-6) dc.push_back(dd[i]);
+        if (cloud.confidence[i] >= bins[b] && cloud.confidence[i] < bins[b + 1]) dc.push_back(dd[i]);
       const Quantiles qc = quantiles(dc);
-      std::printf("    confidence %.2f-%.2f %8zu points: mean %.3f mm, p95 %.3f\n", lo, lo + 0.25, dc.size(), qc.mean, qc.p95);
+      std::printf("    confidence %.2f-%.2f %8zu points: mean %.3f mm, p95 %.3f\n", bins[b], std::min(1.0, bins[b + 1]),
+                  dc.size(), qc.mean, qc.p95);
     }
     // Coverage: the share of the body's area within 5 mm of a point, and where the rest is.
     const PointCloud samples = sample_mesh_uniform(truth, 400000, 7, true);
