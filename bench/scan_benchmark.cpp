@@ -64,6 +64,9 @@ int g_smooth = 3;
 int g_threshold = 0;
 float g_redundant = 4;
 float g_weak = -1;
+int g_radius = -1;
+double g_max_view = -1;
+bool g_gaussian = false;
 
 int run(const std::string& rig_name, const std::string& body, int every) {
   auto sim = pipeline::open_simulated_rig(rig_name, body);
@@ -137,9 +140,12 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       o.triangulate.method = m;
       o.triangulate.min_angle_deg = g_min_angle;
       o.triangulate.smooth_rows = g_smooth;
+      if (g_radius >= 0) o.triangulate.stripe.radius = g_radius;
+      if (g_gaussian) o.triangulate.stripe.peak = PeakEstimator::kGaussian;
       if (g_threshold > 0) o.triangulate.stripe.threshold = g_threshold;
       o.redundant_radius_mm = g_redundant;
       if (g_weak >= 0) o.redundant_weak = g_weak;
+      if (g_max_view > 0) o.view.max_view_deg = g_max_view;
       processors.push_back(std::make_unique<pipeline::ScanProcessor>(*cal, o));
       names.push_back(std::string(pipeline::to_string(ps)) + ", " + to_string(m));
     }
@@ -179,8 +185,9 @@ int run(const std::string& rig_name, const std::string& body, int every) {
   }
   const pipeline::ScanStats stats = processors[0]->stats();
   const Quantiles pe = quantiles(plane_errors);
-  std::printf("redundant points dropped (a point with twice the confidence within %.1f mm): %zu\n", g_redundant,
-              stats.points_redundant);
+  std::printf("grazing points dropped (seen more than %.0f deg from their normal): %zu; redundant points dropped (a "
+              "point with twice the confidence within %.1f mm): %zu\n",
+              processors[0]->options().view.max_view_deg, stats.points_grazing, g_redundant, stats.points_redundant);
   std::printf("scan: %zu frames per camera-step, %zu without a plane, far bottom estimated in %zu; acquisition + "
               "processing %.1f s, processing (frames -> points, one method) %.2f s = %.2f ms per frame\n",
               stats.frames, stats.frames_without_plane, stats.far_bottom_estimated, scan_total,
@@ -229,14 +236,47 @@ int run(const std::string& rig_name, const std::string& body, int every) {
                   far_sum / static_cast<double>(std::max<size_t>(dd.size(), 1)));
     }
     // By confidence (contrast and triangulation angle).
+    // With the signed error's mean (outside +): a bias, not noise, if far from 0.
     const double bins[] = {0.0, 0.1, 0.25, 0.5, 0.75, 1.0 + 1e-6};
     for (size_t b = 0; b + 1 < std::size(bins); ++b) {
       std::vector<double> dc;
+      double signed_sum = 0;
       for (size_t i = 0; i < dd.size(); ++i)
-        if (cloud.confidence[i] >= bins[b] && cloud.confidence[i] < bins[b + 1]) dc.push_back(dd[i]);
+        if (cloud.confidence[i] >= bins[b] && cloud.confidence[i] < bins[b + 1] && dd[i] <= 5) {
+          dc.push_back(dd[i]);
+          signed_sum += distance.closest_point(cloud.positions[i]).signed_distance;
+        }
       const Quantiles qc = quantiles(dc);
-      std::printf("    confidence %.2f-%.2f %8zu points: mean %.3f mm, p95 %.3f\n", bins[b], std::min(1.0, bins[b + 1]),
-                  dc.size(), qc.mean, qc.p95);
+      std::printf("    confidence %.2f-%.2f %8zu points within 5 mm: mean %.3f mm, p95 %.3f, signed mean %+.3f\n", bins[b],
+                  std::min(1.0, bins[b + 1]), dc.size(), qc.mean, qc.p95,
+                  signed_sum / static_cast<double>(std::max<size_t>(dc.size(), 1)));
+    }
+    // By the angle the camera sees the (true) surface at, from its normal: grazing
+    // views shift a stripe's peak towards the side that faces the camera more.
+    {
+      const double edges[] = {0, 60, 70, 75, 80, 85, 90.01};
+      std::vector<std::vector<double>> err(std::size(edges) - 1);
+      std::vector<double> bias(std::size(edges) - 1, 0);
+      for (size_t i = 0; i < dd.size(); ++i) {
+        if (dd[i] > 5) continue;
+        const ClosestPoint cp = distance.closest_point(cloud.positions[i]);
+        const Triangle& t = truth.triangles[cp.triangle];
+        const Eigen::Vector3d n = (truth.vertices[t[1]] - truth.vertices[t[0]])
+                                      .cross(truth.vertices[t[2]] - truth.vertices[t[0]])
+                                      .cast<double>()
+                                      .normalized();
+        const Eigen::Vector3d to_cam =
+            (desc.cameras[static_cast<size_t>(cloud.camera[i])].position - cloud.positions[i].cast<double>()).normalized();
+        const double view = std::acos(std::min(1.0, std::abs(n.dot(to_cam)))) * 180 / M_PI;
+        for (size_t b = 0; b + 1 < std::size(edges); ++b)
+          if (view >= edges[b] && view < edges[b + 1]) err[b].push_back(dd[i]), bias[b] += cp.signed_distance;
+      }
+      for (size_t b = 0; b < err.size(); ++b) {
+        const Quantiles qv = quantiles(err[b]);
+        std::printf("    view %2.0f-%2.0f deg %8zu points within 5 mm: mean %.3f mm, p95 %.3f, signed mean %+.3f\n", edges[b],
+                    std::min(90.0, edges[b + 1]), err[b].size(), qv.mean, qv.p95,
+                    bias[b] / static_cast<double>(std::max<size_t>(err[b].size(), 1)));
+      }
     }
     // Coverage: the share of the body's area within 5 mm of a point, and where the rest is.
     const PointCloud samples = sample_mesh_uniform(truth, 400000, 7, true);
@@ -277,11 +317,14 @@ int main(int argc, char** argv) {
     else if (a == "--every" && i + 1 < argc) every = std::max(1, std::atoi(argv[++i]));
     else if (a == "--min-angle" && i + 1 < argc) g_min_angle = std::atof(argv[++i]);
     else if (a == "--smooth" && i + 1 < argc) g_smooth = std::atoi(argv[++i]);
+    else if (a == "--radius" && i + 1 < argc) g_radius = std::atoi(argv[++i]);
+    else if (a == "--max-view" && i + 1 < argc) g_max_view = std::atof(argv[++i]);
+    else if (a == "--peak" && i + 1 < argc) g_gaussian = std::string(argv[++i]) == "gaussian";
     else if (a == "--threshold" && i + 1 < argc) g_threshold = std::atoi(argv[++i]);
     else if (a == "--redundant" && i + 1 < argc) g_redundant = static_cast<float>(std::atof(argv[++i]));
     else if (a == "--weak" && i + 1 < argc) g_weak = static_cast<float>(std::atof(argv[++i]));
     else {
-      std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N]\n");
+      std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] [--max-view DEG] [--smooth N] [--radius PX] [--peak centroid|gaussian] [--threshold N] [--redundant MM] [--weak C]\n");
       return 2;
     }
   }

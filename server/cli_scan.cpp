@@ -28,6 +28,9 @@ void usage(FILE* out) {
       "  --method M       homography (default: the thesis's image-to-laser-plane\n"
       "                   transform, eq. 3.6) or ray (the pixel's two-plane ray met\n"
       "                   with the laser plane)\n"
+      "  --max-view DEG   drop points their camera saw more than DEG from the\n"
+      "                   surface normal (grazing views put points inside the\n"
+      "                   body; default 90: keep them all)\n"
       "  --no-surface     stop at the point cloud\n"
       "  -q, --quiet      print only errors\n",
       out);
@@ -51,7 +54,8 @@ int run_scan(int argc, char** argv) {
     if (a == "--help" || a == "-h") {
       usage(stdout);
       return 0;
-    } else if (a == "--rig" || a == "--body" || a == "--out" || a == "--every" || a == "--method") {
+    } else if (a == "--rig" || a == "--body" || a == "--out" || a == "--every" || a == "--method" ||
+               a == "--max-view") {
       const char* v = value();
       if (!v) return 2;
       if (a == "--rig") rig_arg = v;
@@ -63,6 +67,15 @@ int run_scan(int argc, char** argv) {
           std::fprintf(stderr, "bodyscan scan: --every expects a positive integer, got '%s'\n", v);
           return 2;
         }
+      }
+      if (a == "--max-view") {
+        char* end = nullptr;
+        const double deg = std::strtod(v, &end);
+        if (end == v || *end != '\0' || !(deg > 0 && deg <= 90)) {
+          std::fprintf(stderr, "bodyscan scan: --max-view expects degrees in (0, 90], got '%s'\n", v);
+          return 2;
+        }
+        options.scan.view.max_view_deg = deg;
       }
       if (a == "--method") {
         const std::string m = v;

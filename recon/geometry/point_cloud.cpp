@@ -9,6 +9,15 @@ bool absent_or_per_point(const std::vector<T>& attribute, size_t n) {
   return attribute.empty() || attribute.size() == n;
 }
 
+template <typename T>
+void keep_unmarked(std::vector<T>& v, const std::vector<uint8_t>& drop) {
+  if (v.empty()) return;
+  size_t k = 0;
+  for (size_t i = 0; i < v.size(); ++i)
+    if (!drop[i]) v[k++] = v[i];
+  v.resize(k);
+}
+
 }  // namespace
 
 bool PointCloud::is_consistent() const {
@@ -28,6 +37,18 @@ bool PointCloud::is_consistent() const {
     if (num_centres > 0 && id >= num_centres) return false;
   }
   return true;
+}
+
+size_t PointCloud::remove_points(const std::vector<uint8_t>& drop) {
+  const size_t before = size();
+  keep_unmarked(positions, drop);
+  keep_unmarked(normals, drop);
+  keep_unmarked(intensity, drop);
+  keep_unmarked(confidence, drop);
+  keep_unmarked(camera, drop);
+  keep_unmarked(laser, drop);
+  keep_unmarked(frame, drop);
+  return before - size();
 }
 
 }  // namespace bodyscan

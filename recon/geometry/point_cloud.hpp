@@ -42,6 +42,10 @@ struct PointCloud {
   // True when every present attribute has one entry per point and every camera id
   // is either kUnknownSource or indexes camera_centres.
   bool is_consistent() const;
+
+  // Removes the points whose `drop` entry is non-zero (one entry per point), keeping
+  // every attribute in step and the rest in order. Returns how many went.
+  size_t remove_points(const std::vector<uint8_t>& drop);
 };
 
 }  // namespace bodyscan

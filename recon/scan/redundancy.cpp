@@ -9,17 +9,6 @@
 
 namespace bodyscan {
 
-namespace {
-template <typename T>
-void keep(std::vector<T>& v, const std::vector<uint8_t>& drop) {
-  if (v.empty()) return;
-  size_t k = 0;
-  for (size_t i = 0; i < v.size(); ++i)
-    if (!drop[i]) v[k++] = v[i];
-  v.resize(k);
-}
-}  // namespace
-
 size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio, float weak) {
   if (cloud.confidence.size() != cloud.size() || cloud.empty()) return 0;
   const KnnIndex index(cloud.positions);
@@ -38,16 +27,7 @@ size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio, float
       }
     }
   });
-  size_t n = 0;
-  for (uint8_t d : drop) n += d;
-  keep(cloud.positions, drop);
-  keep(cloud.normals, drop);
-  keep(cloud.intensity, drop);
-  keep(cloud.confidence, drop);
-  keep(cloud.camera, drop);
-  keep(cloud.laser, drop);
-  keep(cloud.frame, drop);
-  return n;
+  return cloud.remove_points(drop);
 }
 
 }  // namespace bodyscan

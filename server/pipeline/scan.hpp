@@ -13,6 +13,7 @@
 #include "recon/geometry/point_cloud.hpp"
 #include "recon/scan/laser_sweep.hpp"
 #include "recon/scan/redundancy.hpp"
+#include "recon/scan/view_angle.hpp"
 #include "recon/scan/triangulate.hpp"
 #include "server/pipeline/calibrate.hpp"
 
@@ -33,6 +34,11 @@ struct ScanOptions {
   float redundant_radius_mm = 4.f;
   float redundant_ratio = 2.f;
   float redundant_weak = 0.4f;
+  // Grazing views (weigh_by_view_angle), before the redundancy rule. Off by default
+  // (max_view_deg >= 90 keeps every point and its confidence): on the shipped rigs
+  // the grazing points are the only ones on the flanks, and dropping them costs the
+  // thesis rig its coverage must (docs/scan-processing.md, "Grazing views").
+  ViewAngleOptions view = {.max_view_deg = 90};
 };
 
 struct LaserSweepReport {
@@ -55,6 +61,7 @@ struct ScanStats {
   size_t samples = 0;               // stripe samples kept for triangulation
   size_t points = 0;
   size_t points_redundant = 0;      // dropped for a better point nearby
+  size_t points_grazing = 0;        // dropped for a grazing view (ScanOptions::view)
   std::vector<LaserSweepReport> sweeps;
   double processing_seconds = 0;    // frames to points, acquisition excluded
   std::string first_plane_error;    // the first frame without a plane, for the log
@@ -68,6 +75,7 @@ class ScanProcessor {
   // camera, laser, frame, camera centres). Call once, after the scan.
   StatusOr<PointCloud> finish();
   const ScanStats& stats() const { return stats_; }
+  const ScanOptions& options() const { return options_; }
 
  private:
   struct FrameRecord {

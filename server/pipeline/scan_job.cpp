@@ -61,6 +61,8 @@ Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
   j["frames_without_plane"] = r.scan.frames_without_plane;
   j["far_bottom_estimated"] = r.scan.far_bottom_estimated;
   j["fourth_point_rms_mm"] = r.scan.fourth_point_rms_mm;
+  j["points_redundant"] = r.scan.points_redundant;
+  j["points_grazing"] = r.scan.points_grazing;
   j["processing_seconds"] = r.scan.processing_seconds;
   j["lasers"] = nlohmann::json::array();
   for (const LaserSweepReport& s : r.scan.sweeps) {

@@ -1,6 +1,7 @@
 // `bodyscan scan` as a user runs it.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -25,6 +26,26 @@ TEST(ScanCli, CalibratesScansAndWritesTheCloudAndFigures) {
   const nlohmann::json scan = nlohmann::json::parse(slurp(dir + "/scan/scan.json"));
   EXPECT_GT(scan["points"].get<size_t>(), 5000u);
   EXPECT_FALSE(std::filesystem::exists(dir + "/scan/mesh.ply"));  // --no-surface
+  EXPECT_EQ(scan["points_grazing"].get<size_t>(), 0u);              // off by default
+  EXPECT_TRUE(cloud->cloud.normals.empty());
+
+  // --max-view drops what the cameras saw edge-on and leaves normals facing them.
+  const CliResult v =
+      bodyscan("scan --rig sim --out " + quote(dir + "/view") + " --every 12 --no-surface --max-view 60", dir);
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  const nlohmann::json vs = nlohmann::json::parse(slurp(dir + "/view/scan.json"));
+  EXPECT_GT(vs["points_grazing"].get<size_t>(), 100u);
+  auto viewed_ply = read_ply(dir + "/view/points.ply");
+  ASSERT_TRUE(viewed_ply.ok()) << viewed_ply.status().message();
+  const PointCloud* viewed = &viewed_ply->cloud;
+  ASSERT_EQ(viewed->normals.size(), viewed->size());
+  ASSERT_TRUE(viewed->has_cameras());
+  size_t facing = 0;
+  for (size_t i = 0; i < viewed->size(); ++i) {
+    const Vec3f to_camera = (viewed->camera_centres[static_cast<size_t>(viewed->camera[i])] - viewed->positions[i]).normalized();
+    facing += viewed->normals[i].dot(to_camera) >= std::cos(60.5 * M_PI / 180);
+  }
+  EXPECT_EQ(facing, viewed->size());
 }
 
 TEST(ScanCli, BadArgumentsAreClearErrors) {
@@ -37,6 +58,9 @@ TEST(ScanCli, BadArgumentsAreClearErrors) {
   EXPECT_NE(r.err.find("hexagon"), std::string::npos) << r.err;
   r = bodyscan("scan --rig sim --out x --method guess", dir);
   EXPECT_EQ(r.exit_code, 2);
+  r = bodyscan("scan --rig sim --out x --max-view 120", dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--max-view"), std::string::npos) << r.err;
   r = bodyscan("scan --out x", dir);
   EXPECT_EQ(r.exit_code, 2);
 }
