@@ -145,7 +145,7 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       if (g_threshold > 0) o.triangulate.stripe.threshold = g_threshold;
       o.redundant_radius_mm = g_redundant;
       if (g_weak >= 0) o.redundant_weak = g_weak;
-      if (g_max_view > 0) o.view.max_view_deg = g_max_view;
+      o.view.max_view_deg = g_max_view > 0 ? g_max_view : desc.processing.max_view_deg;
       processors.push_back(std::make_unique<pipeline::ScanProcessor>(*cal, o));
       names.push_back(std::string(pipeline::to_string(ps)) + ", " + to_string(m));
     }
@@ -234,6 +234,15 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       for (double x : dd) far_sum += x > 5 ? x : 0, very_far += x > 50;
       std::printf("    beyond 5 mm: %zu points (%zu beyond 50 mm) add %.3f mm to the mean\n", far, very_far,
                   far_sum / static_cast<double>(std::max<size_t>(dd.size(), 1)));
+      int shown = 0;
+      for (size_t i = 0; i < dd.size() && shown < 5; ++i) {
+        if (dd[i] <= 50) continue;
+        ++shown;
+        const Vec3f& p = cloud.positions[i];
+        std::printf("      %.0f mm off at (%.0f, %.0f, %.0f): camera %s, laser %s, frame %d, confidence %.2f\n", dd[i], p.x(),
+                    p.y(), p.z(), desc.cameras[static_cast<size_t>(cloud.camera[i])].id.c_str(),
+                    desc.lasers[static_cast<size_t>(cloud.laser[i])].id.c_str(), cloud.frame[i], cloud.confidence[i]);
+      }
     }
     // By confidence (contrast and triangulation angle).
     // With the signed error's mean (outside +): a bias, not noise, if far from 0.

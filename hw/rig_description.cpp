@@ -323,7 +323,7 @@ bool planes_cross_inside(const LaserDescription& a, const LaserDescription& b, c
 
 RigDescription read_rig(const json& j, const std::string& source) {
   const Reader r(j, "rig");
-  r.only({"name", "frame", "cameras", "lasers", "laser_groups", "simulation"});
+  r.only({"name", "frame", "cameras", "lasers", "laser_groups", "simulation", "processing"});
   RigDescription rig;
   rig.source = source;
   rig.name = r.text("name", std::filesystem::path(source).stem().string());
@@ -362,6 +362,12 @@ RigDescription read_rig(const json& j, const std::string& source) {
   for (const LaserDescription& l : rig.lasers)
     if (!grouped.count(l.id)) rig.laser_groups.push_back({l.id});  // runs alone
   if (r.has("simulation")) rig.simulation = read_simulation(r.child("simulation"), source);
+  if (r.has("processing")) {
+    const Reader p = r.child("processing");
+    p.only({"max_view_deg"});
+    rig.processing.max_view_deg = p.positive("max_view_deg", rig.processing.max_view_deg);
+    if (rig.processing.max_view_deg > 90) p.fail("max_view_deg must be at most 90 (degrees from the surface normal)");
+  }
   return rig;
 }
 
@@ -450,6 +456,7 @@ std::string to_json(const RigDescription& rig) {
                      {"ambient_light", s.ambient_light},
                      {"frame_light", s.frame_light},
                      {"speckle_contrast", s.speckle_contrast}};
+  j["processing"] = {{"max_view_deg", rig.processing.max_view_deg}};
   return j.dump(2);
 }
 

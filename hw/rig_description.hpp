@@ -100,6 +100,15 @@ struct SimulationDescription {
   double speckle_contrast = 0.25;  // std/mean of laser speckle
 };
 
+// How scans of this layout are best processed, where that depends on the layout.
+struct ProcessingHints {
+  // Points a camera saw more than this from the surface normal are dropped
+  // (docs/scan-processing.md, "Grazing views"); 90 keeps them all. A layout that
+  // lights the flanks but sees them edge-on wants a cut; one whose grazing points are
+  // all it has of the flanks does not.
+  double max_view_deg = 90;
+};
+
 struct RigDescription {
   std::string name;
   std::string source;  // the file it was read from, for messages
@@ -110,6 +119,7 @@ struct RigDescription {
   // inside the frame at any pair of steps. Every laser is in exactly one group.
   std::vector<std::vector<std::string>> laser_groups;
   SimulationDescription simulation;
+  ProcessingHints processing;
 
   const LaserDescription* find_laser(const std::string& id) const;
 };

@@ -30,7 +30,8 @@ void usage(FILE* out) {
       "                   with the laser plane)\n"
       "  --max-view DEG   drop points their camera saw more than DEG from the\n"
       "                   surface normal (grazing views put points inside the\n"
-      "                   body; default 90: keep them all)\n"
+      "                   body; default: the rig description's processing\n"
+      "                   .max_view_deg, else 90: keep them all)\n"
       "  --no-surface     stop at the point cloud\n"
       "  -q, --quiet      print only errors\n",
       out);
@@ -75,7 +76,7 @@ int run_scan(int argc, char** argv) {
           std::fprintf(stderr, "bodyscan scan: --max-view expects degrees in (0, 90], got '%s'\n", v);
           return 2;
         }
-        options.scan.view.max_view_deg = deg;
+        options.max_view_deg = deg;
       }
       if (a == "--method") {
         const std::string m = v;

@@ -23,7 +23,10 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& optio
   out.calibration_seconds = seconds_since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  ScanProcessor processor(out.calibration, options.scan);
+  ScanOptions scan_options = options.scan;
+  scan_options.view.max_view_deg =
+      options.max_view_deg.value_or(rig.description ? rig.description->processing.max_view_deg : 90.0);
+  ScanProcessor processor(out.calibration, scan_options);
   RETURN_IF_ERROR(acquire_scan(
       rig, [&](Shot&& s) { return processor.consume(std::move(s)); }, options.every, options.progress,
       out.calibration.sweep_reversed));

@@ -3,6 +3,7 @@
 // surface, write the results.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "recon/geometry/triangle_mesh.hpp"
@@ -16,6 +17,8 @@ struct ScanJobOptions {
   int every = 1;  // scan every Nth laser step
   CalibrateOptions calibrate;
   ScanOptions scan;
+  // Overrides the rig description's processing.max_view_deg (ScanOptions::view).
+  std::optional<double> max_view_deg;
   bool reconstruct = true;
   ReconstructOptions surface;
   ProgressFn progress;  // stages: calibration..., scan, surface...

@@ -107,6 +107,13 @@ TEST(RigDescription, RoundTripsThroughJson) {
   EXPECT_EQ(to_json(*b), to_json(a));
   EXPECT_EQ(b->cameras[1].distortion.p2, a.cameras[1].distortion.p2);
   EXPECT_EQ(b->simulation.subject, a.simulation.subject);
+  EXPECT_EQ(b->processing.max_view_deg, 90.0);  // no cut unless the layout asks
+  auto j = thesis_json();
+  j["processing"]["max_view_deg"] = 75;
+  auto c = parse_rig_description(j.dump(), a.source);
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  EXPECT_EQ(c->processing.max_view_deg, 75.0);
+  EXPECT_EQ(nlohmann::json::parse(to_json(*c))["processing"]["max_view_deg"], 75.0);
 }
 
 TEST(RigDescription, ErrorsNameTheField) {
@@ -137,6 +144,12 @@ TEST(RigDescription, ErrorsNameTheField) {
   j = thesis_json();
   j["cameras"][0]["distortion"]["k1"] = -3.0;
   EXPECT_NE(parse_error(j).find("folds over"), std::string::npos) << parse_error(j);
+  j = thesis_json();
+  j["processing"]["max_view_deg"] = 120;
+  EXPECT_NE(parse_error(j).find("rig.processing: max_view_deg must be at most 90"), std::string::npos) << parse_error(j);
+  j = thesis_json();
+  j["processing"]["smoothing"] = 3;
+  EXPECT_NE(parse_error(j).find("unknown field 'smoothing'"), std::string::npos) << parse_error(j);
   EXPECT_FALSE(load_rig_description("/nonexistent/rig.json").ok());
 }
 
