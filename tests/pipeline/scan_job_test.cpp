@@ -26,6 +26,16 @@ std::unique_ptr<hw::sim::SimulatedRig> half_resolution_rig(const std::string& na
   return rig.ok() ? std::move(rig).value() : nullptr;
 }
 
+// Mean and 95th percentile of the points' distances to the rig's true body (mm).
+std::pair<double, float> distance_to_body(const hw::sim::SimulatedRig& rig, const PointCloud& cloud) {
+  const MeshDistance truth(rig.scene().subject());
+  std::vector<float> d = truth.distances(cloud.positions);
+  std::sort(d.begin(), d.end());
+  double mean = 0;
+  for (float x : d) mean += x / static_cast<double>(d.size());
+  return {mean, d[d.size() * 95 / 100]};
+}
+
 TEST(ScanJob, PointsLieOnTheBodyFromEveryCamera) {
   auto rig = half_resolution_rig();
   ASSERT_TRUE(rig);
@@ -38,12 +48,7 @@ TEST(ScanJob, PointsLieOnTheBodyFromEveryCamera) {
   ASSERT_TRUE(cloud.is_consistent());
   ASSERT_GT(cloud.size(), 10000u);
   ASSERT_EQ(cloud.camera_centres.size(), 3u);
-  const MeshDistance truth(rig->scene().subject());
-  std::vector<float> d = truth.distances(cloud.positions);
-  std::sort(d.begin(), d.end());
-  double mean = 0;
-  for (float x : d) mean += x / static_cast<double>(d.size());
-  const float p95 = d[d.size() * 95 / 100];
+  const auto [mean, p95] = distance_to_body(*rig, cloud);
   // Half-resolution pixels (6 mm on the body) and every 4th step: full resolution is
   // measured by bench/scan_benchmark (docs/benchmarks.md).
   EXPECT_LT(mean, 1.2) << "mm";
@@ -76,17 +81,13 @@ TEST(ScanJob, TheSquareRigDropsGrazingViewsAsItsDescriptionAsks) {
   EXPECT_GT(result->scan.points_grazing, 100u);
   ASSERT_EQ(cloud.normals.size(), cloud.size());
   for (const LaserSweepReport& s : result->scan.sweeps) EXPECT_TRUE(s.fitted) << s.error;
-  const MeshDistance truth(rig->scene().subject());
-  std::vector<float> d = truth.distances(cloud.positions);
-  std::sort(d.begin(), d.end());
-  double mean = 0;
-  for (float x : d) mean += x / static_cast<double>(d.size());
+  const auto [mean, p95] = distance_to_body(*rig, cloud);
   // Half resolution (7 mm pixels on the body from 3.3 m); full resolution: 0.41-0.49
   // mean, 1.13-1.37 p95 (docs/benchmarks.md 6).
   EXPECT_LT(mean, 1.3) << "mm";
-  EXPECT_LT(d[d.size() * 95 / 100], 3.5) << "mm";
+  EXPECT_LT(p95, 3.5) << "mm";
   std::printf("[ square ] %zu points (%zu grazing dropped), mean %.3f mm, p95 %.3f mm\n", cloud.size(),
-              result->scan.points_grazing, mean, d[d.size() * 95 / 100]);
+              result->scan.points_grazing, mean, p95);
   // --max-view (ScanJobOptions::max_view_deg) overrides the description.
   options.max_view_deg = 90;
   auto all = run_scan_job(rig_handle(*rig), options);
