@@ -1,0 +1,177 @@
+#include "recon/measure/girth.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace bodyscan {
+
+namespace {
+
+double cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+double distance_to_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+// The tape around points of one part: hull in the plane, back in 3-D.
+void measure_around(const std::vector<Eigen::Vector3d>& points, const Plane& plane, Girth* g) {
+  Eigen::Vector3d u, v;
+  plane_basis(plane.normal, &u, &v);
+  std::vector<Eigen::Vector2d> flat;
+  flat.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d q = p - plane.point;
+    flat.emplace_back(q.dot(u), q.dot(v));
+  }
+  const std::vector<Eigen::Vector2d> hull = convex_hull(flat);
+  g->value_mm = closed_length(hull);
+  g->tape.clear();
+  for (const Eigen::Vector2d& h : hull) g->tape.push_back(plane.point + h.x() * u + h.y() * v);
+}
+
+}  // namespace
+
+void plane_basis(const Eigen::Vector3d& normal, Eigen::Vector3d* u, Eigen::Vector3d* v) {
+  const Eigen::Vector3d n = normal.normalized();
+  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  *u = (helper - helper.dot(n) * n).normalized();
+  *v = n.cross(*u);
+}
+
+std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> p) {
+  std::sort(p.begin(), p.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  p.erase(std::unique(p.begin(), p.end()), p.end());
+  if (p.size() < 3) return p;
+  std::vector<Eigen::Vector2d> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {  // lower hull
+    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i-- > 0;) {  // upper hull
+    while (k >= t && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
+    h[k++] = p[i];
+  }
+  h.resize(k - 1);  // the last point is the first
+  return h;
+}
+
+double closed_length(const std::vector<Eigen::Vector2d>& polygon) {
+  double sum = 0;
+  for (size_t i = 0; i < polygon.size(); ++i) sum += (polygon[(i + 1) % polygon.size()] - polygon[i]).norm();
+  return polygon.size() < 2 ? 0 : sum;
+}
+
+double closed_length(const std::vector<Eigen::Vector3d>& polygon) {
+  double sum = 0;
+  for (size_t i = 0; i < polygon.size(); ++i) sum += (polygon[(i + 1) % polygon.size()] - polygon[i]).norm();
+  return polygon.size() < 2 ? 0 : sum;
+}
+
+StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, const std::optional<Eigen::Vector3d>& near) {
+  Plane plane = plane_in;
+  if (!(plane.normal.norm() > 0)) return invalid_argument("girth: the plane's normal is zero");
+  plane.normal.normalize();
+  std::vector<SectionLoop> loops = plane_section(mesh, plane);
+  const size_t cut = loops.size();
+  loops.erase(std::remove_if(loops.begin(), loops.end(), [](const SectionLoop& l) { return !l.closed; }), loops.end());
+  if (cut == 0) return not_found("girth: the plane does not cut the body");
+  if (loops.empty()) return not_found("girth: the plane cuts only the body's open border, no closed loop to measure around");
+  size_t best = 0;
+  if (near) {
+    double best_d = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < loops.size(); ++i) {
+      const std::vector<Eigen::Vector3d>& l = loops[i].points;
+      for (size_t k = 0; k < l.size(); ++k) {
+        const double d = distance_to_segment(*near, l[k], l[(k + 1) % l.size()]);
+        if (d < best_d) best_d = d, best = i;
+      }
+    }
+  } else {
+    double longest = -1;
+    for (size_t i = 0; i < loops.size(); ++i) {
+      Girth g;
+      measure_around(loops[i].points, plane, &g);
+      if (g.value_mm > longest) longest = g.value_mm, best = i;
+    }
+  }
+  Girth g;
+  g.plane = plane;
+  g.loops_cut = cut;
+  g.loop = loops[best].points;
+  g.loop_length_mm = closed_length(g.loop);
+  g.min_confidence = *std::min_element(loops[best].confidence.begin(), loops[best].confidence.end());
+  measure_around(g.loop, plane, &g);
+  return g;
+}
+
+StatusOr<Girth> cloud_girth(const PointCloud& cloud, const Plane& plane_in, const std::optional<Eigen::Vector3d>& near,
+                            double slab_mm, double gap_mm) {
+  Plane plane = plane_in;
+  if (!(plane.normal.norm() > 0)) return invalid_argument("girth: the plane's normal is zero");
+  plane.normal.normalize();
+  std::vector<Eigen::Vector3d> slab;
+  for (const Vec3f& p : cloud.positions) {
+    const Eigen::Vector3d q = p.cast<double>();
+    const double d = plane.signed_distance(q);
+    if (std::abs(d) <= slab_mm) slab.push_back(q - d * plane.normal);
+  }
+  if (slab.size() < 3) return not_found("girth: fewer than 3 points lie within " + std::to_string(slab_mm) + " mm of the plane");
+  // Parts: single-linkage groups at gap_mm (union-find over a sort by one axis).
+  std::vector<size_t> parent(slab.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::vector<size_t> order(slab.size());
+  std::iota(order.begin(), order.end(), 0);
+  Eigen::Vector3d u, v;
+  plane_basis(plane.normal, &u, &v);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return slab[a].dot(u) < slab[b].dot(u); });
+  for (size_t i = 0; i < order.size(); ++i)
+    for (size_t j = i + 1; j < order.size() && slab[order[j]].dot(u) - slab[order[i]].dot(u) <= gap_mm; ++j)
+      if ((slab[order[i]] - slab[order[j]]).norm() <= gap_mm) parent[find(order[i])] = find(order[j]);
+  std::vector<std::vector<Eigen::Vector3d>> parts;
+  std::vector<long> part_of(slab.size(), -1);
+  for (size_t i = 0; i < slab.size(); ++i) {
+    const size_t r = find(i);
+    if (part_of[r] < 0) part_of[r] = static_cast<long>(parts.size()), parts.emplace_back();
+    parts[static_cast<size_t>(part_of[r])].push_back(slab[i]);
+  }
+  size_t best = 0;
+  double best_score = -std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < parts.size(); ++i) {
+    if (parts[i].size() < 3) continue;
+    double score;
+    if (near) {
+      double d = std::numeric_limits<double>::infinity();
+      for (const Eigen::Vector3d& p : parts[i]) d = std::min(d, (p - *near).norm());
+      score = -d;
+    } else {
+      Girth g;
+      measure_around(parts[i], plane, &g);
+      score = g.value_mm;
+    }
+    if (score > best_score) best_score = score, best = i;
+  }
+  if (parts[best].size() < 3) return not_found("girth: no part of the cloud has 3 points in the plane");
+  Girth g;
+  g.plane = plane;
+  g.loops_cut = parts.size();
+  g.loop = parts[best];
+  measure_around(g.loop, plane, &g);
+  g.loop_length_mm = 0;  // unordered points: no path along the skin
+  return g;
+}
+
+}  // namespace bodyscan

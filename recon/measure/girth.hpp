@@ -1,0 +1,52 @@
+// Girths the way a tailor's tape takes them (thesis §3.3): cut the body with a plane,
+// take the loop around the part meant, and measure the convex hull of that loop in
+// the plane, because a tape bridges the body's hollows. The thesis does it on the
+// point cloud (points within a threshold of the plane); on a mesh the cut is exact.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "recon/core/status.hpp"
+#include "recon/geometry/point_cloud.hpp"
+#include "recon/geometry/triangle_mesh.hpp"
+#include "recon/measure/plane_section.hpp"
+
+namespace bodyscan {
+
+// The convex hull of points in a plane, counter-clockwise, without collinear points
+// (Andrew's monotone chain, O(n log n)). Fewer than 3 distinct points: those points.
+std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> points);
+// Length of the closed polygon through `polygon` (mm).
+double closed_length(const std::vector<Eigen::Vector2d>& polygon);
+double closed_length(const std::vector<Eigen::Vector3d>& polygon);
+
+struct Girth {
+  double value_mm = 0;                // the tape: the hull's perimeter
+  Plane plane;
+  std::vector<Eigen::Vector3d> loop;  // the section loop measured around, in order
+  std::vector<Eigen::Vector3d> tape;  // the hull's corners in order: the tape's path
+  double loop_length_mm = 0;          // along the skin, hollows followed
+  float min_confidence = 1;           // lowest mesh confidence along the loop (1: all measured)
+  size_t loops_cut = 0;               // how many loops the plane cut (arms, legs, torso...)
+};
+
+// The girth in `plane` around the closed section loop nearest `near` (the loop a
+// person pointed at), or without `near` the loop with the longest tape (at the waist,
+// the torso rather than an arm). Errors: the plane misses the mesh, or cuts no
+// closed loop (an open mesh's border).
+StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane,
+                           const std::optional<Eigen::Vector3d>& near = std::nullopt);
+
+// The same on a point cloud, as the thesis does it: the points within `slab_mm` of
+// the plane, projected into it, grouped into parts (points closer than `gap_mm`
+// belong together), the part nearest `near` (or the one with the longest tape)
+// measured around its hull. `loop` holds the part's projected points (unordered).
+StatusOr<Girth> cloud_girth(const PointCloud& cloud, const Plane& plane, const std::optional<Eigen::Vector3d>& near,
+                            double slab_mm = 2.0, double gap_mm = 25.0);
+
+// A unit vector pair spanning the plane: (u, v, normal) right-handed.
+void plane_basis(const Eigen::Vector3d& normal, Eigen::Vector3d* u, Eigen::Vector3d* v);
+
+}  // namespace bodyscan

@@ -1,0 +1,89 @@
+#include "recon/measure/plane_section.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+namespace bodyscan {
+
+namespace {
+
+uint64_t edge_key(uint32_t a, uint32_t b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<uint64_t>(a) << 32) | b;
+}
+
+}  // namespace
+
+std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& plane) {
+  const size_t nv = mesh.vertices.size();
+  std::vector<double> d(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    d[i] = plane.signed_distance(mesh.vertices[i].cast<double>());
+    if (d[i] == 0) d[i] = 1e-12;  // on the plane: a hair on the positive side
+  }
+  // Each crossed triangle gives one segment between two crossed edges. Link the
+  // segments through their shared edges: an edge of a manifold mesh is crossed by
+  // the segments of its (at most) two triangles.
+  struct Segment {
+    uint64_t a, b;
+  };
+  std::vector<Segment> segments;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> by_edge;  // edge -> segments
+  for (const Triangle& t : mesh.triangles) {
+    uint64_t crossed[2];
+    int n = 0;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t u = t[k], v = t[(k + 1) % 3];
+      if ((d[u] > 0) != (d[v] > 0) && n < 2) crossed[n++] = edge_key(u, v);
+    }
+    if (n != 2) continue;
+    const auto s = static_cast<uint32_t>(segments.size());
+    segments.push_back({crossed[0], crossed[1]});
+    by_edge[crossed[0]].push_back(s);
+    by_edge[crossed[1]].push_back(s);
+  }
+  auto point_on = [&](uint64_t key, float* confidence) {
+    const auto a = static_cast<uint32_t>(key >> 32), b = static_cast<uint32_t>(key & 0xffffffffu);
+    const double t = d[a] / (d[a] - d[b]);
+    if (confidence) {
+      *confidence = mesh.confidence.size() == nv
+                        ? static_cast<float>((1 - t) * mesh.confidence[a] + t * mesh.confidence[b])
+                        : 1.f;
+    }
+    return ((1 - t) * mesh.vertices[a].cast<double>() + t * mesh.vertices[b].cast<double>()).eval();
+  };
+  std::vector<uint8_t> used(segments.size(), 0);
+  std::vector<SectionLoop> loops;
+  // Open polylines first (from an edge only one segment uses), then closed loops.
+  auto walk = [&](uint32_t s, const uint64_t start_edge) {
+    SectionLoop loop;
+    loop.closed = false;
+    float c = 1;
+    loop.points.push_back(point_on(start_edge, &c));
+    loop.confidence.push_back(c);
+    uint64_t edge = start_edge;
+    for (;;) {
+      used[s] = 1;
+      edge = segments[s].a == edge ? segments[s].b : segments[s].a;
+      if (edge == start_edge) {
+        loop.closed = true;
+        break;
+      }
+      loop.points.push_back(point_on(edge, &c));
+      loop.confidence.push_back(c);
+      uint32_t next = s;
+      for (uint32_t o : by_edge[edge])
+        if (!used[o]) next = o;
+      if (next == s) break;  // the mesh's border (or a non-manifold dead end)
+      s = next;
+    }
+    if (loop.points.size() >= 3) loops.push_back(std::move(loop));
+  };
+  for (const auto& [edge, segs] : by_edge)
+    if (segs.size() == 1 && !used[segs[0]]) walk(segs[0], edge);
+  for (uint32_t s = 0; s < segments.size(); ++s)
+    if (!used[s]) walk(s, segments[s].a);
+  return loops;
+}
+
+}  // namespace bodyscan

@@ -1,0 +1,33 @@
+// Where a plane cuts a triangle mesh: closed loops (and, on an open mesh, open
+// polylines) of points on the mesh's edges, the exact plane–mesh intersection the
+// girth tools of thesis §3.3 measure around.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "recon/geometry/triangle_mesh.hpp"
+
+namespace bodyscan {
+
+// The plane through `point` with unit `normal` (mm, world frame).
+struct Plane {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
+  double signed_distance(const Eigen::Vector3d& p) const { return normal.dot(p - point); }
+};
+
+struct SectionLoop {
+  std::vector<Eigen::Vector3d> points;  // in order along the cut; not repeated at the end
+  bool closed = true;                   // false where the cut runs off an open mesh's border
+  // Per point, the mesh's confidence interpolated along the edge (1 when the mesh
+  // has none): where a loop crosses filled holes.
+  std::vector<float> confidence;
+};
+
+// Every loop the plane cuts from the mesh. A vertex exactly on the plane is taken
+// to lie a hair on its positive side, so every cut crosses edges, never vertices,
+// and the loops come out simple. Loops of fewer than 3 points are left out.
+std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& plane);
+
+}  // namespace bodyscan

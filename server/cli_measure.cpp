@@ -1,0 +1,173 @@
+// bodyscan measure: one measurement on a mesh or a point cloud, as JSON on stdout.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "recon/io/ply.hpp"
+#include "recon/measure/girth.hpp"
+
+namespace bodyscan::cli {
+
+namespace {
+
+constexpr const char* kGirthAlgorithm = "girth/convex-hull-1";
+
+void usage(FILE* out) {
+  std::fputs(
+      "usage: bodyscan measure FILE.ply WHAT [--near X,Y,Z]\n"
+      "\n"
+      "Measures a body (mm, Y up; a mesh, or a point cloud as the thesis does) and\n"
+      "prints one JSON document: each measurement with its name, value_mm and the\n"
+      "geometry to draw.\n"
+      "\n"
+      "  --girth-y Y            horizontal girth at height Y: the tape around the\n"
+      "                         section loop (convex hull, as a tape bridges hollows)\n"
+      "  --plane PX,PY,PZ,NX,NY,NZ\n"
+      "                         girth in the plane through P with normal N\n"
+      "  --near X,Y,Z           measure around the loop nearest this point (default:\n"
+      "                         the loop with the longest tape, the torso at the waist)\n"
+      "  --distance X,Y,Z --to X,Y,Z\n"
+      "                         straight distance between two points\n",
+      out);
+}
+
+std::optional<std::vector<double>> numbers(const std::string& text, size_t count) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(x)) return std::nullopt;
+    v.push_back(x);
+  }
+  if (v.size() != count) return std::nullopt;
+  return v;
+}
+
+nlohmann::json point_json(const Eigen::Vector3d& p) { return nlohmann::json::array({p.x(), p.y(), p.z()}); }
+
+nlohmann::json polyline_json(const std::vector<Eigen::Vector3d>& points) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const Eigen::Vector3d& p : points) a.push_back(point_json(p));
+  return a;
+}
+
+}  // namespace
+
+int run_measure(int argc, char** argv) {
+  std::string file;
+  std::optional<double> girth_y;
+  std::optional<Plane> plane;
+  std::optional<Eigen::Vector3d> near, from, to;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      usage(stdout);
+      return 0;
+    }
+    const bool takes_value = a == "--girth-y" || a == "--plane" || a == "--near" || a == "--distance" || a == "--to";
+    if (!takes_value) {
+      if (!a.empty() && a[0] == '-') {
+        std::fprintf(stderr, "bodyscan measure: unknown option '%s'\n", a.c_str());
+        usage(stderr);
+        return 2;
+      }
+      if (!file.empty()) {
+        std::fprintf(stderr, "bodyscan measure: one file only ('%s' and '%s')\n", file.c_str(), a.c_str());
+        return 2;
+      }
+      file = a;
+      continue;
+    }
+    if (i + 1 >= argc) {
+      std::fprintf(stderr, "bodyscan measure: %s needs a value\n", a.c_str());
+      return 2;
+    }
+    const std::string v = argv[++i];
+    const size_t count = a == "--girth-y" ? 1 : a == "--plane" ? 6 : 3;
+    const auto n = numbers(v, count);
+    if (!n) {
+      std::fprintf(stderr, "bodyscan measure: %s expects %zu comma-separated numbers (mm), got '%s'\n", a.c_str(),
+                   count, v.c_str());
+      return 2;
+    }
+    const std::vector<double>& x = *n;
+    if (a == "--girth-y") girth_y = x[0];
+    if (a == "--plane") {
+      const Eigen::Vector3d normal(x[3], x[4], x[5]);
+      if (!(normal.norm() > 0)) {
+        std::fprintf(stderr, "bodyscan measure: --plane's normal (the last three numbers) must not be zero\n");
+        return 2;
+      }
+      plane = Plane{Eigen::Vector3d(x[0], x[1], x[2]), normal.normalized()};
+    }
+    if (a == "--near") near = Eigen::Vector3d(x[0], x[1], x[2]);
+    if (a == "--distance") from = Eigen::Vector3d(x[0], x[1], x[2]);
+    if (a == "--to") to = Eigen::Vector3d(x[0], x[1], x[2]);
+  }
+  const int whats = (girth_y ? 1 : 0) + (plane ? 1 : 0) + (from ? 1 : 0);
+  if (file.empty() || whats != 1 || from.has_value() != to.has_value()) {
+    std::fprintf(stderr, "bodyscan measure: give a FILE and one of --girth-y, --plane, or --distance with --to\n");
+    usage(stderr);
+    return 2;
+  }
+  nlohmann::json out;
+  out["file"] = file;
+  out["measurements"] = nlohmann::json::array();
+  if (from) {
+    out["measurements"].push_back({{"name", "distance"},
+                                   {"kind", "point_to_point"},
+                                   {"value_mm", (*to - *from).norm()},
+                                   {"from", point_json(*from)},
+                                   {"to", point_json(*to)}});
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
+  auto ply = read_ply(file);
+  if (!ply.ok()) {
+    std::fprintf(stderr, "bodyscan measure: %s\n", ply.status().message().c_str());
+    return 1;
+  }
+  const Plane cut = plane ? *plane : Plane{Eigen::Vector3d(0, *girth_y, 0), Eigen::Vector3d::UnitY()};
+  const bool is_mesh = !ply->triangles.empty();
+  StatusOr<Girth> g = Status{};
+  if (is_mesh) {
+    TriangleMesh mesh;
+    mesh.vertices = ply->cloud.positions;
+    mesh.triangles = ply->triangles;
+    if (ply->cloud.confidence.size() == mesh.vertices.size()) mesh.confidence = ply->cloud.confidence;
+    g = mesh_girth(mesh, cut, near);
+  } else {
+    g = cloud_girth(ply->cloud, cut, near);
+  }
+  if (!g.ok()) {
+    std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), g.status().message().c_str());
+    return 1;
+  }
+  out["kind"] = is_mesh ? "mesh" : "points";
+  nlohmann::json m = {{"name", girth_y ? "girth at y " + std::to_string(static_cast<long>(std::lround(*girth_y))) : "girth"},
+                      {"kind", "girth"},
+                      {"value_mm", g->value_mm},
+                      {"plane", {{"point", point_json(g->plane.point)}, {"normal", point_json(g->plane.normal)}}},
+                      {"tape", polyline_json(g->tape)},
+                      {"loops_cut", g->loops_cut},
+                      {"algorithm", kGirthAlgorithm}};
+  if (near) m["near"] = point_json(*near);
+  if (is_mesh) {
+    m["loop"] = polyline_json(g->loop);
+    m["loop_length_mm"] = g->loop_length_mm;
+    m["min_confidence"] = g->min_confidence;
+    m["crosses_filled_hole"] = g->min_confidence < 0.5f;
+  }
+  out["measurements"].push_back(m);
+  std::printf("%s\n", out.dump(2).c_str());
+  return 0;
+}
+
+}  // namespace bodyscan::cli

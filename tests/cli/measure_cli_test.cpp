@@ -1,0 +1,86 @@
+// `bodyscan measure` as a user runs it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "recon/geometry/sample_surface.hpp"
+#include "recon/io/ply.hpp"
+#include "tests/cli/cli_runner.hpp"
+#include "tests/shapes.hpp"
+#include "tests/test_data.hpp"
+
+namespace bodyscan {
+namespace {
+
+// A torso (radius 150) with an arm (radius 40) beside it, 600 mm tall.
+TriangleMesh torso_and_arm() {
+  return testing::merged(testing::prism(testing::circle(150), {0, 0}, 0, 600),
+                         testing::prism(testing::circle(40, {230, 0}, 360), {230, 0}, 100, 600));
+}
+
+TEST(MeasureCli, GirthsOnAMeshAndAPointCloud) {
+  const std::string dir = testing::temp_dir();
+  const std::string mesh = dir + "/body.ply", points = dir + "/points.ply";
+  ASSERT_TRUE(write_ply(mesh, torso_and_arm()).ok());
+  ASSERT_TRUE(write_ply(points, sample_mesh_uniform(torso_and_arm(), 300000, 1, false)).ok());
+  const double torso = 2 * 720 * 150 * std::sin(M_PI / 720), arm = 2 * 360 * 40 * std::sin(M_PI / 360);
+
+  CliResult r = bodyscan("measure " + quote(mesh) + " --girth-y 310", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["kind"], "mesh");
+  const nlohmann::json& m = j["measurements"][0];
+  EXPECT_EQ(m["kind"], "girth");
+  EXPECT_NEAR(m["value_mm"].get<double>(), torso, 1e-3);  // float vertices
+  EXPECT_EQ(m["loops_cut"], 2);
+  EXPECT_EQ(m["loop"].size(), 1440u);  // each quad's side and diagonal
+  EXPECT_NEAR(m["loop"][0][1].get<double>(), 310, 1e-4);
+  EXPECT_FALSE(m["algorithm"].get<std::string>().empty());
+
+  r = bodyscan("measure " + quote(mesh) + " --girth-y 310 --near 230,310,40", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NEAR(nlohmann::json::parse(r.out)["measurements"][0]["value_mm"].get<double>(), arm, 1e-3);
+
+  // A plane given directly (tilted 30 degrees about z) on the torso alone.
+  r = bodyscan("measure " + quote(mesh) + " --plane 0,300,0,0.5,0.8660254,0 --near -150,300,0", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(nlohmann::json::parse(r.out)["measurements"][0]["value_mm"].get<double>(), torso + 20);
+
+  r = bodyscan("measure " + quote(points) + " --girth-y 300", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["kind"], "points");
+  EXPECT_NEAR(j["measurements"][0]["value_mm"].get<double>(), torso, 2.0);
+
+  r = bodyscan("measure --distance 0,0,0 --to 30,40,0 " + quote(mesh), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NEAR(nlohmann::json::parse(r.out)["measurements"][0]["value_mm"].get<double>(), 50.0, 1e-12);
+}
+
+TEST(MeasureCli, BadInputIsAClearError) {
+  const std::string dir = testing::temp_dir();
+  const std::string mesh = dir + "/body.ply";
+  ASSERT_TRUE(write_ply(mesh, torso_and_arm()).ok());
+  CliResult r = bodyscan("measure " + quote(mesh) + " --girth-y 900", dir);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("does not cut"), std::string::npos) << r.err;
+  r = bodyscan("measure " + quote(dir + "/missing.ply") + " --girth-y 300", dir);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("missing.ply"), std::string::npos) << r.err;
+  r = bodyscan("measure " + quote(mesh) + " --girth-y abc", dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--girth-y"), std::string::npos) << r.err;
+  r = bodyscan("measure " + quote(mesh) + " --plane 0,300,0,0,0,0", dir);
+  EXPECT_EQ(r.exit_code, 2);
+  r = bodyscan("measure " + quote(mesh), dir);
+  EXPECT_EQ(r.exit_code, 2);
+  r = bodyscan("measure " + quote(mesh) + " --girth-y 300 --plane 0,300,0,0,1,0", dir);
+  EXPECT_EQ(r.exit_code, 2);
+  std::ofstream(dir + "/broken.ply") << "ply\nformat ascii 1.0\nelement vertex 3\n";
+  r = bodyscan("measure " + quote(dir + "/broken.ply") + " --girth-y 300", dir);
+  EXPECT_EQ(r.exit_code, 1);
+}
+
+}  // namespace
+}  // namespace bodyscan
