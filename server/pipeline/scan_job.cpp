@@ -42,6 +42,9 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& optio
   if (options.reconstruct) {
     ReconstructOptions ro = options.surface;
     if (!ro.progress) ro.progress = options.progress;
+    // The view-angle step leaves quick normals (fixed k) in the cloud for viewers;
+    // the surface estimates its own, sized to the noise, and turns them to the cameras.
+    if (ro.normal_source == NormalSource::kAuto && out.cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
     ASSIGN_OR_RETURN(ReconstructResult r, reconstruct_surface(out.cloud, ro));
     out.mesh = std::move(r.mesh);
     out.surface = r.stats;
