@@ -136,16 +136,15 @@ int run_measure(int argc, char** argv) {
   }
   const Plane cut = plane ? *plane : Plane{Eigen::Vector3d(0, *girth_y, 0), Eigen::Vector3d::UnitY()};
   const bool is_mesh = !ply->triangles.empty();
-  StatusOr<Girth> g = Status{};
-  if (is_mesh) {
+  const auto measure = [&]() -> StatusOr<Girth> {
+    if (!is_mesh) return cloud_girth(ply->cloud, cut, near);
     TriangleMesh mesh;
     mesh.vertices = ply->cloud.positions;
     mesh.triangles = ply->triangles;
     if (ply->cloud.confidence.size() == mesh.vertices.size()) mesh.confidence = ply->cloud.confidence;
-    g = mesh_girth(mesh, cut, near);
-  } else {
-    g = cloud_girth(ply->cloud, cut, near);
-  }
+    return mesh_girth(mesh, cut, near);
+  };
+  const StatusOr<Girth> g = measure();
   if (!g.ok()) {
     std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), g.status().message().c_str());
     return 1;
