@@ -244,28 +244,12 @@ int run(const std::string& rig_name, const std::string& body, int every) {
                     desc.lasers[static_cast<size_t>(cloud.laser[i])].id.c_str(), cloud.frame[i], cloud.confidence[i]);
       }
     }
-    // By confidence (contrast and triangulation angle).
-    // With the signed error's mean (outside +): a bias, not noise, if far from 0.
-    const double bins[] = {0.0, 0.1, 0.25, 0.5, 0.75, 1.0 + 1e-6};
-    for (size_t b = 0; b + 1 < std::size(bins); ++b) {
-      std::vector<double> dc;
-      double signed_sum = 0;
-      for (size_t i = 0; i < dd.size(); ++i)
-        if (cloud.confidence[i] >= bins[b] && cloud.confidence[i] < bins[b + 1] && dd[i] <= 5) {
-          dc.push_back(dd[i]);
-          signed_sum += distance.closest_point(cloud.positions[i]).signed_distance;
-        }
-      const Quantiles qc = quantiles(dc);
-      std::printf("    confidence %.2f-%.2f %8zu points within 5 mm: mean %.3f mm, p95 %.3f, signed mean %+.3f\n", bins[b],
-                  std::min(1.0, bins[b + 1]), dc.size(), qc.mean, qc.p95,
-                  signed_sum / static_cast<double>(std::max<size_t>(dc.size(), 1)));
-    }
-    // By the angle the camera sees the (true) surface at, from its normal: grazing
-    // views shift a stripe's peak towards the side that faces the camera more.
+    // The points within 5 mm by confidence (contrast and triangulation angle) and by
+    // the angle their camera saw the true surface at, each bin with its signed mean
+    // error (outside +): far from 0 it is a bias, not noise. Grazing views shift a
+    // stripe's peak towards the side that faces the camera more.
     {
-      const double edges[] = {0, 60, 70, 75, 80, 85, 90.01};
-      std::vector<std::vector<double>> err(std::size(edges) - 1);
-      std::vector<double> bias(std::size(edges) - 1, 0);
+      std::vector<double> err, signed_err, confidence, view;
       for (size_t i = 0; i < dd.size(); ++i) {
         if (dd[i] > 5) continue;
         const ClosestPoint cp = distance.closest_point(cloud.positions[i]);
@@ -276,16 +260,25 @@ int run(const std::string& rig_name, const std::string& body, int every) {
                                       .normalized();
         const Eigen::Vector3d to_cam =
             (desc.cameras[static_cast<size_t>(cloud.camera[i])].position - cloud.positions[i].cast<double>()).normalized();
-        const double view = std::acos(std::min(1.0, std::abs(n.dot(to_cam)))) * 180 / M_PI;
-        for (size_t b = 0; b + 1 < std::size(edges); ++b)
-          if (view >= edges[b] && view < edges[b + 1]) err[b].push_back(dd[i]), bias[b] += cp.signed_distance;
+        err.push_back(dd[i]);
+        signed_err.push_back(cp.signed_distance);
+        confidence.push_back(cloud.confidence[i]);
+        view.push_back(std::acos(std::min(1.0, std::abs(n.dot(to_cam)))) * 180 / M_PI);
       }
-      for (size_t b = 0; b < err.size(); ++b) {
-        const Quantiles qv = quantiles(err[b]);
-        std::printf("    view %2.0f-%2.0f deg %8zu points within 5 mm: mean %.3f mm, p95 %.3f, signed mean %+.3f\n", edges[b],
-                    std::min(90.0, edges[b + 1]), err[b].size(), qv.mean, qv.p95,
-                    bias[b] / static_cast<double>(std::max<size_t>(err[b].size(), 1)));
-      }
+      const auto report = [&](const char* label, const std::vector<double>& edges, const std::vector<double>& key) {
+        for (size_t b = 0; b + 1 < edges.size(); ++b) {
+          std::vector<double> in;
+          double bias = 0;
+          for (size_t k = 0; k < key.size(); ++k)
+            if (key[k] >= edges[b] && key[k] < edges[b + 1]) in.push_back(err[k]), bias += signed_err[k];
+          const Quantiles q = quantiles(in);
+          std::printf("    %s %4.2f-%4.2f %8zu points within 5 mm: mean %.3f mm, p95 %.3f, signed mean %+.3f\n", label,
+                      edges[b], std::floor(edges[b + 1] * 100) / 100, in.size(), q.mean, q.p95,
+                      bias / static_cast<double>(std::max<size_t>(in.size(), 1)));
+        }
+      };
+      report("confidence", {0.0, 0.1, 0.25, 0.5, 0.75, 1.0 + 1e-6}, confidence);
+      report("view (deg)", {0, 60, 70, 75, 80, 85, 90.01}, view);
     }
     // Coverage: the share of the body's area within 5 mm of a point, and where the rest is.
     const PointCloud samples = sample_mesh_uniform(truth, 400000, 7, true);

@@ -65,17 +65,17 @@ std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> p) {
   return h;
 }
 
-double closed_length(const std::vector<Eigen::Vector2d>& polygon) {
+namespace {
+template <typename V>
+double closed_length_of(const std::vector<V>& polygon) {
   double sum = 0;
   for (size_t i = 0; i < polygon.size(); ++i) sum += (polygon[(i + 1) % polygon.size()] - polygon[i]).norm();
   return polygon.size() < 2 ? 0 : sum;
 }
+}  // namespace
 
-double closed_length(const std::vector<Eigen::Vector3d>& polygon) {
-  double sum = 0;
-  for (size_t i = 0; i < polygon.size(); ++i) sum += (polygon[(i + 1) % polygon.size()] - polygon[i]).norm();
-  return polygon.size() < 2 ? 0 : sum;
-}
+double closed_length(const std::vector<Eigen::Vector2d>& polygon) { return closed_length_of(polygon); }
+double closed_length(const std::vector<Eigen::Vector3d>& polygon) { return closed_length_of(polygon); }
 
 StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, const std::optional<Eigen::Vector3d>& near) {
   Plane plane = plane_in;
