@@ -32,7 +32,10 @@ void usage(FILE* out) {
       "  --near X,Y,Z           measure around the loop nearest this point (default:\n"
       "                         the loop with the longest tape, the torso at the waist)\n"
       "  --distance X,Y,Z --to X,Y,Z\n"
-      "                         straight distance between two points\n",
+      "                         straight distance between two points\n"
+      "  --arc X,Y,Z --to X,Y,Z (with --girth-y or --plane)\n"
+      "                         length along the girth's tape between two points, the\n"
+      "                         shorter way round (thesis fig. 3.43; meshes)\n",
       out);
 }
 
@@ -64,14 +67,15 @@ int run_measure(int argc, char** argv) {
   std::string file;
   std::optional<double> girth_y;
   std::optional<Plane> plane;
-  std::optional<Eigen::Vector3d> near, from, to;
+  std::optional<Eigen::Vector3d> near, from, to, arc_from;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
       usage(stdout);
       return 0;
     }
-    const bool takes_value = a == "--girth-y" || a == "--plane" || a == "--near" || a == "--distance" || a == "--to";
+    const bool takes_value = a == "--girth-y" || a == "--plane" || a == "--near" || a == "--distance" || a == "--to" ||
+                             a == "--arc";
     if (!takes_value) {
       if (!a.empty() && a[0] == '-') {
         std::fprintf(stderr, "bodyscan measure: unknown option '%s'\n", a.c_str());
@@ -110,10 +114,14 @@ int run_measure(int argc, char** argv) {
     if (a == "--near") near = Eigen::Vector3d(x[0], x[1], x[2]);
     if (a == "--distance") from = Eigen::Vector3d(x[0], x[1], x[2]);
     if (a == "--to") to = Eigen::Vector3d(x[0], x[1], x[2]);
+    if (a == "--arc") arc_from = Eigen::Vector3d(x[0], x[1], x[2]);
   }
   const int whats = (girth_y ? 1 : 0) + (plane ? 1 : 0) + (from ? 1 : 0);
-  if (file.empty() || whats != 1 || from.has_value() != to.has_value()) {
-    std::fprintf(stderr, "bodyscan measure: give a FILE and one of --girth-y, --plane, or --distance with --to\n");
+  const bool ends_ok = (from.has_value() || arc_from.has_value()) == to.has_value() && !(from && arc_from);
+  if (file.empty() || whats != 1 || !ends_ok || (arc_from && near)) {
+    std::fprintf(stderr,
+                 "bodyscan measure: give a FILE and one of --girth-y or --plane (optionally --near, or --arc with "
+                 "--to), or --distance with --to\n");
     usage(stderr);
     return 2;
   }
@@ -136,6 +144,33 @@ int run_measure(int argc, char** argv) {
   }
   const Plane cut = plane ? *plane : Plane{Eigen::Vector3d(0, *girth_y, 0), Eigen::Vector3d::UnitY()};
   const bool is_mesh = !ply->triangles.empty();
+  if (arc_from) {
+    if (!is_mesh) {
+      std::fprintf(stderr, "bodyscan measure: --arc needs a mesh (%s is a point cloud)\n", file.c_str());
+      return 1;
+    }
+    TriangleMesh mesh;
+    mesh.vertices = ply->cloud.positions;
+    mesh.triangles = ply->triangles;
+    const StatusOr<Arc> arc = mesh_arc(mesh, cut, *arc_from, *to);
+    if (!arc.ok()) {
+      std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), arc.status().message().c_str());
+      return 1;
+    }
+    out["kind"] = "mesh";
+    out["measurements"].push_back({{"name", "arc"},
+                                   {"kind", "arc"},
+                                   {"value_mm", arc->value_mm},
+                                   {"other_way_mm", arc->other_way_mm},
+                                   {"from", point_json(*arc_from)},
+                                   {"to", point_json(*to)},
+                                   {"path", polyline_json(arc->path)},
+                                   {"plane", {{"point", point_json(cut.point)}, {"normal", point_json(cut.normal)}}},
+                                   {"girth_mm", arc->girth.value_mm},
+                                   {"algorithm", kGirthAlgorithm}});
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
   const auto measure = [&]() -> StatusOr<Girth> {
     if (!is_mesh) return cloud_girth(ply->cloud, cut, near);
     TriangleMesh mesh;

@@ -174,4 +174,55 @@ StatusOr<Girth> cloud_girth(const PointCloud& cloud, const Plane& plane_in, cons
   return g;
 }
 
+namespace {
+
+// Where q meets a closed polygon: the distance along it from its first corner to the
+// point nearest q, and that point.
+std::pair<double, Eigen::Vector3d> place_on(const std::vector<Eigen::Vector3d>& polygon, const Eigen::Vector3d& q) {
+  double best = std::numeric_limits<double>::infinity(), along = 0, at = 0;
+  Eigen::Vector3d nearest = polygon.front();
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector3d& a = polygon[i];
+    const Eigen::Vector3d ab = polygon[(i + 1) % polygon.size()] - a;
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((q - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    const Eigen::Vector3d p = a + t * ab;
+    if ((p - q).norm() < best) best = (p - q).norm(), at = along + t * std::sqrt(len2), nearest = p;
+    along += std::sqrt(len2);
+  }
+  return {at, nearest};
+}
+
+}  // namespace
+
+StatusOr<Arc> mesh_arc(const TriangleMesh& mesh, const Plane& plane, const Eigen::Vector3d& from,
+                       const Eigen::Vector3d& to) {
+  ASSIGN_OR_RETURN(Girth g, mesh_girth(mesh, plane, Eigen::Vector3d(0.5 * (from + to))));
+  if (g.tape.size() < 3) return not_found("arc: the section is too small to measure along");
+  const auto [sa, pa] = place_on(g.tape, from);
+  const auto [sb, pb] = place_on(g.tape, to);
+  const double forward = sb >= sa ? sb - sa : g.value_mm - (sa - sb);  // along the tape's order
+  Arc arc;
+  arc.value_mm = std::min(forward, g.value_mm - forward);
+  arc.other_way_mm = g.value_mm - arc.value_mm;
+  // The path: the corners passed on the shorter way, between the two places.
+  const bool ahead = forward <= g.value_mm - forward;
+  const double start = ahead ? sa : sb, length = arc.value_mm;
+  arc.path.push_back(ahead ? pa : pb);
+  double along = 0;
+  std::vector<std::pair<double, Eigen::Vector3d>> corners;  // (distance past start, corner)
+  for (size_t i = 0; i < g.tape.size(); ++i) {
+    double d = along - start;
+    if (d < 0) d += g.value_mm;
+    if (d > 0 && d < length) corners.emplace_back(d, g.tape[i]);
+    along += (g.tape[(i + 1) % g.tape.size()] - g.tape[i]).norm();
+  }
+  std::sort(corners.begin(), corners.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (const auto& c : corners) arc.path.push_back(c.second);
+  arc.path.push_back(ahead ? pb : pa);
+  if (!ahead) std::reverse(arc.path.begin(), arc.path.end());  // from `from` to `to`
+  arc.girth = std::move(g);
+  return arc;
+}
+
 }  // namespace bodyscan

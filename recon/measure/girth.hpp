@@ -46,6 +46,20 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane,
 StatusOr<Girth> cloud_girth(const PointCloud& cloud, const Plane& plane, const std::optional<Eigen::Vector3d>& near,
                             double slab_mm = 2.0, double gap_mm = 25.0);
 
+// An arc (thesis fig. 3.43): the length along a girth's tape between two points
+// (each taken at the tape's point nearest it), the shorter way round; the other way's
+// length comes with it.
+struct Arc {
+  double value_mm = 0;
+  double other_way_mm = 0;
+  std::vector<Eigen::Vector3d> path;  // from the first point's place on the tape to the second's
+  Girth girth;                        // the girth whose tape it follows
+};
+
+// The arc on the section loop nearest the two points' midpoint.
+StatusOr<Arc> mesh_arc(const TriangleMesh& mesh, const Plane& plane, const Eigen::Vector3d& from,
+                       const Eigen::Vector3d& to);
+
 // A unit vector pair spanning the plane: (u, v, normal) right-handed.
 void plane_basis(const Eigen::Vector3d& normal, Eigen::Vector3d* u, Eigen::Vector3d* v);
 

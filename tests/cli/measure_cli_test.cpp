@@ -53,6 +53,17 @@ TEST(MeasureCli, GirthsOnAMeshAndAPointCloud) {
   EXPECT_EQ(j["kind"], "points");
   EXPECT_NEAR(j["measurements"][0]["value_mm"].get<double>(), torso, 2.0);
 
+  r = bodyscan("measure " + quote(mesh) + " --girth-y 310 --arc 0,310,-150 --to -150,310,0", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out)["measurements"][0];
+  EXPECT_EQ(j["kind"], "arc");
+  EXPECT_NEAR(j["value_mm"].get<double>(), torso / 4, 1e-3);
+  EXPECT_NEAR(j["other_way_mm"].get<double>(), 3 * torso / 4, 1e-3);
+  EXPECT_GE(j["path"].size(), 3u);
+  r = bodyscan("measure " + quote(points) + " --girth-y 310 --arc 0,310,-150 --to -150,310,0", dir);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("needs a mesh"), std::string::npos) << r.err;
+
   r = bodyscan("measure --distance 0,0,0 --to 30,40,0 " + quote(mesh), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NEAR(nlohmann::json::parse(r.out)["measurements"][0]["value_mm"].get<double>(), 50.0, 1e-12);
@@ -76,6 +87,8 @@ TEST(MeasureCli, BadInputIsAClearError) {
   r = bodyscan("measure " + quote(mesh), dir);
   EXPECT_EQ(r.exit_code, 2);
   r = bodyscan("measure " + quote(mesh) + " --girth-y 300 --plane 0,300,0,0,1,0", dir);
+  EXPECT_EQ(r.exit_code, 2);
+  r = bodyscan("measure " + quote(mesh) + " --girth-y 300 --arc 0,300,150", dir);  // no --to
   EXPECT_EQ(r.exit_code, 2);
   std::ofstream(dir + "/broken.ply") << "ply\nformat ascii 1.0\nelement vertex 3\n";
   r = bodyscan("measure " + quote(dir + "/broken.ply") + " --girth-y 300", dir);

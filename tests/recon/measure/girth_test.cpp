@@ -117,6 +117,33 @@ TEST(MeshGirth, LoopsThroughFilledHolesAreFlagged) {
   EXPECT_NEAR(high->min_confidence, 0.4f, 1e-5);  // 30 of the 50 mm from a measured ring to a filled one
 }
 
+TEST(MeshArc, FollowsTheTapeTheShorterWayRound) {
+  const TriangleMesh body = prism(circle(150), {0, 0}, 0, 400);
+  const double perimeter = 2 * 720 * 150 * std::sin(M_PI / 720);
+  // From the front (+z) to the right side (+x), a quarter of the way round.
+  auto a = mesh_arc(body, horizontal(210), Eigen::Vector3d(0, 210, 170), Eigen::Vector3d(160, 215, 0));
+  ASSERT_TRUE(a.ok()) << a.status().message();
+  EXPECT_NEAR(a->value_mm, perimeter / 4, 1e-3);
+  EXPECT_NEAR(a->other_way_mm, 3 * perimeter / 4, 1e-3);
+  EXPECT_NEAR(a->girth.value_mm, perimeter, 1e-3);
+  ASSERT_GE(a->path.size(), 3u);
+  EXPECT_NEAR((a->path.front() - Eigen::Vector3d(0, 210, 150)).norm(), 0, 1e-3);   // from the first point
+  EXPECT_NEAR((a->path.back() - Eigen::Vector3d(150, 210, 0)).norm(), 0, 1e-3);    // to the second
+  EXPECT_NEAR(closed_length(a->path) - (a->path.back() - a->path.front()).norm(), a->value_mm, 1e-3);
+  // Across the notch of a "C" the arc takes the tape's chord, not the notch.
+  std::vector<Eigen::Vector2d> c;
+  for (int i = 0; i < 360; ++i) {
+    const double ang = 2 * M_PI * i / 360;
+    c.push_back((std::abs(std::remainder(ang, 2 * M_PI)) < 0.3 ? 60 : 100) * Eigen::Vector2d(std::cos(ang), -std::sin(ang)));
+  }
+  const double deg = M_PI / 180;
+  auto across = mesh_arc(prism(c, {0, 0}, 0, 100, 2), horizontal(50),
+                         Eigen::Vector3d(100 * std::cos(18 * deg), 50, 100 * std::sin(18 * deg)),
+                         Eigen::Vector3d(100 * std::cos(18 * deg), 50, -100 * std::sin(18 * deg)));
+  ASSERT_TRUE(across.ok());
+  EXPECT_NEAR(across->value_mm, 200 * std::sin(18 * deg), 1e-3);
+}
+
 TEST(CloudGirth, PointsNearThePlaneMeasureLikeTheMesh) {
   const TriangleMesh torso = prism(circle(150), {0, 0}, 0, 600);
   const TriangleMesh arm = prism(circle(40, {250, 0}, 360), {250, 0}, 100, 600);
