@@ -66,7 +66,6 @@ float g_redundant = 4;
 float g_weak = -1;
 int g_radius = -1;
 double g_max_view = -1;
-bool g_gaussian = false;
 
 int run(const std::string& rig_name, const std::string& body, int every) {
   auto sim = pipeline::open_simulated_rig(rig_name, body);
@@ -141,7 +140,6 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       o.triangulate.min_angle_deg = g_min_angle;
       o.triangulate.smooth_rows = g_smooth;
       if (g_radius >= 0) o.triangulate.stripe.radius = g_radius;
-      if (g_gaussian) o.triangulate.stripe.peak = PeakEstimator::kGaussian;
       if (g_threshold > 0) o.triangulate.stripe.threshold = g_threshold;
       o.redundant_radius_mm = g_redundant;
       if (g_weak >= 0) o.redundant_weak = g_weak;
@@ -321,12 +319,11 @@ int main(int argc, char** argv) {
     else if (a == "--smooth" && i + 1 < argc) g_smooth = std::atoi(argv[++i]);
     else if (a == "--radius" && i + 1 < argc) g_radius = std::atoi(argv[++i]);
     else if (a == "--max-view" && i + 1 < argc) g_max_view = std::atof(argv[++i]);
-    else if (a == "--peak" && i + 1 < argc) g_gaussian = std::string(argv[++i]) == "gaussian";
     else if (a == "--threshold" && i + 1 < argc) g_threshold = std::atoi(argv[++i]);
     else if (a == "--redundant" && i + 1 < argc) g_redundant = static_cast<float>(std::atof(argv[++i]));
     else if (a == "--weak" && i + 1 < argc) g_weak = static_cast<float>(std::atof(argv[++i]));
     else {
-      std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] [--max-view DEG] [--smooth N] [--radius PX] [--peak centroid|gaussian] [--threshold N] [--redundant MM] [--weak C]\n");
+      std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] [--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C]\n");
       return 2;
     }
   }

@@ -133,11 +133,13 @@ StatusOr<LaserSweep> LaserSweep::fit(const std::vector<SweepPoint>& points,
       if (!step.allFinite()) break;
       const double before = cost(f);
       Frame next = f.perturbed(step);
-      for (int halve = 0; halve < 6 && cost(next) > before; ++halve) {
+      double after = cost(next);
+      for (int halve = 0; halve < 6 && after > before; ++halve) {
         step *= 0.5;
         next = f.perturbed(step);
+        after = cost(next);
       }
-      if (cost(next) > before) break;
+      if (after > before) break;
       f = next;
       if (step.cwiseAbs().maxCoeff() < 1e-12) break;
     }

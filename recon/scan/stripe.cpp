@@ -5,7 +5,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cmath>
 
 namespace bodyscan {
 
@@ -89,17 +88,7 @@ StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const
         sx += static_cast<double>(d) * x;
         saturated = saturated || f[x] >= full_scale;
       }
-      double column = sx / sw;
-      if (options.peak == PeakEstimator::kGaussian && !saturated && x0 > lo && x0 + 1 < hi) {
-        const int a = f[x0 - 1] > b[x0 - 1] ? f[x0 - 1] - b[x0 - 1] : 0;
-        const int c = f[x0 + 1] > b[x0 + 1] ? f[x0 + 1] - b[x0 + 1] : 0;
-        if (a > 0 && c > 0) {
-          const double la = std::log(a), lb = std::log(static_cast<double>(peak)), lc = std::log(c);
-          const double curvature = la - 2 * lb + lc;
-          if (curvature < 0) column = x0 + std::clamp(0.5 * (la - lc) / curvature, -0.5, 0.5);
-        }
-      }
-      per_row[static_cast<size_t>(y)] = {y, static_cast<float>(column), peak, saturated};
+      per_row[static_cast<size_t>(y)] = {y, static_cast<float>(sx / sw), peak, saturated};
       found[static_cast<size_t>(y)] = 1;
     }
   });

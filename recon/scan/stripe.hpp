@@ -20,19 +20,9 @@ struct ImageView {
   const uint16_t* row(int y) const { return pixels + static_cast<size_t>(y) * width; }
 };
 
-// How a row's stripe position is found to sub-pixel from the pixels around its
-// brightest one.
-enum class PeakEstimator {
-  kCentroid,  // the thesis's: intensity-weighted centroid within `radius`
-  kGaussian,  // the vertex of a parabola through the logs of the three brightest
-              // neighbours (exact for a Gaussian profile); the centroid where they
-              // are flat (saturated) or not all lit
-};
-
 struct StripeOptions {
   int threshold = 20;  // minimum peak of frame - base, in pixel values
   int radius = 4;      // half-width of the centroid window (the thesis's r)
-  PeakEstimator peak = PeakEstimator::kCentroid;
 };
 
 struct StripeSample {
