@@ -9,13 +9,19 @@
 #include <vector>
 
 #include "recon/io/ply.hpp"
+#include "recon/measure/body_measurements.hpp"
 #include "recon/measure/girth.hpp"
+#include "recon/measure/surface_path.hpp"
+#include "server/pipeline/measurements_json.hpp"
 
 namespace bodyscan::cli {
 
 namespace {
 
-constexpr const char* kGirthAlgorithm = "girth/convex-hull-1";
+using pipeline::kGirthAlgorithm;
+using pipeline::plane_json;
+using pipeline::point_json;
+using pipeline::polyline_json;
 
 void usage(FILE* out) {
   std::fputs(
@@ -35,7 +41,16 @@ void usage(FILE* out) {
       "                         straight distance between two points\n"
       "  --arc X,Y,Z --to X,Y,Z (with --girth-y or --plane)\n"
       "                         length along the girth's tape between two points, the\n"
-      "                         shorter way round (thesis fig. 3.43; meshes)\n",
+      "                         shorter way round (thesis fig. 3.43; meshes)\n"
+      "  --surface X,Y,Z --to X,Y,Z\n"
+      "                         length over the skin between two points: the\n"
+      "                         shortest path on the mesh (meshes)\n"
+      "  --auto                 the automatic set: landmarks and the ISO 8559-1\n"
+      "                         measurements (a standing body facing +Z; meshes)\n"
+      "  --floor Y              with --auto: the floor's height (default: the mesh's\n"
+      "                         lowest point)\n"
+      "\n"
+      "Exit status: 0 measured, 1 the file or the measurement failed, 2 bad arguments.\n",
       out);
 }
 
@@ -53,29 +68,27 @@ std::optional<std::vector<double>> numbers(const std::string& text, size_t count
   return v;
 }
 
-nlohmann::json point_json(const Eigen::Vector3d& p) { return nlohmann::json::array({p.x(), p.y(), p.z()}); }
-
-nlohmann::json polyline_json(const std::vector<Eigen::Vector3d>& points) {
-  nlohmann::json a = nlohmann::json::array();
-  for (const Eigen::Vector3d& p : points) a.push_back(point_json(p));
-  return a;
-}
-
 }  // namespace
 
 int run_measure(int argc, char** argv) {
   std::string file;
   std::optional<double> girth_y;
   std::optional<Plane> plane;
-  std::optional<Eigen::Vector3d> near, from, to, arc_from;
+  std::optional<Eigen::Vector3d> near, from, to, arc_from, surface_from;
+  std::optional<double> floor_y;
+  bool automatic = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
       usage(stdout);
       return 0;
     }
+    if (a == "--auto") {
+      automatic = true;
+      continue;
+    }
     const bool takes_value = a == "--girth-y" || a == "--plane" || a == "--near" || a == "--distance" || a == "--to" ||
-                             a == "--arc";
+                             a == "--arc" || a == "--surface" || a == "--floor";
     if (!takes_value) {
       if (!a.empty() && a[0] == '-') {
         std::fprintf(stderr, "bodyscan measure: unknown option '%s'\n", a.c_str());
@@ -94,7 +107,7 @@ int run_measure(int argc, char** argv) {
       return 2;
     }
     const std::string v = argv[++i];
-    const size_t count = a == "--girth-y" ? 1 : a == "--plane" ? 6 : 3;
+    const size_t count = a == "--girth-y" || a == "--floor" ? 1 : a == "--plane" ? 6 : 3;
     const auto n = numbers(v, count);
     if (!n) {
       std::fprintf(stderr, "bodyscan measure: %s expects %zu comma-separated numbers (mm), got '%s'\n", a.c_str(),
@@ -115,20 +128,23 @@ int run_measure(int argc, char** argv) {
     if (a == "--distance") from = Eigen::Vector3d(x[0], x[1], x[2]);
     if (a == "--to") to = Eigen::Vector3d(x[0], x[1], x[2]);
     if (a == "--arc") arc_from = Eigen::Vector3d(x[0], x[1], x[2]);
+    if (a == "--surface") surface_from = Eigen::Vector3d(x[0], x[1], x[2]);
+    if (a == "--floor") floor_y = x[0];
   }
-  const int whats = (girth_y ? 1 : 0) + (plane ? 1 : 0) + (from ? 1 : 0);
-  const bool ends_ok = (from.has_value() || arc_from.has_value()) == to.has_value() && !(from && arc_from);
-  if (file.empty() || whats != 1 || !ends_ok || (arc_from && near)) {
+  const int whats = (girth_y ? 1 : 0) + (plane ? 1 : 0) + (from ? 1 : 0) + (surface_from ? 1 : 0) + (automatic ? 1 : 0);
+  const int starts = (from ? 1 : 0) + (arc_from ? 1 : 0) + (surface_from ? 1 : 0);
+  const bool ends_ok = (starts == 1) == to.has_value() && starts <= 1;
+  if (file.empty() || whats != 1 || !ends_ok || (arc_from && near) || (floor_y && !automatic) ||
+      (near && (from || surface_from || automatic))) {
     std::fprintf(stderr,
                  "bodyscan measure: give a FILE and one of --girth-y or --plane (optionally --near, or --arc with "
-                 "--to), or --distance with --to\n");
+                 "--to), --distance or --surface with --to, or --auto (optionally --floor)\n");
     usage(stderr);
     return 2;
   }
-  nlohmann::json out;
-  out["file"] = file;
-  out["measurements"] = nlohmann::json::array();
+  nlohmann::json out = pipeline::measurements_document(file, "mesh");
   if (from) {
+    out.erase("kind");  // the file is not read
     out["measurements"].push_back({{"name", "distance"},
                                    {"kind", "point_to_point"},
                                    {"value_mm", (*to - *from).norm()},
@@ -142,8 +158,38 @@ int run_measure(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan measure: %s\n", ply.status().message().c_str());
     return 1;
   }
-  const Plane cut = plane ? *plane : Plane{Eigen::Vector3d(0, *girth_y, 0), Eigen::Vector3d::UnitY()};
   const bool is_mesh = !ply->triangles.empty();
+  if ((surface_from || automatic) && !is_mesh) {
+    std::fprintf(stderr, "bodyscan measure: %s needs a mesh (%s is a point cloud)\n",
+                 automatic ? "--auto" : "--surface", file.c_str());
+    return 1;
+  }
+  if (surface_from || automatic) {
+    TriangleMesh mesh;
+    mesh.vertices = ply->cloud.positions;
+    mesh.triangles = ply->triangles;
+    if (ply->cloud.confidence.size() == mesh.vertices.size()) mesh.confidence = ply->cloud.confidence;
+    if (surface_from) {
+      const StatusOr<SurfacePath> p = mesh_surface_path(mesh, *surface_from, *to);
+      if (!p.ok()) {
+        std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), p.status().message().c_str());
+        return 1;
+      }
+      out["measurements"].push_back(pipeline::to_json(*p, "surface length"));
+    } else {
+      BodyMeasureOptions options;
+      options.floor_y = floor_y;
+      const StatusOr<BodyMeasurements> body = measure_body(mesh, options);
+      if (!body.ok()) {
+        std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), body.status().message().c_str());
+        return 1;
+      }
+      pipeline::add_body_measurements(*body, &out);
+    }
+    std::printf("%s\n", out.dump(2).c_str());
+    return 0;
+  }
+  const Plane cut = plane ? *plane : Plane{Eigen::Vector3d(0, *girth_y, 0), Eigen::Vector3d::UnitY()};
   if (arc_from) {
     if (!is_mesh) {
       std::fprintf(stderr, "bodyscan measure: --arc needs a mesh (%s is a point cloud)\n", file.c_str());
@@ -165,7 +211,7 @@ int run_measure(int argc, char** argv) {
                                    {"from", point_json(*arc_from)},
                                    {"to", point_json(*to)},
                                    {"path", polyline_json(arc->path)},
-                                   {"plane", {{"point", point_json(cut.point)}, {"normal", point_json(cut.normal)}}},
+                                   {"plane", plane_json(cut)},
                                    {"girth_mm", arc->girth.value_mm},
                                    {"algorithm", kGirthAlgorithm}});
     std::printf("%s\n", out.dump(2).c_str());
@@ -188,7 +234,7 @@ int run_measure(int argc, char** argv) {
   nlohmann::json m = {{"name", girth_y ? "girth at y " + std::to_string(static_cast<long>(std::lround(*girth_y))) : "girth"},
                       {"kind", "girth"},
                       {"value_mm", g->value_mm},
-                      {"plane", {{"point", point_json(g->plane.point)}, {"normal", point_json(g->plane.normal)}}},
+                      {"plane", plane_json(g->plane)},
                       {"tape", polyline_json(g->tape)},
                       {"loops_cut", g->loops_cut},
                       {"algorithm", kGirthAlgorithm}};

@@ -17,7 +17,8 @@ void usage(FILE* out) {
       "\n"
       "Calibrates the rig from what its cameras see (dot grid, frame lights, lasers on\n"
       "the frame's poles), scans the subject, turns the laser stripes into one point\n"
-      "cloud and reconstructs a closed surface. Writes DIR/points.ply, DIR/mesh.ply,\n"
+      "cloud, reconstructs a closed surface and measures it. Writes DIR/points.ply,\n"
+      "DIR/mesh.ply, DIR/measurements.json (docs/measurements.md),\n"
       "DIR/calibration.json and DIR/scan.json.\n"
       "\n"
       "  --rig RIG        sim (the thesis rig and the demo body), thesis, square,\n"
@@ -148,8 +149,20 @@ int run_scan(int argc, char** argv) {
       std::printf("surface: %zu vertices, %zu triangles in %.1f s\n", result->mesh.vertices.size(),
                   result->mesh.triangles.size(), result->surface.total_seconds());
     }
-    std::printf("wrote %s/points.ply%s, calibration.json, scan.json\n", out.c_str(),
-                result->mesh.triangles.empty() ? "" : ", mesh.ply");
+    if (result->body) {
+      std::printf("measurements: %zu taken (%zu skipped), %zu landmarks\n", result->body->measurements.size(),
+                  result->body->skipped.size(), result->body->landmarks.size());
+    }
+    std::printf("wrote %s/points.ply%s%s, calibration.json, scan.json\n", out.c_str(),
+                result->mesh.triangles.empty() ? "" : ", mesh.ply", result->body ? ", measurements.json" : "");
+  }
+  if (!result->measure_error.empty()) {
+    std::fprintf(stderr, "bodyscan scan: warning: no automatic measurements: %s\n", result->measure_error.c_str());
+  }
+  if (!result->surface_error.empty()) {
+    std::fprintf(stderr, "bodyscan scan: the point cloud is saved in %s, but the surface failed: %s\n", out.c_str(),
+                 result->surface_error.c_str());
+    return 1;
   }
   return 0;
 }

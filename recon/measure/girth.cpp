@@ -20,6 +20,18 @@ double distance_to_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a, c
   return (a + t * ab - p).norm();
 }
 
+// Whether the closed polygon (in the plane spanned by u, v) winds round p.
+bool encloses(const std::vector<Eigen::Vector3d>& loop, const Eigen::Vector3d& p, const Eigen::Vector3d& u,
+              const Eigen::Vector3d& v) {
+  bool inside = false;
+  const double px = p.dot(u), py = p.dot(v);
+  for (size_t i = 0, j = loop.size() - 1; i < loop.size(); j = i++) {
+    const double xi = loop[i].dot(u), yi = loop[i].dot(v), xj = loop[j].dot(u), yj = loop[j].dot(v);
+    if ((yi > py) != (yj > py) && px < (xj - xi) * (py - yi) / (yj - yi) + xi) inside = !inside;
+  }
+  return inside;
+}
+
 // The tape around points of one part: hull in the plane, back in 3-D.
 void measure_around(const std::vector<Eigen::Vector3d>& points, const Plane& plane, Girth* g) {
   Eigen::Vector3d u, v;
@@ -77,11 +89,16 @@ double closed_length_of(const std::vector<V>& polygon) {
 double closed_length(const std::vector<Eigen::Vector2d>& polygon) { return closed_length_of(polygon); }
 double closed_length(const std::vector<Eigen::Vector3d>& polygon) { return closed_length_of(polygon); }
 
-StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, const std::optional<Eigen::Vector3d>& near) {
+StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane, const std::optional<Eigen::Vector3d>& near) {
+  return mesh_girth(mesh, plane, near, nullptr);
+}
+
+StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, const std::optional<Eigen::Vector3d>& near,
+                           const std::vector<uint32_t>* triangles) {
   Plane plane = plane_in;
   if (!(plane.normal.norm() > 0)) return invalid_argument("girth: the plane's normal is zero");
   plane.normal.normalize();
-  std::vector<SectionLoop> loops = plane_section(mesh, plane);
+  std::vector<SectionLoop> loops = plane_section(mesh, plane, triangles);
   const size_t cut = loops.size();
   loops.erase(std::remove_if(loops.begin(), loops.end(), [](const SectionLoop& l) { return !l.closed; }), loops.end());
   if (cut == 0) return not_found("girth: the plane does not cut the body");
@@ -89,8 +106,16 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
   size_t best = 0;
   if (near) {
     double best_d = std::numeric_limits<double>::infinity();
+    // A loop round the point (a limb's axis, the neck's centre) wins outright;
+    // otherwise the loop passing nearest (a point picked on the skin).
+    Eigen::Vector3d u, v;
+    plane_basis(plane.normal, &u, &v);
     for (size_t i = 0; i < loops.size(); ++i) {
       const std::vector<Eigen::Vector3d>& l = loops[i].points;
+      if (encloses(l, *near, u, v)) {
+        best = i;
+        break;
+      }
       for (size_t k = 0; k < l.size(); ++k) {
         const double d = distance_to_segment(*near, l[k], l[(k + 1) % l.size()]);
         if (d < best_d) best_d = d, best = i;

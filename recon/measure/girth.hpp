@@ -32,12 +32,16 @@ struct Girth {
   size_t loops_cut = 0;               // how many loops the plane cut (arms, legs, torso...)
 };
 
-// The girth in `plane` around the closed section loop nearest `near` (the loop a
-// person pointed at), or without `near` the loop with the longest tape (at the waist,
+// The girth in `plane` around the closed section loop that encircles `near` (a
+// limb's centre), else the loop nearest it (a point picked on the skin), or without
+// `near` the loop with the longest tape (at the waist,
 // the torso rather than an arm). Errors: the plane misses the mesh, or cuts no
 // closed loop (an open mesh's border).
 StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane,
                            const std::optional<Eigen::Vector3d>& near = std::nullopt);
+// The same, cutting only `triangles` (those the plane can reach; plane_section.hpp).
+StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane, const std::optional<Eigen::Vector3d>& near,
+                           const std::vector<uint32_t>* triangles);
 
 // The same on a point cloud, as the thesis does it: the points within `slab_mm` of
 // the plane, projected into it, grouped into parts (points closer than `gap_mm`

@@ -15,12 +15,16 @@ uint64_t edge_key(uint32_t a, uint32_t b) {
 }  // namespace
 
 std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& plane) {
+  return plane_section(mesh, plane, nullptr);
+}
+
+std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& plane,
+                                       const std::vector<uint32_t>* triangles) {
   const size_t nv = mesh.vertices.size();
-  std::vector<double> d(nv);
-  for (size_t i = 0; i < nv; ++i) {
-    d[i] = plane.signed_distance(mesh.vertices[i].cast<double>());
-    if (d[i] == 0) d[i] = 1e-12;  // on the plane: a hair on the positive side
-  }
+  auto dist = [&](uint32_t i) {
+    const double x = plane.signed_distance(mesh.vertices[i].cast<double>());
+    return x == 0 ? 1e-12 : x;  // on the plane: a hair on the positive side
+  };
   // Each crossed triangle gives one segment between two crossed edges. Link the
   // segments through their shared edges: an edge of a manifold mesh is crossed by
   // the segments of its (at most) two triangles.
@@ -29,12 +33,15 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
   };
   std::vector<Segment> segments;
   std::unordered_map<uint64_t, std::vector<uint32_t>> by_edge;  // edge -> segments
-  for (const Triangle& t : mesh.triangles) {
+  const size_t count = triangles ? triangles->size() : mesh.triangles.size();
+  for (size_t ti = 0; ti < count; ++ti) {
+    const Triangle& t = mesh.triangles[triangles ? (*triangles)[ti] : ti];
+    const double dt[3] = {dist(t[0]), dist(t[1]), dist(t[2])};
     uint64_t crossed[2];
     int n = 0;
     for (int k = 0; k < 3; ++k) {
       const uint32_t u = t[k], v = t[(k + 1) % 3];
-      if ((d[u] > 0) != (d[v] > 0) && n < 2) crossed[n++] = edge_key(u, v);
+      if ((dt[k] > 0) != (dt[(k + 1) % 3] > 0) && n < 2) crossed[n++] = edge_key(u, v);
     }
     if (n != 2) continue;
     const auto s = static_cast<uint32_t>(segments.size());
@@ -44,7 +51,8 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
   }
   auto point_on = [&](uint64_t key, float* confidence) {
     const auto a = static_cast<uint32_t>(key >> 32), b = static_cast<uint32_t>(key & 0xffffffffu);
-    const double t = d[a] / (d[a] - d[b]);
+    const double da = dist(a), db = dist(b);
+    const double t = da / (da - db);
     if (confidence) {
       *confidence = mesh.confidence.size() == nv
                         ? static_cast<float>((1 - t) * mesh.confidence[a] + t * mesh.confidence[b])

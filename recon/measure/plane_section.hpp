@@ -29,5 +29,9 @@ struct SectionLoop {
 // to lie a hair on its positive side, so every cut crosses edges, never vertices,
 // and the loops come out simple. Loops of fewer than 3 points are left out.
 std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& plane);
+// The same over a subset of the triangles (e.g. those spanning the plane's height),
+// so that many parallel cuts through a big mesh cost what they cross.
+std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& plane,
+                                       const std::vector<uint32_t>* triangles);
 
 }  // namespace bodyscan

@@ -197,10 +197,20 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   if (options.curvature_compensation) {
     mean_curvature = estimate_mean_curvature(pts, index, graph, frames, {.k = 20});
   }
-  const std::vector<float> no_confidence;
-  const std::vector<Kernel> kernels =
-      adapt_kernels(pts, frames, sigma_density, options.sharpening != 0.f ? &curvature : nullptr,
-                    mean_curvature, options.use_confidence ? cloud->confidence : no_confidence, ko);
+  // Isolated points (a floor sample, a speck of dust far from the body) would get
+  // kernels as wide as the gap to their neighbours, and the field's grid with them.
+  std::vector<float> confidence = options.use_confidence ? cloud->confidence : std::vector<float>{};
+  if (options.isolated_spacing_ratio > 0.f && st.median_density_sigma > 0.f) {
+    const float limit = options.isolated_spacing_ratio * st.median_density_sigma;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      if (sigma_density[i] <= limit) continue;
+      if (confidence.empty()) confidence.assign(pts.size(), 1.f);
+      confidence[i] = 0.f;
+      ++st.isolated_points;
+    }
+  }
+  const std::vector<Kernel> kernels = adapt_kernels(
+      pts, frames, sigma_density, options.sharpening != 0.f ? &curvature : nullptr, mean_curvature, confidence, ko);
   st.t_kernels = seconds_since(t0);
 
   t0 = Clock::now();

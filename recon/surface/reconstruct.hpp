@@ -45,6 +45,9 @@ struct ReconstructOptions {
   size_t normal_k = 0;        // neighbours per PCA normal (0 = auto from the noise)
   NormalSource normal_source = NormalSource::kAuto;
   bool use_confidence = true;  // weight kernels by the cloud's per-point confidence
+  // Points whose density sigma (eq. 3.17) exceeds this many times the median are
+  // isolated strays and get no kernel (0 = keep every point).
+  float isolated_spacing_ratio = 8.f;
   // Marching cubes needs this much Gaussian weight at a node, as a fraction of the
   // median weight on the surface (median_surface_weight): cuts the spurious zero
   // crossings in kernels' tails that noise creates.
@@ -71,6 +74,7 @@ struct ReconstructOptions {
 struct ReconstructStats {
   size_t input_points = 0;
   size_t used_points = 0;           // points with positive confidence
+  size_t isolated_points = 0;       // of those, dropped as isolated strays
   NormalSource normals = NormalSource::kAuto;  // what was used
   size_t orientation_components = 0;
   float median_density_sigma = 0.f;  // median of eq. 3.17, the cloud's unit

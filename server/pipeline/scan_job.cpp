@@ -7,6 +7,7 @@
 
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/ply.hpp"
+#include "server/pipeline/measurements_json.hpp"
 
 namespace bodyscan::pipeline {
 
@@ -45,9 +46,22 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& optio
     // The view-angle step leaves quick normals (fixed k) in the cloud for viewers;
     // the surface estimates its own, sized to the noise, and turns them to the cameras.
     if (ro.normal_source == NormalSource::kAuto && out.cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
-    ASSIGN_OR_RETURN(ReconstructResult r, reconstruct_surface(out.cloud, ro));
-    out.mesh = std::move(r.mesh);
-    out.surface = r.stats;
+    StatusOr<ReconstructResult> r = reconstruct_surface(out.cloud, ro);
+    if (r.ok()) {
+      out.mesh = std::move(r->mesh);
+      out.surface = r->stats;
+    } else {
+      out.surface_error = r.status().message();
+    }
+  }
+  if (options.measure && !out.mesh.triangles.empty()) {
+    BodyMeasureOptions mo;
+    // The floor the subject stands on: the bottom frame's tubing lies on it, its
+    // light centres (world Y = 0) half a tube up.
+    if (rig.description) mo.floor_y = -0.5 * rig.description->frame.tube;
+    StatusOr<BodyMeasurements> body = measure_body(out.mesh, mo);
+    if (body.ok()) out.body = std::move(*body);
+    else out.measure_error = body.status().message();
   }
   return out;
 }
@@ -60,6 +74,11 @@ Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
   RETURN_IF_ERROR(write_file_atomically((d / "calibration.json").string(), to_json(r.calibration).dump(2)));
   RETURN_IF_ERROR(write_ply((d / "points.ply").string(), r.cloud));
   if (!r.mesh.triangles.empty()) RETURN_IF_ERROR(write_ply((d / "mesh.ply").string(), r.mesh));
+  if (r.body) {
+    nlohmann::json m = measurements_document("mesh.ply", "mesh");
+    add_body_measurements(*r.body, &m);
+    RETURN_IF_ERROR(write_file_atomically((d / "measurements.json").string(), m.dump(1)));
+  }
   nlohmann::json j;
   j["points"] = r.cloud.size();
   j["frames"] = r.scan.frames;
@@ -82,6 +101,8 @@ Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
                            {"axis_point_mm", {s.axis_point.x(), s.axis_point.y(), s.axis_point.z()}},
                            {"axis_direction", {s.axis_direction.x(), s.axis_direction.y(), s.axis_direction.z()}}});
   }
+  if (!r.surface_error.empty()) j["surface_error"] = r.surface_error;
+  if (!r.measure_error.empty()) j["measure_error"] = r.measure_error;
   j["calibration_seconds"] = r.calibration_seconds;
   j["scan_seconds"] = r.scan_seconds;
   if (!r.mesh.triangles.empty()) {

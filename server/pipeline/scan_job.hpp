@@ -7,11 +7,21 @@
 #include <string>
 
 #include "recon/geometry/triangle_mesh.hpp"
+#include "recon/measure/body_measurements.hpp"
 #include "recon/surface/reconstruct.hpp"
 #include "server/pipeline/calibrate.hpp"
 #include "server/pipeline/scan.hpp"
 
 namespace bodyscan::pipeline {
+
+// A body is closed: every opening a scan leaves (the soles, the crown, the insides
+// of the legs, under the arms) is a hole to fill, however large; measurements flag
+// the girths that cross the fill.
+inline ReconstructOptions body_surface_options() {
+  ReconstructOptions o;
+  o.max_hole_area_fraction = 1.0;
+  return o;
+}
 
 struct ScanJobOptions {
   int every = 1;  // scan every Nth laser step
@@ -20,7 +30,8 @@ struct ScanJobOptions {
   // Overrides the rig description's processing.max_view_deg (ScanOptions::view).
   std::optional<double> max_view_deg;
   bool reconstruct = true;
-  ReconstructOptions surface;
+  ReconstructOptions surface = body_surface_options();
+  bool measure = true;  // the automatic set on the surface (measure_body)
   ProgressFn progress;  // stages: calibration..., scan, surface...
 };
 
@@ -30,14 +41,22 @@ struct ScanJobResult {
   ScanStats scan;
   TriangleMesh mesh;  // empty unless reconstructed
   ReconstructStats surface;
+  // Why the surface could not be built (the cloud is still good and kept); empty
+  // when it was, or was not asked for.
+  std::string surface_error;
+  std::optional<BodyMeasurements> body;  // the automatic set, when measured
+  std::string measure_error;             // why it could not be (the surface is kept)
   double calibration_seconds = 0;  // acquisition and processing
   double scan_seconds = 0;         // acquisition and processing
 };
 
+// Errors when calibration or the scan fails, or the scan gives no usable cloud; a
+// failed reconstruction is reported in surface_error, the cloud kept.
 StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& options = {});
 
-// DIR/points.ply, DIR/mesh.ply (when reconstructed), DIR/calibration.json and
-// DIR/scan.json (the figures), each written atomically. Creates DIR.
+// DIR/points.ply, DIR/mesh.ply (when reconstructed), DIR/measurements.json (when
+// measured; docs/measurements.md), DIR/calibration.json and DIR/scan.json (the
+// figures), each written atomically. Creates DIR.
 Status write_scan_results(const ScanJobResult& result, const std::string& dir);
 
 }  // namespace bodyscan::pipeline

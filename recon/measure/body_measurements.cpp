@@ -1,0 +1,710 @@
+#include "recon/measure/body_measurements.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "recon/measure/body_slicer.hpp"
+#include "recon/measure/girth.hpp"
+#include "recon/measure/surface_path.hpp"
+
+namespace bodyscan {
+
+const BodyMeasurement* BodyMeasurements::find(const std::string& name) const {
+  for (const BodyMeasurement& m : measurements)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+const BodyLandmark* BodyMeasurements::landmark(const std::string& name) const {
+  for (const BodyLandmark& l : landmarks)
+    if (l.name == name) return &l;
+  return nullptr;
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// The loop that spans the midline X = xc (torso, neck, head), the longest if several.
+const Ring* midline(const std::vector<Ring>& rings, double xc) {
+  const Ring* best = nullptr;
+  for (const Ring& r : rings)
+    if (r.spans_x(xc) && (!best || r.girth > best->girth)) best = &r;
+  return best;
+}
+
+// Loops wholly on side s (+1 left, -1 right) of the midline: `farthest` picks the
+// arm (outermost), otherwise the leg (innermost).
+const Ring* side_ring(const std::vector<Ring>& rings, double xc, int s, bool farthest, double min_girth = 30) {
+  const Ring* best = nullptr;
+  double best_d = 0;
+  for (const Ring& r : rings) {
+    if (r.spans_x(xc) || r.girth < min_girth) continue;
+    const double d = s * (r.centroid.x() - xc);
+    if (d <= 0) continue;
+    if (!best || (farthest ? d > best_d : d < best_d)) best = &r, best_d = d;
+  }
+  return best;
+}
+
+size_t count_side(const std::vector<Ring>& rings, double xc, int s, double min_girth = 30) {
+  size_t n = 0;
+  for (const Ring& r : rings)
+    if (!r.spans_x(xc) && r.girth >= min_girth && s * (r.centroid.x() - xc) > 0) ++n;
+  return n;
+}
+
+// The boundary between lo (pred false) and hi (pred true), to `tol`.
+double bisect(double lo, double hi, const std::function<bool(double)>& pred, double tol = 0.25) {
+  while (std::abs(hi - lo) > tol) {
+    const double mid = 0.5 * (lo + hi);
+    (pred(mid) ? hi : lo) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// The corner of a sampled curve: the sample farthest from the chord joining its
+// ends (sign +1: on the chord's left, -1: right, 0: either).
+size_t corner(const std::vector<Eigen::Vector2d>& c, int sign = 0) {
+  if (c.size() < 3) return 0;
+  const Eigen::Vector2d a = c.front(), d = (c.back() - a).normalized();
+  size_t best = 0;
+  double best_v = -kInf;
+  for (size_t i = 1; i + 1 < c.size(); ++i) {
+    const Eigen::Vector2d p = c[i] - a;
+    const double dist = d.x() * p.y() - d.y() * p.x();
+    const double v = sign == 0 ? std::abs(dist) : sign * dist;
+    if (v > best_v) best_v = v, best = i;
+  }
+  return best;
+}
+
+// Least-squares line through points: (centre, unit direction with y >= 0).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Vector3d>& p, size_t b, size_t e,
+                                                      double* residual = nullptr) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (size_t i = b; i < e; ++i) c += p[i];
+  c /= static_cast<double>(e - b);
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (size_t i = b; i < e; ++i) cov += (p[i] - c) * (p[i] - c).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  Eigen::Vector3d d = es.eigenvectors().col(2);
+  if (d.y() < 0) d = -d;
+  if (residual) *residual = es.eigenvalues()(0) + es.eigenvalues()(1);
+  return {c, d};
+}
+
+class Finder {
+ public:
+  Finder(const TriangleMesh& mesh, const BodyMeasureOptions& options, BodyMeasurements* out)
+      : mesh_(mesh), opt_(options), out_(out) {}
+
+  Status run() {
+    if (mesh_.triangles.empty()) return invalid_argument("measure: the mesh has no triangles");
+    double lo = kInf, hi = -kInf;
+    for (const Vec3f& v : mesh_.vertices) {
+      if (v.y() > hi) hi = v.y(), top_ = v.cast<double>();
+      lo = std::min(lo, static_cast<double>(v.y()));
+    }
+    floor_ = opt_.floor_y.value_or(lo);
+    out_->floor_y = floor_;
+    h_ = hi - floor_;
+    if (!(h_ > 500)) return invalid_argument("measure: the body is under 500 mm tall; is it a standing body in mm, Y up?");
+    slicer_.emplace(mesh_, lo, hi, opt_.step_mm);
+    paths_.emplace(mesh_);
+    RETURN_IF_ERROR(find_axis());
+    RETURN_IF_ERROR(find_crotch());
+    for (int s : {1, -1}) RETURN_IF_ERROR(find_armpit(s));
+    RETURN_IF_ERROR(find_neck());
+    for (int s : {1, -1}) RETURN_IF_ERROR(find_side_neck(s));
+    for (int s : {1, -1}) RETURN_IF_ERROR(find_shoulder(s));
+    find_neck_points();
+    find_torso_levels();
+    measure_heights();
+    measure_torso();
+    for (int s : {1, -1}) measure_leg(s);
+    for (int s : {1, -1}) measure_arm(s);
+    measure_lengths();
+    return Status();
+  }
+
+ private:
+  static std::string side(int s) { return s > 0 ? "left" : "right"; }
+  double at(double fraction) const { return floor_ + fraction * h_; }
+  std::vector<Ring> rings(double y) const { return slicer_->rings(y); }
+
+  void landmark(const std::string& name, const Eigen::Vector3d& p) { out_->landmarks.push_back({name, p}); }
+  Eigen::Vector3d lm(const std::string& name) const { return out_->landmark(name)->position; }
+
+  // --- landmarks -------------------------------------------------------------
+
+  Status find_axis() {
+    const std::vector<Ring> r = rings(at(0.55));
+    const Ring* best = nullptr;
+    for (const Ring& x : r)
+      if (!best || x.girth > best->girth) best = &x;
+    if (!best) return not_found("measure: nothing at 55 % of the height; is the body standing on the floor?");
+    xc_ = best->centroid.x();
+    zc_ = best->centroid.z();
+    return Status();
+  }
+
+  Status find_crotch() {
+    auto merged = [&](double y) { return midline(rings(y), xc_) != nullptr; };
+    const double step = 5;
+    double prev = at(0.25);
+    if (merged(prev)) return not_found("measure: the legs are not apart at a quarter of the height; stand with feet apart");
+    for (double y = prev + step; y <= at(0.65); y += step) {
+      if (merged(y)) {
+        crotch_y_ = bisect(prev, y, merged);
+        const std::vector<Ring> r = rings(crotch_y_ + 0.5);
+        double f = zc_, b = zc_;
+        if (const Ring* m = midline(r, xc_)) m->crossing_z(xc_, &f, &b);
+        landmark("crotch", {xc_, crotch_y_, 0.5 * (f + b)});
+        return Status();
+      }
+      prev = y;
+    }
+    return not_found("measure: no crotch found between 25 % and 65 % of the height");
+  }
+
+  Status find_armpit(int s) {
+    auto arm = [&](double y) { return side_ring(rings(y), xc_, s, true) != nullptr; };
+    const double step = 5;
+    double y = crotch_y_ + 0.03 * h_;
+    while (y < at(0.9) && !arm(y)) y += step;
+    if (y >= at(0.9)) return not_found("measure: no " + side(s) + " arm apart from the body; hold the arms away from the sides");
+    double last = y;
+    for (y += step; y < at(0.95) && arm(y); y += step) last = y;
+    const double armpit = bisect(y, last, arm);
+    armpit_y_[s > 0 ? 0 : 1] = armpit;
+    // The armpit: halfway across the last gap between arm and torso.
+    const std::vector<Ring> r = rings(armpit - 0.5);
+    const Ring* a = side_ring(r, xc_, s, true);
+    const Ring* t = midline(r, xc_);
+    Eigen::Vector3d p(xc_ + s * 0.1 * h_, armpit, zc_);
+    if (a && t) {
+      double best = kInf;
+      for (const Eigen::Vector3d& u : a->points)
+        for (const Eigen::Vector3d& v : t->points)
+          if ((u - v).squaredNorm() < best) best = (u - v).squaredNorm(), p = 0.5 * (u + v);
+    }
+    landmark("armpit_" + side(s), p);
+    return Status();
+  }
+
+  // Triangles with a corner within r of c (for the tilted cuts).
+  std::vector<uint32_t> triangles_near(const Eigen::Vector3d& c, double r) const {
+    std::vector<uint32_t> out;
+    const float r2 = static_cast<float>(r * r);
+    const Vec3f cf = c.cast<float>();
+    for (uint32_t t = 0; t < mesh_.triangles.size(); ++t)
+      for (uint32_t v : mesh_.triangles[t])
+        if ((mesh_.vertices[v] - cf).squaredNorm() <= r2) {
+          out.push_back(t);
+          break;
+        }
+    return out;
+  }
+
+  Status find_neck() {
+    const double ya = std::max(armpit_y_[0], armpit_y_[1]);
+    double best = kInf;
+    for (double y = ya + 0.04 * h_; y <= floor_ + h_ - 0.09 * h_; y += 2) {
+      const std::vector<Ring> r = rings(y);
+      const Ring* m = midline(r, xc_);
+      if (m && m->girth < best) best = m->girth, neck_y_ = y, neck_c_ = m->centroid;
+    }
+    if (!(best < kInf)) return not_found("measure: no neck found between the armpits and the head");
+    landmark("neck_level", neck_c_);
+    return Status();
+  }
+
+  Status find_side_neck(int s) {
+    std::vector<Eigen::Vector2d> curve;  // (y, half-width)
+    std::vector<Eigen::Vector3d> extreme;
+    double w0 = -1;
+    const double ya = std::max(armpit_y_[0], armpit_y_[1]);
+    for (double y = neck_y_; y > ya; y -= 2) {
+      const std::vector<Ring> r = rings(y);
+      const Ring* m = midline(r, xc_);
+      if (!m) break;
+      Eigen::Vector3d e = m->points.front();
+      for (const Eigen::Vector3d& p : m->points)
+        if (s * p.x() > s * e.x()) e = p;
+      const double w = s * (e.x() - xc_);
+      if (w0 < 0) w0 = w;
+      curve.emplace_back(y, w);
+      extreme.push_back(e);
+      if (w > w0 + 0.035 * h_) break;
+    }
+    if (curve.size() < 4) return not_found("measure: no " + side(s) + " shoulder below the neck");
+    const size_t k = corner(curve);
+    landmark("side_neck_point_" + side(s), extreme[k]);
+    return Status();
+  }
+
+  Status find_shoulder(int s) {
+    const Eigen::Vector3d snp = lm("side_neck_point_" + side(s));
+    const double w_snp = s * (snp.x() - xc_);
+    const double ya = armpit_y_[s > 0 ? 0 : 1];
+    const double bin = 3, u0 = w_snp + 0.01 * h_, u1 = w_snp + 0.25 * h_;
+    const auto nb = static_cast<size_t>((u1 - u0) / bin) + 1;
+    std::vector<double> top(nb, -kInf);
+    std::vector<Eigen::Vector3d> at_top(nb);
+    for (const Vec3f& vf : mesh_.vertices) {
+      const Eigen::Vector3d v = vf.cast<double>();
+      const double u = s * (v.x() - xc_);
+      // Below the side neck point: the head overhangs the neck's side.
+      if (u < u0 || u >= u1 || v.y() < ya || v.y() > snp.y() + 0.01 * h_) continue;
+      const auto b = static_cast<size_t>((u - u0) / bin);
+      if (v.y() > top[b]) top[b] = v.y(), at_top[b] = v;
+    }
+    std::vector<Eigen::Vector2d> curve;
+    std::vector<Eigen::Vector3d> pts;
+    curve.emplace_back(w_snp, snp.y());
+    pts.push_back(snp);
+    for (size_t b = 0; b < nb; ++b) {
+      if (!(top[b] > -kInf)) continue;
+      curve.emplace_back(s * (at_top[b].x() - xc_), top[b]);
+      pts.push_back(at_top[b]);
+      if (top[b] <= ya + 0.25 * (snp.y() - ya)) break;  // well down the arm
+    }
+    if (curve.size() < 4) return not_found("measure: no " + side(s) + " shoulder outline");
+    // The shoulder's corner bulges above the chord from the neck to the arm.
+    const size_t k = corner(curve, 1);
+    landmark("shoulder_point_" + side(s), pts[k]);
+    return Status();
+  }
+
+  void find_neck_points() {
+    const double y_snp = 0.5 * (lm("side_neck_point_left").y() + lm("side_neck_point_right").y());
+    double f = neck_c_.z(), b = neck_c_.z();
+    const std::vector<Ring> rr = rings(y_snp);
+    if (const Ring* m = midline(rr, xc_)) m->crossing_z(xc_, &f, &b);
+    landmark("back_neck_point", {xc_, y_snp, b});
+    std::vector<Eigen::Vector2d> curve;  // (y, front z), top down
+    for (double y = neck_y_; y >= y_snp - 0.08 * h_; y -= 2) {
+      const std::vector<Ring> r = rings(y);
+      double fz = 0, bz = 0;
+      const Ring* m = midline(r, xc_);
+      if (m && m->crossing_z(xc_, &fz, &bz)) curve.emplace_back(y, fz);
+    }
+    Eigen::Vector3d front(xc_, y_snp - 0.03 * h_, neck_c_.z());
+    if (curve.size() >= 3) {
+      // The notch: the front's deepest point behind the chord from neck to chest.
+      const Eigen::Vector2d a = curve.front(), e = curve.back();
+      double best = kInf;
+      for (const Eigen::Vector2d& c : curve) {
+        const double chord_z = a.y() + (c.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y());
+        if (c.y() - chord_z < best) best = c.y() - chord_z, front = {xc_, c.x(), c.y()};
+      }
+    }
+    landmark("front_neck_point", front);
+  }
+
+  void find_torso_levels() {
+    const double ya = std::min(armpit_y_[0], armpit_y_[1]);
+    // Bust: the chest's most forward point.
+    double best = -kInf;
+    for (double y = ya - 0.12 * h_; y <= ya - 0.01 * h_; y += 2) {
+      const std::vector<Ring> r = rings(y);
+      if (const Ring* m = midline(r, xc_); m && m->z_max > best) best = m->z_max, bust_y_ = y;
+    }
+    {
+      const std::vector<Ring> r = rings(bust_y_);
+      const Ring* m = midline(r, xc_);
+      for (int s : {1, -1}) {
+        Eigen::Vector3d p(xc_ + s * 0.05 * h_, bust_y_, zc_);
+        double z = -kInf;
+        if (m)
+          for (const Eigen::Vector3d& q : m->points)
+            if (s * (q.x() - xc_) > 0.01 * h_ && q.z() > z) z = q.z(), p = q;
+        landmark("bust_point_" + side(s), p);
+      }
+    }
+    // Under-bust: below the bust points, the front's deepest point behind the chord.
+    {
+      const double xb = 0.5 * (lm("bust_point_left").x() + lm("bust_point_right").x());
+      const double xs = 0.5 * (lm("bust_point_left").x() - lm("bust_point_right").x());
+      std::vector<Eigen::Vector2d> curve;
+      for (double y = bust_y_; y >= bust_y_ - 0.1 * h_; y -= 2) {
+        const std::vector<Ring> r = rings(y);
+        double f = 0, b = 0, f2 = 0, b2 = 0;
+        const Ring* m = midline(r, xc_);
+        if (m && m->crossing_z(xb + xs, &f, &b) && m->crossing_z(xb - xs, &f2, &b2))
+          curve.emplace_back(y, 0.5 * (f + f2));
+      }
+      underbust_y_ = bust_y_ - 0.05 * h_;
+      if (curve.size() >= 3) {
+        const Eigen::Vector2d a = curve.front(), e = curve.back();
+        double deepest = kInf;
+        for (const Eigen::Vector2d& c : curve) {
+          const double chord_z = a.y() + (c.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y());
+          if (c.y() - chord_z < deepest) deepest = c.y() - chord_z, underbust_y_ = c.x();
+        }
+      }
+      landmark("underbust_front_point", {xc_, underbust_y_, front_z(underbust_y_)});
+    }
+    // Hip: the buttocks' greatest backward projection.
+    best = kInf;
+    hip_y_ = crotch_y_ + 0.08 * h_;
+    Eigen::Vector3d hip_point(xc_, hip_y_, zc_);
+    for (double y = crotch_y_ + 0.01 * h_; y <= crotch_y_ + 0.16 * h_; y += 2) {
+      const std::vector<Ring> r = rings(y);
+      if (const Ring* m = midline(r, xc_); m && m->z_min < best) {
+        best = m->z_min, hip_y_ = y;
+        for (const Eigen::Vector3d& p : m->points)
+          if (p.z() == m->z_min) hip_point = p;
+      }
+    }
+    landmark("hip_back_point", hip_point);
+    // Waist: the narrowest torso between hip and under-bust.
+    double lo = std::max(hip_y_ + 0.04 * h_, at(0.55)), hi = std::min(underbust_y_ - 0.02 * h_, at(0.70));
+    if (lo >= hi) lo = hip_y_ + 0.04 * h_, hi = underbust_y_ - 0.02 * h_;
+    best = kInf;
+    waist_y_ = 0.5 * (lo + hi);
+    for (double y = lo; y <= hi; y += 2) {
+      const std::vector<Ring> r = rings(y);
+      if (const Ring* m = midline(r, xc_); m && m->girth < best) best = m->girth, waist_y_ = y;
+    }
+    double f = zc_, b = zc_;
+    const std::vector<Ring> rr = rings(waist_y_);
+    if (const Ring* m = midline(rr, xc_)) m->crossing_z(xc_, &f, &b);
+    landmark("waist_back_point", {xc_, waist_y_, b});
+    landmark("waist_front_point", {xc_, waist_y_, f});
+  }
+
+  double front_z(double y) const {
+    double f = zc_, b = zc_;
+    const std::vector<Ring> rr = rings(y);
+    if (const Ring* m = midline(rr, xc_)) m->crossing_z(xc_, &f, &b);
+    return f;
+  }
+
+  // --- measurements ----------------------------------------------------------
+
+  void add(BodyMeasurement m) { out_->measurements.push_back(std::move(m)); }
+  void skip(const std::string& name, const std::string& why) { out_->skipped.push_back(name + ": " + why); }
+
+  void height(const std::string& name, const std::string& label, const std::string& clause, const std::string& lmk,
+              const Eigen::Vector3d& p, const std::string& definition) {
+    BodyMeasurement m;
+    m.name = name, m.label = label, m.iso_clause = clause, m.kind = "height";
+    m.value_mm = p.y() - floor_;
+    m.path = {Eigen::Vector3d(p.x(), floor_, p.z()), p};
+    m.landmarks = {lmk};
+    m.definition = definition;
+    add(std::move(m));
+  }
+
+  void girth(const std::string& name, const std::string& label, const std::string& clause, const StatusOr<Girth>& g,
+             std::vector<std::string> landmarks, const std::string& definition) {
+    if (!g.ok()) {
+      skip(name, g.status().message());
+      return;
+    }
+    BodyMeasurement m;
+    m.name = name, m.label = label, m.iso_clause = clause, m.kind = "girth";
+    m.value_mm = g->value_mm;
+    m.path = g->tape;
+    m.closed = true;
+    m.loop = g->loop;
+    m.plane = g->plane;
+    m.landmarks = std::move(landmarks);
+    m.definition = definition;
+    m.min_confidence = g->min_confidence;
+    add(std::move(m));
+  }
+
+  StatusOr<Girth> level_girth(double y, const Eigen::Vector3d& near) const { return slicer_->girth(y, near); }
+
+  void measure_heights() {
+    landmark("top_of_head", top_);
+    height("stature", "Stature", "5.1.1", "top_of_head", top_, "top of the head above the floor");
+    height("cervical_height", "Cervical height", "", "back_neck_point", lm("back_neck_point"),
+           "back neck point above the floor");
+    height("crotch_height", "Inside leg length (crotch height)", "5.1.15", "crotch", lm("crotch"),
+           "crotch above the floor");
+  }
+
+  void measure_torso() {
+    const double ya = std::min(armpit_y_[0], armpit_y_[1]);
+    const Eigen::Vector3d axis(xc_, 0, zc_);
+    auto near = [&](double y) { return Eigen::Vector3d(xc_, y, zc_); };
+    (void)axis;
+    // Neck girth: the smallest loop round the neck over planes tilted forward and back.
+    {
+      const std::vector<uint32_t> tris = triangles_near(neck_c_, 0.12 * h_);
+      StatusOr<Girth> best = not_found("no loop round the neck");
+      auto cut = [&](double deg) {
+        const double t = deg * M_PI / 180;
+        Plane p{neck_c_, Eigen::Vector3d(0, std::cos(t), std::sin(t))};
+        StatusOr<Girth> g = mesh_girth(mesh_, p, neck_c_, &tris);
+        if (g.ok() && (!best.ok() || g->value_mm < best->value_mm)) best = std::move(g), neck_tilt_ = deg;
+      };
+      for (double d = -40; d <= 40; d += 4) cut(d);
+      const double centre = neck_tilt_;
+      for (double d = centre - 3; d <= centre + 3; d += 1) cut(d);
+      girth("neck_girth", "Neck girth", "5.3.2", best, {"neck_level"},
+            "smallest girth round the neck, over planes through its narrowest level tilted up to 40 degrees forward "
+            "or back (perpendicular to the neck's axis)");
+    }
+    // Neck base: the tape round the neck's base through its four points.
+    {
+      const std::vector<Eigen::Vector3d> via = {lm("back_neck_point"), lm("side_neck_point_left"),
+                                                lm("front_neck_point"), lm("side_neck_point_right"),
+                                                lm("back_neck_point")};
+      surface("neck_base_girth", "Neck base girth", "5.3.3", via,
+              {"back_neck_point", "side_neck_point_left", "front_neck_point", "side_neck_point_right"},
+              "round the neck's base over the skin through the back, side and front neck points");
+      if (!out_->measurements.empty() && out_->measurements.back().name == "neck_base_girth") {
+        out_->measurements.back().kind = "girth";
+        out_->measurements.back().closed = true;
+      }
+    }
+    girth("chest_girth", "Chest girth", "5.3.6", level_girth(ya - 0.005 * h_, near(ya)), {"armpit_left", "armpit_right"},
+          "horizontal, just under the lower armpit");
+    girth("bust_girth", "Bust girth", "5.3.4", level_girth(bust_y_, near(bust_y_)), {"bust_point_left", "bust_point_right"},
+          "horizontal, at the level of the chest's most forward point");
+    girth("underbust_girth", "Under-bust girth", "5.3.8", level_girth(underbust_y_, near(underbust_y_)),
+          {"underbust_front_point"}, "horizontal, where the front turns in below the bust");
+    girth("waist_girth", "Waist girth", "5.3.10", level_girth(waist_y_, near(waist_y_)),
+          {"waist_back_point", "waist_front_point"},
+          "horizontal, at the narrowest torso between hip level and under-bust (55-70 % of the height)");
+    girth("hip_girth", "Hip girth", "5.3.13", level_girth(hip_y_, near(hip_y_)), {"hip_back_point"},
+          "horizontal, at the level of the buttocks' greatest backward projection");
+    {
+      double best = -kInf, yb = hip_y_;
+      for (double y = crotch_y_ + 0.01 * h_; y <= waist_y_; y += 2) {
+        const std::vector<Ring> r = rings(y);
+        if (const Ring* m = midline(r, xc_); m && m->girth > best) best = m->girth, yb = y;
+      }
+      girth("max_hip_girth", "Maximum hip girth", "5.3.14", level_girth(yb, near(yb)), {"crotch", "waist_back_point"},
+            "horizontal, the largest between crotch and waist");
+    }
+    height("waist_height", "Waist height", "5.1.10", "waist_back_point", lm("waist_back_point"),
+           "waist level above the floor");
+    height("hip_height", "Hip height", "", "hip_back_point", lm("hip_back_point"), "hip level above the floor");
+  }
+
+  // The leg's horizontal loop on side s at height y, if any.
+  const Ring* leg(const std::vector<Ring>& r, int s) const { return side_ring(r, xc_, s, false); }
+
+  void measure_leg(int s) {
+    const std::string sd = side(s);
+    auto extreme = [&](double y0, double y1, bool largest, double* y_at) {
+      double best = largest ? -kInf : kInf;
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (double y = y0; y <= y1; y += 2) {
+        const std::vector<Ring> r = rings(y);
+        const Ring* l = leg(r, s);
+        if (l && (largest ? l->girth > best : l->girth < best)) best = l->girth, *y_at = y, c = l->centroid;
+      }
+      return c;
+    };
+    double ty = crotch_y_ - 0.02 * h_;
+    const Eigen::Vector3d tc = extreme(crotch_y_ - 0.05 * h_, crotch_y_ - 0.005 * h_, true, &ty);
+    girth("thigh_girth_" + sd, "Thigh girth (" + sd + ")", "5.3.20", level_girth(ty, tc), {"crotch"},
+          "horizontal, the largest just below the crotch");
+    // Knee: the narrowest cut of the leg between calf and thigh (the joint narrows
+    // it; 18-36 % of the height), the deepest local minimum if there are several;
+    // calf: the largest cut below it.
+    std::vector<double> ys, gs;
+    std::vector<Eigen::Vector3d> cs;
+    for (double y = at(0.18); y <= at(0.36); y += 2) {
+      const std::vector<Ring> r = rings(y);
+      if (const Ring* l = leg(r, s)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
+    }
+    if (gs.size() < 10) {
+      skip("knee_girth_" + sd, "no " + sd + " leg at knee height");
+      return;
+    }
+    size_t kk = 0;
+    double deepest = kInf;
+    for (size_t i = 0; i < gs.size(); ++i) {
+      // A local minimum over +-10 mm.
+      bool minimum = true;
+      for (size_t j = i >= 5 ? i - 5 : 0; j < std::min(gs.size(), i + 6); ++j) minimum = minimum && gs[j] >= gs[i];
+      if (minimum && i > 0 && i + 1 < gs.size() && gs[i] < deepest) deepest = gs[i], kk = i;
+    }
+    if (!(deepest < kInf)) kk = static_cast<size_t>(std::min_element(gs.begin(), gs.end()) - gs.begin());
+    const double ky = ys[kk];
+    const Eigen::Vector3d kc = cs[kk];
+    double cy = at(0.2);
+    const Eigen::Vector3d cc = extreme(at(0.10), ky, true, &cy);
+    {
+      const std::vector<Ring> r = rings(ky);
+      const Ring* l = leg(r, s);
+      landmark("knee_" + sd, {kc.x(), ky, l ? l->z_max : kc.z()});
+    }
+    height("knee_height_" + sd, "Knee height (" + sd + ")", "", "knee_" + sd, lm("knee_" + sd),
+           "knee level above the floor");
+    girth("knee_girth_" + sd, "Knee girth (" + sd + ")", "5.3.22", level_girth(ky, kc), {"knee_" + sd},
+          "horizontal, the narrowest cut of the leg between calf and thigh (18-36 % of the height)");
+    const double my = 0.5 * (crotch_y_ + ky);
+    const std::vector<Ring> mr = rings(my);
+    const Ring* ml = leg(mr, s);
+    girth("mid_thigh_girth_" + sd, "Mid-thigh girth (" + sd + ")", "5.3.21",
+          ml ? level_girth(my, ml->centroid) : StatusOr<Girth>(not_found("no leg at mid-thigh")), {"crotch", "knee_" + sd},
+          "horizontal, halfway between crotch and kneecap");
+    girth("calf_girth_" + sd, "Calf girth (" + sd + ")", "5.3.24", level_girth(cy, cc), {"knee_" + sd},
+          "horizontal, the largest between ankle and knee");
+    double ay = at(0.06);
+    const Eigen::Vector3d ac = extreme(at(0.04), cy, false, &ay);
+    girth("min_leg_girth_" + sd, "Minimum leg girth (" + sd + ")", "5.3.25", level_girth(ay, ac), {},
+          "horizontal, the smallest between ankle and calf");
+  }
+
+  void measure_arm(int s) {
+    const std::string sd = side(s);
+    const double ya = armpit_y_[s > 0 ? 0 : 1];
+    std::vector<Eigen::Vector3d> c;  // centroids, armpit downwards
+    std::vector<double> g;
+    for (double y = ya - 3; y > floor_; y -= 3) {
+      const std::vector<Ring> r = rings(y);
+      const Ring* a = side_ring(r, xc_, s, true);
+      // Past the crotch the leg is on this side too: stop when the arm is gone, or
+      // splits into fingers.
+      if (!a || (y < crotch_y_ && std::abs(a->centroid.x() - xc_) < 0.1 * h_)) break;
+      if (count_side(r, xc_, s) > (y < crotch_y_ ? 2u : 1u)) break;
+      if (!g.empty() && a->girth < 0.4 * *std::max_element(g.begin(), g.end())) break;
+      c.push_back(a->centroid);
+      g.push_back(a->girth);
+    }
+    if (c.size() < 30) {
+      skip("upper_arm_girth_" + sd, "the " + sd + " arm is too short to follow");
+      return;
+    }
+    // Wrist: the narrowest cut in the lower part of the arm, above the palm's end.
+    const size_t n = c.size();
+    size_t w = n - 4;
+    for (size_t i = n * 55 / 100; i + 3 < n; ++i)
+      if (g[i] < g[w]) w = i;
+    // Elbow: where the axis bends (two lines fitted to the centroids, wrist to armpit).
+    size_t e = w / 2;
+    double best = kInf;
+    for (size_t k = w / 5; k < w * 4 / 5; ++k) {
+      double r1 = 0, r2 = 0;
+      fit_line(c, 0, k + 1, &r1);
+      fit_line(c, k, w + 1, &r2);
+      if (r1 + r2 < best) best = r1 + r2, e = k;
+    }
+    const auto [uc, ud] = fit_line(c, 0, e + 1);
+    const auto [fc, fd] = fit_line(c, e, w + 1);
+    auto on_axis = [](const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& p) {
+      return (o + (p - o).dot(d) * d).eval();
+    };
+    const Eigen::Vector3d elbow_c = on_axis(uc, ud, c[e]), wrist_c = on_axis(fc, fd, c[w]);
+    // Outward: across the arm, in the frontal plane, away from the body.
+    auto outward = [&](const Eigen::Vector3d& d) {
+      Eigen::Vector3d o = -Eigen::Vector3d::UnitZ().cross(d);
+      if (s * o.x() < 0) o = -o;
+      return o.normalized().eval();
+    };
+    auto outer_point = [&](const Girth& gg, const Eigen::Vector3d& centre, const Eigen::Vector3d& out) {
+      Eigen::Vector3d best_p = centre;
+      double most = -kInf;
+      for (const Eigen::Vector3d& p : gg.loop)
+        if ((p - centre).dot(out) > most) most = (p - centre).dot(out), best_p = p;
+      return best_p;
+    };
+    const std::vector<uint32_t> wt = triangles_near(wrist_c, 0.08 * h_);
+    StatusOr<Girth> wg = mesh_girth(mesh_, Plane{wrist_c, fd}, wrist_c, &wt);
+    const std::vector<uint32_t> et = triangles_near(elbow_c, 0.08 * h_);
+    StatusOr<Girth> eg = mesh_girth(mesh_, Plane{elbow_c, ud}, elbow_c, &et);
+    const Eigen::Vector3d wrist_p = wg.ok() ? outer_point(*wg, wrist_c, outward(fd)) : wrist_c;
+    const Eigen::Vector3d elbow_p = eg.ok() ? outer_point(*eg, elbow_c, outward(ud)) : elbow_c;
+    landmark("wrist_point_" + sd, wrist_p);
+    landmark("elbow_point_" + sd, elbow_p);
+    girth("wrist_girth_" + sd, "Wrist girth (" + sd + ")", "5.3.19", wg, {"wrist_point_" + sd},
+          "the narrowest cut above the hand, perpendicular to the forearm's axis");
+    const Eigen::Vector3d acr = lm("shoulder_point_" + sd);
+    const Eigen::Vector3d mid = on_axis(uc, ud, 0.5 * (acr + elbow_c));
+    // Close to the armpit the cut can reach the chest: then slide it toward the
+    // elbow until its loop is the arm's alone (within 5 % of the height of the axis).
+    const std::vector<uint32_t> ut = triangles_near(mid, 0.3 * h_);
+    StatusOr<Girth> ug = not_found("the cut never clears the chest");
+    for (double off = 0; off <= 0.08 * h_; off += 4) {
+      const Eigen::Vector3d p = mid - off * ud;
+      StatusOr<Girth> g = mesh_girth(mesh_, Plane{p, ud}, p, &ut);
+      if (!g.ok()) continue;
+      double reach = 0;
+      for (const Eigen::Vector3d& q : g->loop) reach = std::max(reach, (q - p).norm());
+      if (reach < 0.05 * h_) {
+        ug = std::move(g);
+        break;
+      }
+    }
+    girth("upper_arm_girth_" + sd, "Upper-arm girth (" + sd + ")", "5.3.16", ug,
+          {"shoulder_point_" + sd, "elbow_point_" + sd},
+          "perpendicular to the upper arm's axis, halfway between shoulder point and elbow (moved toward the "
+          "elbow until the cut clears the chest)");
+    // Outer arm length: shoulder point, elbow, wrist along the arm's outer side.
+    surface("outer_arm_length_" + sd, "Outer arm length (" + sd + ")", "5.7.8",
+            {acr, elbow_p, wrist_p}, {"shoulder_point_" + sd, "elbow_point_" + sd, "wrist_point_" + sd},
+            "over the skin from the shoulder point by the elbow's outer side to the wrist");
+  }
+
+  void surface(const std::string& name, const std::string& label, const std::string& clause,
+               const std::vector<Eigen::Vector3d>& via, std::vector<std::string> landmarks,
+               const std::string& definition) {
+    BodyMeasurement m;
+    m.name = name, m.label = label, m.iso_clause = clause, m.kind = "surface_length";
+    for (size_t i = 0; i + 1 < via.size(); ++i) {
+      StatusOr<SurfacePath> p = paths_->shortest(via[i], via[i + 1]);
+      if (!p.ok()) {
+        skip(name, p.status().message());
+        return;
+      }
+      m.value_mm += p->value_mm;
+      m.min_confidence = std::min(m.min_confidence, p->min_confidence);
+      m.path.insert(m.path.end(), p->path.begin() + (m.path.empty() ? 0 : 1), p->path.end());
+    }
+    m.landmarks = std::move(landmarks);
+    m.definition = definition;
+    add(std::move(m));
+  }
+
+  void measure_lengths() {
+    const Eigen::Vector3d l = lm("shoulder_point_left"), r = lm("shoulder_point_right"), b = lm("back_neck_point");
+    surface("shoulder_width", "Across-back shoulder width", "5.4.3", {r, b, l},
+            {"shoulder_point_right", "back_neck_point", "shoulder_point_left"},
+            "over the skin from shoulder point to shoulder point by the back neck point");
+    BodyMeasurement m;
+    m.name = "biacromial_breadth", m.label = "Shoulder breadth (straight)", m.kind = "distance";
+    m.value_mm = (l - r).norm();
+    m.path = {r, l};
+    m.landmarks = {"shoulder_point_right", "shoulder_point_left"};
+    m.definition = "straight line between the shoulder points";
+    add(std::move(m));
+    surface("back_neck_to_waist", "Back neck point to waist", "5.4.5", {b, lm("waist_back_point")},
+            {"back_neck_point", "waist_back_point"}, "over the skin down the centre back to the waist level");
+  }
+
+  const TriangleMesh& mesh_;
+  const BodyMeasureOptions& opt_;
+  BodyMeasurements* out_;
+  std::optional<BodySlicer> slicer_;
+  std::optional<SurfacePaths> paths_;
+  Eigen::Vector3d top_ = Eigen::Vector3d::Zero(), neck_c_ = Eigen::Vector3d::Zero();
+  double floor_ = 0, h_ = 0, xc_ = 0, zc_ = 0;
+  double crotch_y_ = 0, armpit_y_[2] = {0, 0}, neck_y_ = 0, neck_tilt_ = 0;
+  double bust_y_ = 0, underbust_y_ = 0, waist_y_ = 0, hip_y_ = 0;
+};
+
+}  // namespace
+
+StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeasureOptions& options) {
+  BodyMeasurements out;
+  Finder finder(mesh, options, &out);
+  RETURN_IF_ERROR(finder.run());
+  return out;
+}
+
+}  // namespace bodyscan

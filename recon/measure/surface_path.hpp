@@ -1,0 +1,64 @@
+// Lengths along the body (a tape laid on the skin between two points, rather than
+// around a plane's section): the shortest path on the mesh's surface.
+//
+// The path is exact for the triangle mesh, not an edge-graph approximation (which
+// runs 2-8 % long by zig-zagging along edges):
+//  1. both ends are snapped to the nearest point of the surface;
+//  2. a strip of edge-adjacent triangles joining them is found by Dijkstra on the
+//     triangles' adjacency (centroid to centroid);
+//  3. the strip is unfolded into the plane and the shortest path through it is
+//     pulled taut with the funnel algorithm (Lee & Preparata 1984), which is exact
+//     within the strip;
+//  4. where the taut path wraps round a strip vertex whose other side is shorter
+//     (the angle there, going round the other way, is under 180 degrees), the strip
+//     is re-routed through that vertex's other triangles, and step 3 repeats until
+//     no vertex is left to re-route. What remains is a locally shortest geodesic:
+//     it passes through a vertex only where the surface is saddle-shaped.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "recon/core/status.hpp"
+#include "recon/geometry/triangle_mesh.hpp"
+
+namespace bodyscan {
+
+struct SurfacePath {
+  double value_mm = 0;                // along the surface
+  double straight_mm = 0;             // the chord between the two ends
+  std::vector<Eigen::Vector3d> path;  // on the surface, from the first end to the second
+  Eigen::Vector3d from = Eigen::Vector3d::Zero(), to = Eigen::Vector3d::Zero();  // the ends as snapped
+  float min_confidence = 1;           // lowest mesh confidence along the path (1: all measured)
+  size_t reroutes = 0;                // vertex re-routings step 4 made
+};
+
+struct SurfacePathOptions {
+  size_t max_reroute_rounds = 10000;
+};
+
+// Shortest paths on one mesh, its adjacency and search tree built once (O(T log T)).
+// Keeps a reference to the mesh, which must outlive it and not change.
+class SurfacePaths {
+ public:
+  explicit SurfacePaths(const TriangleMesh& mesh);
+  ~SurfacePaths();
+  SurfacePaths(const SurfacePaths&) = delete;
+  SurfacePaths& operator=(const SurfacePaths&) = delete;
+
+  // The shortest path between the surface points nearest `from` and `to`. Errors:
+  // empty mesh; the two points lie on parts of the mesh that do not connect.
+  StatusOr<SurfacePath> shortest(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                 const SurfacePathOptions& options = {}) const;
+
+ private:
+  class Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// One path on a mesh (builds a SurfacePaths for it).
+StatusOr<SurfacePath> mesh_surface_path(const TriangleMesh& mesh, const Eigen::Vector3d& from,
+                                        const Eigen::Vector3d& to, const SurfacePathOptions& options = {});
+
+}  // namespace bodyscan

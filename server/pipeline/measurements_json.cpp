@@ -1,0 +1,69 @@
+#include "server/pipeline/measurements_json.hpp"
+
+namespace bodyscan::pipeline {
+
+nlohmann::json point_json(const Eigen::Vector3d& p) { return nlohmann::json::array({p.x(), p.y(), p.z()}); }
+
+nlohmann::json polyline_json(const std::vector<Eigen::Vector3d>& points) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const Eigen::Vector3d& p : points) a.push_back(point_json(p));
+  return a;
+}
+
+nlohmann::json plane_json(const Plane& plane) {
+  return {{"point", point_json(plane.point)}, {"normal", point_json(plane.normal)}};
+}
+
+nlohmann::json measurements_document(const std::string& file, const std::string& kind) {
+  return {{"schema", kMeasurementsSchema},
+          {"file", file},
+          {"kind", kind},
+          {"measurements", nlohmann::json::array()}};
+}
+
+nlohmann::json to_json(const BodyMeasurement& m) {
+  nlohmann::json j = {{"name", m.name},
+                      {"label", m.label},
+                      {"iso_clause", m.iso_clause.empty() ? nlohmann::json(nullptr) : nlohmann::json(m.iso_clause)},
+                      {"kind", m.kind},
+                      {"value_mm", m.value_mm},
+                      {"path", polyline_json(m.path)},
+                      {"closed", m.closed},
+                      {"landmarks", m.landmarks},
+                      {"definition", m.definition},
+                      {"min_confidence", m.min_confidence},
+                      {"crosses_filled_hole", m.crosses_filled_hole()},
+                      {"algorithm", std::string(kBodyMeasurementsAlgorithm) + "/" +
+                                        (m.kind == "girth" && m.plane ? kGirthAlgorithm
+                                         : m.kind == "height" || m.kind == "distance" ? "straight-1"
+                                                                                      : kSurfaceAlgorithm)}};
+  if (m.plane) j["plane"] = plane_json(*m.plane);
+  if (!m.loop.empty()) j["loop"] = polyline_json(m.loop);
+  return j;
+}
+
+void add_body_measurements(const BodyMeasurements& body, nlohmann::json* document) {
+  nlohmann::json& d = *document;
+  d["algorithm"] = kBodyMeasurementsAlgorithm;
+  d["floor_y_mm"] = body.floor_y;
+  d["landmarks"] = nlohmann::json::array();
+  for (const BodyLandmark& l : body.landmarks) d["landmarks"].push_back({{"name", l.name}, {"position", point_json(l.position)}});
+  for (const BodyMeasurement& m : body.measurements) d["measurements"].push_back(to_json(m));
+  d["skipped"] = body.skipped;
+}
+
+nlohmann::json to_json(const SurfacePath& p, const std::string& name) {
+  return {{"name", name},
+          {"kind", "surface_length"},
+          {"value_mm", p.value_mm},
+          {"straight_mm", p.straight_mm},
+          {"from", point_json(p.from)},
+          {"to", point_json(p.to)},
+          {"path", polyline_json(p.path)},
+          {"closed", false},
+          {"min_confidence", p.min_confidence},
+          {"crosses_filled_hole", p.min_confidence < 0.5f},
+          {"algorithm", kSurfaceAlgorithm}};
+}
+
+}  // namespace bodyscan::pipeline

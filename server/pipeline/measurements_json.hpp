@@ -1,0 +1,34 @@
+// The measurements document (docs/measurements.md): what `bodyscan measure` prints
+// and the scan job writes as measurements.json, one schema for both.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+#include "recon/measure/body_measurements.hpp"
+#include "recon/measure/girth.hpp"
+#include "recon/measure/surface_path.hpp"
+
+namespace bodyscan::pipeline {
+
+inline constexpr const char* kMeasurementsSchema = "bodyscan.measurements/1";
+inline constexpr const char* kGirthAlgorithm = "girth/convex-hull-1";
+inline constexpr const char* kSurfaceAlgorithm = "surface/geodesic-funnel-1";
+
+nlohmann::json point_json(const Eigen::Vector3d& p);
+nlohmann::json polyline_json(const std::vector<Eigen::Vector3d>& points);
+nlohmann::json plane_json(const Plane& plane);
+
+// A document with no measurements yet: schema, file, kind ("mesh" or "points").
+nlohmann::json measurements_document(const std::string& file, const std::string& kind);
+
+// One automatic measurement, and the whole automatic set (landmarks, measurements,
+// skipped) added to a document.
+nlohmann::json to_json(const BodyMeasurement& m);
+void add_body_measurements(const BodyMeasurements& body, nlohmann::json* document);
+
+// A surface length between two points.
+nlohmann::json to_json(const SurfacePath& p, const std::string& name);
+
+}  // namespace bodyscan::pipeline

@@ -1,0 +1,154 @@
+#include "recon/measure/body_measurements.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "recon/io/ply.hpp"
+#include "tests/test_meshes.hpp"
+
+namespace bodyscan {
+namespace {
+
+// MakeHuman's joint centres for the shipped bodies (../shared/data/bodies/manifest.json,
+// "landmarks_mm_approx"; soles at Y = 0) and its indicative torso girths.
+struct Truth {
+  const char* file;
+  double stature, neck, shoulder, elbow, wrist, hip_joint, knee, waist, max_hip;
+};
+const Truth kBodies[] = {
+    {"male_average.ply", 1729.3, 1483.8, 1379, 1189, 1061, 919, 505, 745, 938},
+    {"female_average.ply", 1588.0, 1344, 1261, 1090, 970, 813, 445, 650, 939},
+};
+
+class BodyMeasurementsTest : public ::testing::TestWithParam<Truth> {
+ protected:
+  static const BodyMeasurements& measured(const std::string& file) {
+    static std::map<std::string, BodyMeasurements> cache;
+    auto it = cache.find(file);
+    if (it == cache.end()) {
+      auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/" + file);
+      EXPECT_TRUE(mesh.ok());
+      auto body = measure_body(*mesh);
+      EXPECT_TRUE(body.ok()) << body.status().message();
+      it = cache.emplace(file, *body).first;
+    }
+    return it->second;
+  }
+  static double value(const BodyMeasurements& b, const std::string& name) {
+    const BodyMeasurement* m = b.find(name);
+    EXPECT_NE(m, nullptr) << name;
+    return m ? m->value_mm : NAN;
+  }
+  static Eigen::Vector3d at(const BodyMeasurements& b, const std::string& name) {
+    const BodyLandmark* l = b.landmark(name);
+    EXPECT_NE(l, nullptr) << name;
+    return l ? l->position : Eigen::Vector3d::Constant(NAN);
+  }
+};
+
+TEST_P(BodyMeasurementsTest, TakesTheWholeSet) {
+  const BodyMeasurements& b = measured(GetParam().file);
+  EXPECT_TRUE(b.skipped.empty()) << b.skipped.front();
+  for (const char* name :
+       {"stature", "cervical_height", "crotch_height", "neck_girth", "neck_base_girth", "chest_girth", "bust_girth",
+        "underbust_girth", "waist_girth", "hip_girth", "max_hip_girth", "waist_height", "hip_height",
+        "thigh_girth_left", "mid_thigh_girth_left", "knee_girth_left", "calf_girth_left", "min_leg_girth_left",
+        "upper_arm_girth_left", "wrist_girth_left", "outer_arm_length_left", "thigh_girth_right",
+        "upper_arm_girth_right", "shoulder_width", "biacromial_breadth", "back_neck_to_waist"}) {
+    const BodyMeasurement* m = b.find(name);
+    ASSERT_NE(m, nullptr) << name;
+    EXPECT_GT(m->value_mm, 0) << name;
+    EXPECT_FALSE(m->path.empty()) << name;
+    EXPECT_FALSE(m->definition.empty()) << name;
+    EXPECT_EQ(m->min_confidence, 1.f) << name;  // a mesh without confidence: all measured
+    for (const std::string& l : m->landmarks) EXPECT_NE(b.landmark(l), nullptr) << name << " uses " << l;
+    if (m->kind == "girth") EXPECT_TRUE(m->closed) << name;
+  }
+}
+
+TEST_P(BodyMeasurementsTest, LandmarksSitWhereTheSkeletonSaysAndInAnatomicalRanges) {
+  const Truth& t = GetParam();
+  const BodyMeasurements& b = measured(t.file);
+  const double h = t.stature;
+  EXPECT_NEAR(value(b, "stature"), h, 0.5);
+  // The crotch lies below the hip joints, 45-49 % of the stature.
+  const double crotch = at(b, "crotch").y();
+  EXPECT_GT(crotch, t.hip_joint - 130);
+  EXPECT_LT(crotch, t.hip_joint - 40);
+  EXPECT_NEAR(crotch / h, 0.47, 0.025);
+  // Armpits at 72-78 %.
+  for (const char* s : {"armpit_left", "armpit_right"}) EXPECT_NEAR(at(b, s).y() / h, 0.75, 0.03) << s;
+  // The acromion sits on top of the shoulder joint, a little outside it.
+  for (const char* s : {"shoulder_point_left", "shoulder_point_right"}) {
+    EXPECT_GT(at(b, s).y(), t.shoulder) << s;
+    EXPECT_LT(at(b, s).y(), t.shoulder + 70) << s;
+  }
+  EXPECT_NEAR(at(b, "elbow_point_left").y(), t.elbow, 50);
+  EXPECT_NEAR(at(b, "wrist_point_left").y(), t.wrist, 50);
+  EXPECT_NEAR(at(b, "knee_left").y(), t.knee, 50);
+  EXPECT_NEAR(at(b, "knee_left").y() / h, 0.28, 0.03);
+  // The back neck point (C7) near MakeHuman's neck joint, 84-88 % of the stature;
+  // the front neck point below it.
+  EXPECT_NEAR(at(b, "back_neck_point").y(), t.neck, 40);
+  EXPECT_NEAR(at(b, "back_neck_point").y() / h, 0.86, 0.02);
+  EXPECT_LT(at(b, "front_neck_point").y(), at(b, "back_neck_point").y());
+  EXPECT_GT(at(b, "front_neck_point").z(), at(b, "back_neck_point").z());  // it faces +Z
+  // Waist at 58-66 %, and the hip between crotch and waist.
+  EXPECT_NEAR(value(b, "waist_height") / h, 0.62, 0.04);
+  EXPECT_GT(value(b, "hip_height"), crotch);
+  EXPECT_LT(value(b, "hip_height"), value(b, "waist_height"));
+}
+
+TEST_P(BodyMeasurementsTest, GirthsAgreeWithTheManifestAndAreSymmetric) {
+  const Truth& t = GetParam();
+  const BodyMeasurements& b = measured(t.file);
+  // The manifest's waist is the smallest torso tape over 56-68 % of the stature, its
+  // hip the largest over 47-56 %: ours search by landmarks, so agree within a few mm.
+  EXPECT_NEAR(value(b, "waist_girth"), t.waist, 6);
+  EXPECT_NEAR(value(b, "max_hip_girth"), t.max_hip, 6);
+  EXPECT_LE(value(b, "hip_girth"), value(b, "max_hip_girth") + 1e-9);
+  EXPECT_LT(value(b, "neck_girth"), value(b, "neck_base_girth"));
+  EXPECT_LT(value(b, "wrist_girth_left"), value(b, "upper_arm_girth_left"));
+  EXPECT_LT(value(b, "min_leg_girth_left"), value(b, "calf_girth_left"));
+  EXPECT_LT(value(b, "knee_girth_left"), value(b, "thigh_girth_left"));
+  EXPECT_GT(value(b, "shoulder_width"), value(b, "biacromial_breadth"));
+  // The bodies are mirror-symmetric.
+  for (const char* m : {"thigh_girth", "knee_girth", "calf_girth", "upper_arm_girth", "wrist_girth", "outer_arm_length"})
+    EXPECT_NEAR(value(b, std::string(m) + "_left"), value(b, std::string(m) + "_right"), 1.0) << m;
+}
+
+INSTANTIATE_TEST_SUITE_P(ShippedBodies, BodyMeasurementsTest, ::testing::ValuesIn(kBodies));
+
+TEST(BodyMeasurements, DoNotDependOnWhereTheBodyStands) {
+  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
+  ASSERT_TRUE(mesh.ok());
+  auto a = measure_body(*mesh);
+  ASSERT_TRUE(a.ok());
+  TriangleMesh moved = *mesh;
+  for (Vec3f& v : moved.vertices) v += Vec3f(83.f, -20.f, -41.f);
+  BodyMeasureOptions o;
+  o.floor_y = -20;
+  auto b = measure_body(moved, o);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  ASSERT_EQ(a->measurements.size(), b->measurements.size());
+  for (size_t i = 0; i < a->measurements.size(); ++i)
+    EXPECT_NEAR(a->measurements[i].value_mm, b->measurements[i].value_mm, 1.0) << a->measurements[i].name;
+  // A floor below the soles adds to the heights only.
+  o.floor_y = -30;
+  auto c = measure_body(moved, o);
+  ASSERT_TRUE(c.ok());
+  EXPECT_NEAR(c->find("stature")->value_mm, a->find("stature")->value_mm + 10, 1e-3);
+  EXPECT_NEAR(c->find("waist_girth")->value_mm, a->find("waist_girth")->value_mm, 1.0);
+}
+
+TEST(BodyMeasurements, RefusesWhatIsNotAStandingBody) {
+  EXPECT_FALSE(measure_body(TriangleMesh{}).ok());
+  auto ball = measure_body(testing::icosphere(3, 900));
+  ASSERT_FALSE(ball.ok());
+  EXPECT_NE(ball.status().message().find("legs"), std::string::npos) << ball.status().message();
+}
+
+}  // namespace
+}  // namespace bodyscan
