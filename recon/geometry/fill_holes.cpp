@@ -162,7 +162,7 @@ class HolePatch {
     }
     if (n > max_dp) {
       size_t si = 0, sj = 0;
-      if (find_split(poly, &si, &sj)) {
+      if (find_split(poly, edge_normal, &si, &sj)) {
         std::vector<uint32_t> a(poly.begin() + static_cast<long>(si), poly.begin() + static_cast<long>(sj) + 1);
         std::vector<Vec3f> na(edge_normal.begin() + static_cast<long>(si), edge_normal.begin() + static_cast<long>(sj));
         na.push_back(Vec3f::Zero());  // the diagonal
@@ -364,18 +364,31 @@ class HolePatch {
   }
 
   // A diagonal (i, j) cutting a long loop into two parts of at least a quarter of
-  // it each, as short as possible relative to the loop length it cuts off.
-  bool find_split(const std::vector<uint32_t>& poly, size_t* si, size_t* sj) const {
+  // it each, as short as possible. A diagonal that leaves the surface outward at
+  // either end (along the surrounding triangles' normals) spans a gap outside the
+  // body rather than the hole - between the inner thighs below the crotch, the
+  // shortest of all - and is taken only when nothing else is left.
+  bool find_split(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal, size_t* si,
+                  size_t* sj) const {
     const size_t n = poly.size();
     const size_t min_part = std::max<size_t>(3, n / 4);
+    std::vector<Vec3f> normal(n, Vec3f::Zero());
+    for (size_t i = 0; i < n && edge_normal.size() == n; ++i) {
+      const Vec3f v = edge_normal[i] + edge_normal[(i + n - 1) % n];
+      if (v.squaredNorm() > 0.f) normal[i] = v.normalized();
+    }
     double best = std::numeric_limits<double>::max();
-    for (size_t i = 0; i < n; ++i) {
-      for (size_t j = i + min_part; j + min_part <= n + i && j < n; ++j) {
-        const double d = (pos(poly[i]) - pos(poly[j])).norm();
-        if (d < best && !edge_taken(poly[i], poly[j])) {
-          best = d;
-          *si = i;
-          *sj = j;
+    for (int pass = 0; pass < 2 && !(best < std::numeric_limits<double>::max()); ++pass) {
+      for (size_t i = 0; i < n; ++i) {
+        for (size_t j = i + min_part; j + min_part <= n + i && j < n; ++j) {
+          const Vec3f dv = pos(poly[j]) - pos(poly[i]);
+          const double d = dv.norm();
+          if (pass == 0 && d > 0 && (normal[i].dot(dv) > 0.5f * d || normal[j].dot(-dv) > 0.5f * d)) continue;
+          if (d < best && !edge_taken(poly[i], poly[j])) {
+            best = d;
+            *si = i;
+            *sj = j;
+          }
         }
       }
     }

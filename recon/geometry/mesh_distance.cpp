@@ -187,6 +187,12 @@ uint64_t splitmix64(uint64_t x) {
 
 }  // namespace
 
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                          const Eigen::Vector3d& c) {
+  int feature = 0;
+  return closest_on_triangle<double>(p, a, b - a, c - a, &feature);
+}
+
 MeshDistance::MeshDistance(const TriangleMesh& mesh)
     : vertices_(mesh.vertices), triangles_(mesh.triangles) {
   const size_t num = triangles_.size();

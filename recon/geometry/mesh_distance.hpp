@@ -36,6 +36,10 @@ struct ClosestPoint {
   float signed_distance = std::numeric_limits<float>::infinity();
 };
 
+// The point of triangle (a, b, c) nearest p (Ericson §5.1.5).
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                          const Eigen::Vector3d& c);
+
 class MeshDistance {
  public:
   // Builds the hierarchy in O(T log T) for T triangles and copies what it needs, so

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <unordered_map>
 
 #include "recon/measure/body_slicer.hpp"
 #include "recon/measure/girth.hpp"
@@ -99,6 +100,19 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Ve
   return {c, d};
 }
 
+// Whether a loop in the plane with normal n winds round p (the loop is the limb's
+// own, not a neighbour's that the nearest-loop rule fell back to).
+bool winds_round(const std::vector<Eigen::Vector3d>& loop, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+  Eigen::Vector3d u, v;
+  plane_basis(n, &u, &v);
+  double turn = 0;
+  for (size_t i = 0; i < loop.size(); ++i) {
+    const Eigen::Vector3d a = loop[i] - p, b = loop[(i + 1) % loop.size()] - p;
+    turn += std::atan2(a.dot(u) * b.dot(v) - a.dot(v) * b.dot(u), a.dot(u) * b.dot(u) + a.dot(v) * b.dot(v));
+  }
+  return std::abs(turn) > M_PI;
+}
+
 class Finder {
  public:
   Finder(const TriangleMesh& mesh, const BodyMeasureOptions& options, BodyMeasurements* out)
@@ -136,9 +150,25 @@ class Finder {
  private:
   static std::string side(int s) { return s > 0 ? "left" : "right"; }
   double at(double fraction) const { return floor_ + fraction * h_; }
-  std::vector<Ring> rings(double y) const { return slicer_->rings(y); }
+  // The cut at y, remembered: the searches revisit the same levels (both legs,
+  // several windows).
+  const std::vector<Ring>& rings(double y) const {
+    const auto key = static_cast<int64_t>(std::llround(y * 64));
+    auto it = ring_cache_.find(key);
+    if (it == ring_cache_.end()) it = ring_cache_.emplace(key, slicer_->rings(static_cast<double>(key) / 64)).first;
+    return it->second;
+  }
 
-  void landmark(const std::string& name, const Eigen::Vector3d& p) { out_->landmarks.push_back({name, p}); }
+  void landmark(const std::string& name, const Eigen::Vector3d& p) {
+    float confidence = 1;
+    if (mesh_.confidence.size() == mesh_.vertices.size()) {
+      const Vec3f q = p.cast<float>();
+      float best = std::numeric_limits<float>::infinity();
+      for (size_t i = 0; i < mesh_.vertices.size(); ++i)
+        if (const float d = (mesh_.vertices[i] - q).squaredNorm(); d < best) best = d, confidence = mesh_.confidence[i];
+    }
+    out_->landmarks.push_back({name, p, confidence});
+  }
   Eigen::Vector3d lm(const std::string& name) const { return out_->landmark(name)->position; }
 
   // --- landmarks -------------------------------------------------------------
@@ -389,7 +419,11 @@ class Finder {
 
   // --- measurements ----------------------------------------------------------
 
-  void add(BodyMeasurement m) { out_->measurements.push_back(std::move(m)); }
+  void add(BodyMeasurement m) {
+    for (const std::string& l : m.landmarks)
+      if (const BodyLandmark* b = out_->landmark(l)) m.min_confidence = std::min(m.min_confidence, b->confidence);
+    out_->measurements.push_back(std::move(m));
+  }
   void skip(const std::string& name, const std::string& why) { out_->skipped.push_back(name + ": " + why); }
 
   void height(const std::string& name, const std::string& label, const std::string& clause, const std::string& lmk,
@@ -440,7 +474,7 @@ class Finder {
     (void)axis;
     // Neck girth: the smallest loop round the neck over planes tilted forward and back.
     {
-      const std::vector<uint32_t> tris = triangles_near(neck_c_, 0.12 * h_);
+      const std::vector<uint32_t> tris = triangles_near(neck_c_, 0.08 * h_);
       StatusOr<Girth> best = not_found("no loop round the neck");
       auto cut = [&](double deg) {
         const double t = deg * M_PI / 180;
@@ -627,15 +661,22 @@ class Finder {
     const Eigen::Vector3d acr = lm("shoulder_point_" + sd);
     const Eigen::Vector3d mid = on_axis(uc, ud, 0.5 * (acr + elbow_c));
     // Close to the armpit the cut can reach the chest: then slide it toward the
-    // elbow until its loop is the arm's alone (within 5 % of the height of the axis).
-    const std::vector<uint32_t> ut = triangles_near(mid, 0.3 * h_);
+    // elbow until its loop is the arm's alone (winds round the axis, and reaches no
+    // farther than 5 % of the height from its own centre).
+    const std::vector<uint32_t> ut = triangles_near(mid, 0.07 * h_);
     StatusOr<Girth> ug = not_found("the cut never clears the chest");
     for (double off = 0; off <= 0.08 * h_; off += 4) {
       const Eigen::Vector3d p = mid - off * ud;
-      StatusOr<Girth> g = mesh_girth(mesh_, Plane{p, ud}, p, &ut);
-      if (!g.ok()) continue;
+      // Cut within reach of the axis only: a loop running out of it is open, so
+      // the chest never joins.
+      const std::vector<uint32_t> near_p = off == 0 ? ut : triangles_near(p, 0.07 * h_);
+      StatusOr<Girth> g = mesh_girth(mesh_, Plane{p, ud}, p, &near_p);
+      if (!g.ok() || !winds_round(g->loop, p, ud)) continue;
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (const Eigen::Vector3d& q : g->loop) centre += q;
+      centre /= static_cast<double>(g->loop.size());
       double reach = 0;
-      for (const Eigen::Vector3d& q : g->loop) reach = std::max(reach, (q - p).norm());
+      for (const Eigen::Vector3d& q : g->loop) reach = std::max(reach, (q - centre).norm());
       if (reach < 0.05 * h_) {
         ug = std::move(g);
         break;
@@ -692,6 +733,7 @@ class Finder {
   BodyMeasurements* out_;
   std::optional<BodySlicer> slicer_;
   std::optional<SurfacePaths> paths_;
+  mutable std::unordered_map<int64_t, std::vector<Ring>> ring_cache_;
   Eigen::Vector3d top_ = Eigen::Vector3d::Zero(), neck_c_ = Eigen::Vector3d::Zero();
   double floor_ = 0, h_ = 0, xc_ = 0, zc_ = 0;
   double crotch_y_ = 0, armpit_y_[2] = {0, 0}, neck_y_ = 0, neck_tilt_ = 0;

@@ -40,6 +40,9 @@ inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-1";
 struct BodyLandmark {
   std::string name;  // e.g. "crotch", "armpit_left", "back_neck_point"
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // mm, on (or in) the body
+  // The mesh's confidence at its nearest vertex (1: measured, 0: invented by hole
+  // filling); the measurements built on it inherit the lowest.
+  float confidence = 1;
 };
 
 struct BodyMeasurement {
@@ -56,7 +59,7 @@ struct BodyMeasurement {
   std::optional<Plane> plane;         // girths
   std::vector<std::string> landmarks;  // names used
   std::string definition;              // how it was taken, one sentence
-  float min_confidence = 1;            // lowest mesh confidence along it
+  float min_confidence = 1;            // lowest mesh confidence along it and at its landmarks
   bool crosses_filled_hole() const { return min_confidence < 0.5f; }
 };
 

@@ -1,7 +1,6 @@
 #include "recon/measure/plane_section.hpp"
 
 #include <algorithm>
-#include <unordered_map>
 
 namespace bodyscan {
 
@@ -32,7 +31,7 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
     uint64_t a, b;
   };
   std::vector<Segment> segments;
-  std::unordered_map<uint64_t, std::vector<uint32_t>> by_edge;  // edge -> segments
+  std::vector<std::pair<uint64_t, uint32_t>> by_edge;  // (edge, segment), sorted by edge
   const size_t count = triangles ? triangles->size() : mesh.triangles.size();
   for (size_t ti = 0; ti < count; ++ti) {
     const Triangle& t = mesh.triangles[triangles ? (*triangles)[ti] : ti];
@@ -46,9 +45,13 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
     if (n != 2) continue;
     const auto s = static_cast<uint32_t>(segments.size());
     segments.push_back({crossed[0], crossed[1]});
-    by_edge[crossed[0]].push_back(s);
-    by_edge[crossed[1]].push_back(s);
+    by_edge.emplace_back(crossed[0], s);
+    by_edge.emplace_back(crossed[1], s);
   }
+  std::sort(by_edge.begin(), by_edge.end());
+  auto first_of = [&](uint64_t edge) {
+    return std::lower_bound(by_edge.begin(), by_edge.end(), std::make_pair(edge, uint32_t{0}));
+  };
   auto point_on = [&](uint64_t key, float* confidence) {
     const auto a = static_cast<uint32_t>(key >> 32), b = static_cast<uint32_t>(key & 0xffffffffu);
     const double da = dist(a), db = dist(b);
@@ -80,15 +83,19 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
       loop.points.push_back(point_on(edge, &c));
       loop.confidence.push_back(c);
       uint32_t next = s;
-      for (uint32_t o : by_edge[edge])
-        if (!used[o]) next = o;
+      for (auto it = first_of(edge); it != by_edge.end() && it->first == edge; ++it)
+        if (!used[it->second]) next = it->second;
       if (next == s) break;  // the mesh's border (or a non-manifold dead end)
       s = next;
     }
     if (loop.points.size() >= 3) loops.push_back(std::move(loop));
   };
-  for (const auto& [edge, segs] : by_edge)
-    if (segs.size() == 1 && !used[segs[0]]) walk(segs[0], edge);
+  for (size_t i = 0; i < by_edge.size();) {
+    size_t j = i + 1;
+    while (j < by_edge.size() && by_edge[j].first == by_edge[i].first) ++j;
+    if (j - i == 1 && !used[by_edge[i].second]) walk(by_edge[i].second, by_edge[i].first);
+    i = j;
+  }
   for (uint32_t s = 0; s < segments.size(); ++s)
     if (!used[s]) walk(s, segments[s].a);
   return loops;

@@ -47,8 +47,20 @@ struct Apex {
 
 class SurfacePaths::Impl {
  public:
-  explicit Impl(const TriangleMesh& mesh) : mesh_(mesh), distance_(mesh) {
+  explicit Impl(const TriangleMesh& mesh) : mesh_(mesh) {
     const size_t nv = mesh.vertices.size(), nt = mesh.triangles.size();
+    centroids_.resize(nt);
+    double edge_sum = 0;
+    for (size_t t = 0; t < nt; ++t) {
+      const Triangle& tr = mesh.triangles[t];
+      centroids_[t] = (vertex(tr[0]) + vertex(tr[1]) + vertex(tr[2])) / 3.0;
+      edge_sum += (vertex(tr[0]) - vertex(tr[1])).norm();
+    }
+    // Vertices sorted into cubic cells about three edges wide, for snapping.
+    cell_ = nt ? std::max(1e-6, 3 * edge_sum / static_cast<double>(nt)) : 1.0;
+    cells_.reserve(nv);
+    for (uint32_t v = 0; v < nv; ++v) cells_.emplace_back(cell_key(cell_of(vertex(v))), v);
+    std::sort(cells_.begin(), cells_.end());
     offset_.assign(nv + 1, 0);
     for (const Triangle& t : mesh.triangles)
       for (uint32_t v : t) ++offset_[v + 1];
@@ -74,13 +86,12 @@ class SurfacePaths::Impl {
   StatusOr<SurfacePath> find(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
                              const SurfacePathOptions& options) const {
     if (mesh_.triangles.empty()) return invalid_argument("the mesh has no triangles");
-    const ClosestPoint a = distance_.closest_point(from.cast<float>());
-    const ClosestPoint b = distance_.closest_point(to.cast<float>());
     SurfacePath out;
-    out.from = a.point.cast<double>();
-    out.to = b.point.cast<double>();
+    uint32_t ta = 0, tb = 0;
+    out.from = snap(from, &ta);
+    out.to = snap(to, &tb);
     out.straight_mm = (out.to - out.from).norm();
-    std::vector<uint32_t> strip = dual_dijkstra(around(a.triangle, out.from), out.from, around(b.triangle, out.to), out.to);
+    std::vector<uint32_t> strip = dual_dijkstra(around(ta, out.from), out.from, around(tb, out.to), out.to);
     if (strip.empty()) {
       return not_found("the two points lie on parts of the surface that do not connect");
     }
@@ -121,9 +132,57 @@ class SurfacePaths::Impl {
     return tr[0] == v || tr[1] == v || tr[2] == v;
   }
   Eigen::Vector3d vertex(uint32_t v) const { return mesh_.vertices[v].cast<double>(); }
-  Eigen::Vector3d centroid(uint32_t t) const {
-    const Triangle& tr = mesh_.triangles[t];
-    return (vertex(tr[0]) + vertex(tr[1]) + vertex(tr[2])) / 3.0;
+  const Eigen::Vector3d& centroid(uint32_t t) const { return centroids_[t]; }
+
+  Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
+    return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / cell_)), static_cast<int>(std::floor(p.y() / cell_)),
+                           static_cast<int>(std::floor(p.z() / cell_)));
+  }
+  static uint64_t cell_key(const Eigen::Vector3i& c) {
+    auto u = [](int x) { return static_cast<uint64_t>(static_cast<uint32_t>(x + (1 << 20))) & 0x1fffffu; };
+    return (u(c.x()) << 42) | (u(c.y()) << 21) | u(c.z());
+  }
+
+  // The surface point nearest p: the nearest vertex (rings of cells outward), then
+  // the nearest point on the triangles round it and round its neighbours.
+  Eigen::Vector3d snap(const Eigen::Vector3d& p, uint32_t* triangle) const {
+    const Eigen::Vector3i c = cell_of(p);
+    uint32_t nearest = 0;
+    double best = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < (1 << 20); ++r) {
+      for (int dx = -r; dx <= r; ++dx)
+        for (int dy = -r; dy <= r; ++dy)
+          for (int dz = -r; dz <= r; ++dz) {
+            if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != r) continue;
+            const uint64_t key = cell_key(c + Eigen::Vector3i(dx, dy, dz));
+            auto it = std::lower_bound(cells_.begin(), cells_.end(), std::make_pair(key, 0u));
+            for (; it != cells_.end() && it->first == key; ++it) {
+              const double d = (vertex(it->second) - p).squaredNorm();
+              if (d < best) best = d, nearest = it->second;
+            }
+          }
+      if (best <= (r * cell_) * (r * cell_)) break;
+      if (r == 16 && !(best < std::numeric_limits<double>::infinity())) {
+        // Far from the surface: every vertex, once.
+        for (uint32_t v = 0; v < mesh_.vertices.size(); ++v) {
+          const double d = (vertex(v) - p).squaredNorm();
+          if (d < best) best = d, nearest = v;
+        }
+        break;
+      }
+    }
+    Eigen::Vector3d out = vertex(nearest);
+    double out_d = std::numeric_limits<double>::infinity();
+    *triangle = incident_.empty() ? 0 : incident_[offset_[nearest]];
+    for (uint32_t k = offset_[nearest]; k < offset_[nearest + 1]; ++k)
+      for (uint32_t u : mesh_.triangles[incident_[k]])
+        for (uint32_t j = offset_[u]; j < offset_[u + 1]; ++j) {
+          const Triangle& tr = mesh_.triangles[incident_[j]];
+          const Eigen::Vector3d q = closest_point_on_triangle(p, vertex(tr[0]), vertex(tr[1]), vertex(tr[2]));
+          const double d = (q - p).squaredNorm();
+          if (d < out_d) out_d = d, out = q, *triangle = incident_[j];
+        }
+    return out;
   }
   // The corner angle of triangle t at its vertex v (radians).
   double corner_angle(uint32_t t, uint32_t v) const {
@@ -171,49 +230,63 @@ class SurfacePaths::Impl {
                                       const std::vector<uint32_t>& goals, const Eigen::Vector3d& g) const {
     for (uint32_t t : starts)
       if (std::find(goals.begin(), goals.end(), t) != goals.end()) return {t};
-    std::vector<double> dist(mesh_.triangles.size(), std::numeric_limits<double>::infinity());
-    std::vector<uint32_t> prev(mesh_.triangles.size(), kNone);
-    std::vector<char> goal(mesh_.triangles.size(), 0);
-    for (uint32_t t : goals) goal[t] = 1;
+    // A* with the straight distance to g as the (consistent) estimate; the arrays
+    // persist between queries and only what a query touched is reset.
+    const size_t nt = mesh_.triangles.size();
+    if (dist_.size() != nt) {
+      dist_.assign(nt, std::numeric_limits<double>::infinity());
+      prev_.assign(nt, kNone);
+      state_.assign(nt, 0);
+    }
+    std::vector<uint32_t> touched;
+    auto reset = [&] {
+      for (uint32_t t : touched) dist_[t] = std::numeric_limits<double>::infinity(), prev_[t] = kNone, state_[t] = 0;
+    };
+    auto estimate = [&](uint32_t t) { return (centroid(t) - g).norm(); };
+    for (uint32_t t : goals) state_[t] |= 1, touched.push_back(t);
     using Item = std::pair<double, uint32_t>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
     for (uint32_t t : starts) {
-      dist[t] = (centroid(t) - s).norm();
-      queue.emplace(dist[t], t);
+      dist_[t] = (centroid(t) - s).norm();
+      touched.push_back(t);
+      queue.emplace(dist_[t] + estimate(t), t);
     }
-    // A goal is reached when popped with its last leg, centroid to g, added.
+    // A goal is reached when popped with its last leg, centroid to g, added (state 2).
     uint32_t reached = kNone;
-    std::vector<char> finishing(mesh_.triangles.size(), 0);
     while (!queue.empty()) {
-      const auto [d, t] = queue.top();
+      const auto [f, t] = queue.top();
       queue.pop();
-      if (finishing[t]) {
+      if (state_[t] & 2) {
         reached = t;
         break;
       }
-      if (d > dist[t]) continue;
-      const Eigen::Vector3d c = centroid(t);
-      if (goal[t]) {
-        finishing[t] = 1;
+      const double d = dist_[t];
+      if (f > d + estimate(t) + 1e-9) continue;
+      const Eigen::Vector3d& c = centroid(t);
+      if (state_[t] & 1) {
+        state_[t] |= 2;
         queue.emplace(d + (c - g).norm(), t);
       }
       for (int i = 0; i < 3; ++i) {
         const uint32_t u = neighbour_[3 * t + i];
-        if (u == kNone) continue;
+        if (u == kNone || (state_[u] & 2)) continue;
         const double du = d + (centroid(u) - c).norm();
-        if (du < dist[u]) {
-          dist[u] = du;
-          prev[u] = t;
-          queue.emplace(du, u);
+        if (du < dist_[u]) {
+          if (dist_[u] == std::numeric_limits<double>::infinity() && prev_[u] == kNone) touched.push_back(u);
+          dist_[u] = du;
+          prev_[u] = t;
+          queue.emplace(du + estimate(u), u);
         }
       }
     }
-    if (reached == kNone) return {};
     std::vector<uint32_t> strip;
-    for (uint32_t t = reached; t != kNone; t = prev[t]) strip.push_back(t);
+    if (reached != kNone)
+      for (uint32_t t = reached; t != kNone; t = prev_[t]) strip.push_back(t);
+    reset();
     std::reverse(strip.begin(), strip.end());
     return strip;
   }
+
 
   // Lays the strip flat, each triangle hinged on the edge it shares with the last.
   std::vector<Flat> unfold(const std::vector<uint32_t>& strip) const {
@@ -467,7 +540,13 @@ class SurfacePaths::Impl {
   }
 
   const TriangleMesh& mesh_;
-  MeshDistance distance_;
+  std::vector<Eigen::Vector3d> centroids_;
+  double cell_ = 1;
+  std::vector<std::pair<uint64_t, uint32_t>> cells_;  // (cell key, vertex), sorted
+  // The search's scratch arrays (one query at a time).
+  mutable std::vector<double> dist_;
+  mutable std::vector<uint32_t> prev_;
+  mutable std::vector<uint8_t> state_;
   std::vector<uint32_t> offset_, incident_;  // vertex -> triangles
   std::vector<uint32_t> neighbour_;          // 3 per triangle: across edge (t[i], t[i+1])
 };

@@ -38,8 +38,9 @@ struct SurfacePathOptions {
   size_t max_reroute_rounds = 10000;
 };
 
-// Shortest paths on one mesh, its adjacency and search tree built once (O(T log T)).
-// Keeps a reference to the mesh, which must outlive it and not change.
+// Shortest paths on one mesh, its adjacency and snapping grid built once
+// (O(T log T)). Keeps a reference to the mesh, which must outlive it and not
+// change. One query at a time (the search keeps its scratch arrays).
 class SurfacePaths {
  public:
   explicit SurfacePaths(const TriangleMesh& mesh);

@@ -244,6 +244,7 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
     });
     HoleFillOptions fill;
     fill.max_hole_area = options.max_hole_area_fraction * surface_area(result.mesh);
+    fill.fairing = options.hole_fairing;
     const HoleFillStats holes = fill_holes(result.mesh, fill);
     st.holes_filled = holes.holes_filled;
     st.hole_area = holes.area_added;

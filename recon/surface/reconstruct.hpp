@@ -16,6 +16,7 @@
 
 #include "recon/core/progress.hpp"
 #include "recon/core/status.hpp"
+#include "recon/geometry/fill_holes.hpp"
 #include "recon/geometry/point_cloud.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 
@@ -64,6 +65,9 @@ struct ReconstructOptions {
   // as the surface's real edge and stay open (a scanned patch, a tube's ends); a
   // body's unseen soles or crown are 1-3 % of its skin.
   double max_hole_area_fraction = 0.05;
+  // How filled patches are shaped (fill_holes.hpp): a membrane spans the opening,
+  // a thin plate continues the surrounding curvature.
+  HoleFairing hole_fairing = HoleFairing::kMembrane;
   int brick_size = 16;
   // Kernels reach this many voxels plus three noise sigmas along their normals
   // (Kernel::band); 0 = their full support.

@@ -47,7 +47,8 @@ void add_body_measurements(const BodyMeasurements& body, nlohmann::json* documen
   d["algorithm"] = kBodyMeasurementsAlgorithm;
   d["floor_y_mm"] = body.floor_y;
   d["landmarks"] = nlohmann::json::array();
-  for (const BodyLandmark& l : body.landmarks) d["landmarks"].push_back({{"name", l.name}, {"position", point_json(l.position)}});
+  for (const BodyLandmark& l : body.landmarks)
+    d["landmarks"].push_back({{"name", l.name}, {"position", point_json(l.position)}, {"confidence", l.confidence}});
   for (const BodyMeasurement& m : body.measurements) d["measurements"].push_back(to_json(m));
   d["skipped"] = body.skipped;
 }
