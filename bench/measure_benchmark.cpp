@@ -45,6 +45,8 @@ double allowance(const BodyMeasurement& m) {
 
 struct Scan {
   TriangleMesh mesh, truth;
+  PointCloud cloud;
+  float voxel = 0;
   std::optional<BodyMeasurements> body;
   double floor = 0;
 };
@@ -69,6 +71,8 @@ StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64
   if (!r.surface_error.empty()) return internal_error("surface: " + r.surface_error);
   Scan s;
   s.mesh = std::move(r.mesh);
+  s.cloud = std::move(r.cloud);
+  s.voxel = r.surface.voxel_size;
   s.body = std::move(r.body);
   if (!s.body) return internal_error("measurements: " + r.measure_error);
   s.truth = sim->scene().subject();  // still for the first scan (no sway)
@@ -98,6 +102,19 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   const double t_scan = secs(t0);
   std::printf("automatic set: %.3f s on the scan (%zu triangles), %.3f s on the truth (%zu triangles)\n", t_scan,
               a->mesh.triangles.size(), t_truth, a->truth.triangles.size());
+  {
+    // The same scan surfaced on a coarser grid, about 500k triangles.
+    ReconstructOptions ro = pipeline::body_surface_options();
+    ro.voxel_size = a->voxel * 1.77f;
+    ro.normal_source = NormalSource::kCameras;
+    auto coarse = reconstruct_surface(a->cloud, ro);
+    if (coarse.ok()) {
+      t0 = Clock::now();
+      auto c = measure_body(coarse->mesh, mo);
+      std::printf("automatic set: %.3f s on the scan surfaced at %.2f mm voxels (%zu triangles)%s\n", secs(t0),
+                  ro.voxel_size, coarse->mesh.triangles.size(), c.ok() ? "" : " (failed)");
+    }
+  }
 
   // Fixed planes: horizontal girths at fractions of the stature, round the torso and
   // each leg as the truth's cut finds them.

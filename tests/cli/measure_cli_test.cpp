@@ -69,6 +69,60 @@ TEST(MeasureCli, GirthsOnAMeshAndAPointCloud) {
   EXPECT_NEAR(nlohmann::json::parse(r.out)["measurements"][0]["value_mm"].get<double>(), 50.0, 1e-12);
 }
 
+TEST(MeasureCli, SurfaceLengthsAndTheAutomaticSet) {
+  const std::string dir = testing::temp_dir();
+  const std::string mesh = dir + "/body.ply";
+  ASSERT_TRUE(write_ply(mesh, torso_and_arm()).ok());
+  // Up the torso's back, 200 mm: a straight line on the wall.
+  CliResult r = bodyscan("measure " + quote(mesh) + " --surface 0,150,-150 --to 0,350,-150", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json m = nlohmann::json::parse(r.out)["measurements"][0];
+  EXPECT_EQ(m["kind"], "surface_length");
+  EXPECT_NEAR(m["value_mm"].get<double>(), 200.0, 0.05);
+  EXPECT_NEAR(m["straight_mm"].get<double>(), 200.0, 0.05);
+  EXPECT_GE(m["path"].size(), 2u);
+  EXPECT_EQ(m["crosses_filled_hole"], false);
+
+  // The whole set on the shipped demo body: the document the scan job writes.
+  const std::string body = BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply";
+  r = bodyscan("measure " + quote(body) + " --auto", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["schema"], "bodyscan.measurements/1");
+  EXPECT_EQ(j["algorithm"], "iso8559-auto-1");
+  EXPECT_NEAR(j["floor_y_mm"].get<double>(), 0.0, 1e-3);
+  EXPECT_TRUE(j["skipped"].empty());
+  EXPECT_GE(j["landmarks"].size(), 20u);
+  bool waist = false;
+  for (const nlohmann::json& x : j["measurements"]) {
+    EXPECT_FALSE(x["name"].get<std::string>().empty());
+    EXPECT_GT(x["value_mm"].get<double>(), 0);
+    EXPECT_FALSE(x["path"].empty()) << x["name"];
+    if (x["name"] == "waist_girth") {
+      waist = true;
+      EXPECT_EQ(x["iso_clause"], "5.3.10");
+      EXPECT_EQ(x["closed"], true);
+      EXPECT_TRUE(x.contains("plane"));
+      EXPECT_NEAR(x["value_mm"].get<double>(), 745, 6);  // the manifest's waist
+    }
+  }
+  EXPECT_TRUE(waist);
+  // A floor given: heights grow by the gap, girths stay.
+  r = bodyscan("measure " + quote(body) + " --auto --floor -10", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const nlohmann::json& x : nlohmann::json::parse(r.out)["measurements"])
+    if (x["name"] == "stature") EXPECT_NEAR(x["value_mm"].get<double>(), 1729.3 + 10, 0.1);
+
+  // What cannot be done says why.
+  r = bodyscan("measure " + quote(mesh) + " --auto", dir);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("measure:"), std::string::npos) << r.err;
+  r = bodyscan("measure " + quote(mesh) + " --floor 0 --girth-y 300", dir);
+  EXPECT_EQ(r.exit_code, 2);
+  r = bodyscan("measure " + quote(mesh) + " --surface 0,0,0", dir);  // no --to
+  EXPECT_EQ(r.exit_code, 2);
+}
+
 TEST(MeasureCli, BadInputIsAClearError) {
   const std::string dir = testing::temp_dir();
   const std::string mesh = dir + "/body.ply";
