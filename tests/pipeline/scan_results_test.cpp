@@ -1,0 +1,66 @@
+// What the scan job leaves on disk: the measurements document beside the mesh, and
+// the cloud kept when the surface fails.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "recon/io/ply.hpp"
+#include "server/pipeline/scan_job.hpp"
+#include "tests/test_data.hpp"
+
+namespace bodyscan::pipeline {
+namespace {
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+TEST(ScanResults, MeasurementsSitBesideTheMesh) {
+  auto body = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/female_average.ply");
+  ASSERT_TRUE(body.ok());
+  ScanJobResult r;
+  r.cloud.positions = body->vertices;  // any cloud will do
+  r.mesh = *body;
+  BodyMeasureOptions mo;
+  mo.floor_y = -2;
+  auto m = measure_body(r.mesh, mo);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  r.body = *m;
+  const std::string dir = testing::temp_dir() + "/scan";
+  ASSERT_TRUE(write_scan_results(r, dir).ok());
+  const nlohmann::json j = read_json(dir + "/measurements.json");
+  EXPECT_EQ(j["schema"], "bodyscan.measurements/1");
+  EXPECT_EQ(j["file"], "mesh.ply");
+  EXPECT_NEAR(j["floor_y_mm"].get<double>(), -2.0, 1e-9);
+  ASSERT_EQ(j["measurements"].size(), m->measurements.size());
+  for (size_t i = 0; i < m->measurements.size(); ++i) {
+    EXPECT_EQ(j["measurements"][i]["name"], m->measurements[i].name);
+    EXPECT_DOUBLE_EQ(j["measurements"][i]["value_mm"].get<double>(), m->measurements[i].value_mm);
+  }
+  EXPECT_EQ(j["landmarks"].size(), m->landmarks.size());
+  EXPECT_TRUE(std::filesystem::exists(dir + "/mesh.ply"));
+  EXPECT_FALSE(read_json(dir + "/scan.json").contains("surface_error"));
+}
+
+TEST(ScanResults, AFailedSurfaceKeepsTheCloudAndSaysWhy) {
+  ScanJobResult r;
+  r.cloud.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  r.surface_error = "the surface needs 31693330 bricks";
+  r.measure_error = "";
+  const std::string dir = testing::temp_dir() + "/scan";
+  ASSERT_TRUE(write_scan_results(r, dir).ok());
+  EXPECT_TRUE(std::filesystem::exists(dir + "/points.ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/mesh.ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/measurements.json"));
+  const nlohmann::json s = read_json(dir + "/scan.json");
+  EXPECT_EQ(s["surface_error"], r.surface_error);
+  auto back = read_ply(dir + "/points.ply");
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(back->cloud.positions.size(), 3u);
+}
+
+}  // namespace
+}  // namespace bodyscan::pipeline
