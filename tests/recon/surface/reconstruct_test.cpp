@@ -79,6 +79,25 @@ TEST(ReconstructSurface, UnitSphereWithoutNormals) {
   }
 }
 
+TEST(ReconstructSurface, IsolatedStraysGetNoKernel) {
+  // A sphere and three stray points far off (a floor sample, a speck): each would
+  // get a kernel as wide as the gap to its neighbours and the grid with it.
+  PointCloud c = fibonacci_sphere(4096, 1.0);
+  for (const Vec3f p : {Vec3f(12, 0, 0), Vec3f(0, -9, 7), Vec3f(-15, 4, 0)}) {
+    c.positions.push_back(p);
+    c.normals.push_back(Vec3f::UnitY());
+  }
+  const ReconstructResult r = run(c);
+  expect_closed_single(r.mesh, "sphere with strays");
+  EXPECT_EQ(r.stats.isolated_points, 3u);
+  for (const Vec3f& v : r.mesh.vertices) EXPECT_LT(v.norm(), 1.1f);
+  EXPECT_LT(radial_rms(r.mesh, 1.0), 0.002);
+  ReconstructOptions keep;
+  keep.isolated_spacing_ratio = 0;
+  auto all = reconstruct_surface(c, keep);
+  if (all.ok()) EXPECT_EQ(all->stats.isolated_points, 0u);
+}
+
 TEST(ReconstructSurface, NoisyUnitSphere) {
   // Noise 0.01 per axis, about 0.18 of the spacing (0.055).
   PointCloud c = without_normals(fibonacci_sphere(4096, 1.0));
