@@ -4,7 +4,7 @@
 // scans (other noise, a swaying subject), and the time the automatic set takes.
 //
 //   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
-//                     [--sway MM] [--every N]
+//                     [--sway MM] [--every N] [--fairing membrane|thin|auto]
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
 // 9 mm off on large girths, 4 mm on small girths and heights, 5 mm on lengths; the
@@ -51,6 +51,8 @@ struct Scan {
   double floor = 0;
 };
 
+HoleFairing g_fairing = pipeline::body_surface_options().hole_fairing;
+
 StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64_t seed, double sway, int every) {
   std::string path = rig_name;
   if (rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos) {
@@ -67,6 +69,7 @@ StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64
                                           : hw::sim::SimulatedRig::create(desc, subject));
   pipeline::ScanJobOptions o;
   o.every = every;
+  o.surface.hole_fairing = g_fairing;
   ASSIGN_OR_RETURN(pipeline::ScanJobResult r, pipeline::run_scan_job(pipeline::rig_handle(*sim), o));
   if (!r.surface_error.empty()) return internal_error("surface: " + r.surface_error);
   Scan s;
@@ -105,6 +108,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   {
     // The same scan surfaced on a coarser grid, about 500k triangles.
     ReconstructOptions ro = pipeline::body_surface_options();
+    ro.hole_fairing = g_fairing;
     ro.voxel_size = a->voxel * 1.77f;
     ro.normal_source = NormalSource::kCameras;
     auto coarse = reconstruct_surface(a->cloud, ro);
@@ -212,7 +216,12 @@ int main(int argc, char** argv) {
     else if (a == "--repeat") repeat = true;
     else if (a == "--sway" && i + 1 < argc) sway = std::atof(argv[++i]);
     else if (a == "--every" && i + 1 < argc) every = std::atoi(argv[++i]);
-    else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N]\n"), 2;
+    else if (a == "--fairing" && i + 1 < argc) {
+      const std::string f = argv[++i];
+      g_fairing = f == "membrane" ? HoleFairing::kMembrane : f == "thin" ? HoleFairing::kThinPlate : HoleFairing::kAuto;
+    }
+    else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
+                        "[--fairing membrane|thin|auto]\n"), 2;
   }
   if (rigs.empty()) rigs = {"thesis"};
   if (bodies.empty()) bodies = {""};

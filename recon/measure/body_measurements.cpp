@@ -480,7 +480,10 @@ class Finder {
         const double t = deg * M_PI / 180;
         Plane p{neck_c_, Eigen::Vector3d(0, std::cos(t), std::sin(t))};
         StatusOr<Girth> g = mesh_girth(mesh_, p, neck_c_, &tris);
-        if (g.ok() && (!best.ok() || g->value_mm < best->value_mm)) best = std::move(g), neck_tilt_ = deg;
+        // Only a loop round the neck counts (a steep cut can leave the part of the
+        // mesh searched, and a scrap of ear or chin would win).
+        if (g.ok() && winds_round(g->loop, neck_c_, p.normal) && (!best.ok() || g->value_mm < best->value_mm))
+          best = std::move(g), neck_tilt_ = deg;
       };
       for (double d = -40; d <= 40; d += 4) cut(d);
       const double centre = neck_tilt_;

@@ -382,7 +382,17 @@ class SurfacePaths::Impl {
     std::vector<Apex> apexes{{0, true}};
     Eigen::Vector2d apex = portals[0].left2, left = apex, right = apex;
     size_t apex_i = 0, left_i = 0, right_i = 0;
-    for (size_t i = 1; i < portals.size(); ++i) {
+    size_t i = 1;
+    // A new corner at one leg's end: the funnel starts again from there.
+    auto restart = [&](bool on_left) {
+      apex_i = on_left ? left_i : right_i;
+      apexes.push_back({apex_i, on_left});
+      apex = on_left ? left : right;
+      left = right = apex;
+      left_i = right_i = apex_i;
+      i = apex_i;
+    };
+    for (; i < portals.size(); ++i) {
       const Eigen::Vector2d& l = portals[i].left2;
       const Eigen::Vector2d& r = portals[i].right2;
       if (cross2(right - apex, r - apex) >= 0) {  // r tightens the right leg
@@ -390,12 +400,7 @@ class SurfacePaths::Impl {
           right = r;
           right_i = i;
         } else {  // crosses the left leg: the path turns round the left leg's end
-          apexes.push_back({left_i, true});
-          apex = left;
-          apex_i = left_i;
-          left = right = apex;
-          left_i = right_i = apex_i;
-          i = apex_i;
+          restart(true);
           continue;
         }
       }
@@ -404,12 +409,7 @@ class SurfacePaths::Impl {
           left = l;
           left_i = i;
         } else {
-          apexes.push_back({right_i, false});
-          apex = right;
-          apex_i = right_i;
-          left = right = apex;
-          left_i = right_i = apex_i;
-          i = apex_i;
+          restart(false);
           continue;
         }
       }

@@ -20,11 +20,10 @@ namespace bodyscan::pipeline {
 inline ReconstructOptions body_surface_options() {
   ReconstructOptions o;
   o.max_hole_area_fraction = 1.0;
-  // The unseen crown and crotch are openings in a curved surface: a thin plate
-  // continues the curvature round them (a membrane lays the crown 14 mm flat; on
-  // the thesis rig's scan of male_average the filled skin lies 3.0 mm mean, 10 mm
-  // p95 from the truth against 3.8 and 18 mm; docs/measurements.md).
-  o.hole_fairing = HoleFairing::kThinPlate;
+  // The unseen crown is a cap on a curved surface: a thin plate continues the
+  // curvature over it, where a membrane lays it 14 mm flat; the slot up the insides
+  // of the legs keeps the membrane, which a thin plate balloons (docs/measurements.md).
+  o.hole_fairing = HoleFairing::kAuto;
   return o;
 }
 
