@@ -4,7 +4,9 @@
 // scans (other noise, a swaying subject), and the time the automatic set takes.
 //
 //   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
-//                     [--sway MM] [--every N] [--fairing membrane|thin|auto]
+//                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR]
+//
+// --save writes each scan's surface and the posed true body as PLY into DIR.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
 // 9 mm off on large girths, 4 mm on small girths and heights, 5 mm on lengths; the
@@ -52,6 +54,7 @@ struct Scan {
 };
 
 HoleFairing g_fairing = pipeline::body_surface_options().hole_fairing;
+std::string g_save;
 
 StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64_t seed, double sway, int every) {
   std::string path = rig_name;
@@ -94,6 +97,11 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   auto a = scan(rig, body, 1, 0, every);
   if (!a.ok()) return std::fprintf(stderr, "scan: %s\n", a.status().message().c_str()), 1;
   std::printf("scan job %.0f s, mesh %zu triangles\n", secs(t0), a->mesh.triangles.size());
+  if (!g_save.empty()) {
+    const std::string stem = g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
+    const Status w1 = write_ply(stem + "-scan.ply", a->mesh), w2 = write_ply(stem + "-truth.ply", a->truth);
+    if (!w1.ok() || !w2.ok()) std::fprintf(stderr, "--save: %s\n", (w1.ok() ? w2 : w1).message().c_str());
+  }
   BodyMeasureOptions mo;
   mo.floor_y = a->floor;
   t0 = Clock::now();
@@ -216,12 +224,13 @@ int main(int argc, char** argv) {
     else if (a == "--repeat") repeat = true;
     else if (a == "--sway" && i + 1 < argc) sway = std::atof(argv[++i]);
     else if (a == "--every" && i + 1 < argc) every = std::atoi(argv[++i]);
+    else if (a == "--save" && i + 1 < argc) g_save = argv[++i];
     else if (a == "--fairing" && i + 1 < argc) {
       const std::string f = argv[++i];
-      g_fairing = f == "membrane" ? HoleFairing::kMembrane : f == "thin" ? HoleFairing::kThinPlate : HoleFairing::kAuto;
+      g_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
     }
     else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
-                        "[--fairing membrane|thin|auto]\n"), 2;
+                        "[--fairing membrane|thin]\n"), 2;
   }
   if (rigs.empty()) rigs = {"thesis"};
   if (bodies.empty()) bodies = {""};

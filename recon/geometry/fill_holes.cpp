@@ -1,6 +1,5 @@
 #include "recon/geometry/fill_holes.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -473,26 +472,6 @@ class HolePatch {
 
 }  // namespace
 
-// Whether a boundary loop is the rim of a cap over a convex end (the crown): round
-// (its two in-plane spreads within a factor 1.6 of each other) and bent out of its
-// plane (RMS off the best-fit plane over a quarter of the RMS spread), where a thin
-// plate continues the end's curvature. A slot up a limb is long and narrow, a
-// window in a flank flat: a membrane spans those without ballooning.
-bool cap_rim(const TriangleMesh& mesh, const std::vector<uint32_t>& loop) {
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (uint32_t v : loop) c += mesh.vertices[v].cast<double>();
-  c /= static_cast<double>(loop.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (uint32_t v : loop) {
-    const Eigen::Vector3d d = mesh.vertices[v].cast<double>() - c;
-    cov += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-  const Eigen::Vector3d l = es.eigenvalues();  // ascending
-  const double spread = l.sum();
-  return spread > 0 && l(1) > 0.4 * l(2) && l(0) > 0.06 * spread;
-}
-
 HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
   HoleFillStats stats;
   const size_t original_vertices = mesh.vertices.size();
@@ -525,11 +504,7 @@ HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
       continue;
     }
     if (options.refine) patch.refine();
-    if (options.fairing != HoleFairing::kNone) {
-      const bool thin_plate = options.fairing == HoleFairing::kThinPlate ||
-                              (options.fairing == HoleFairing::kAuto && cap_rim(mesh, loop));
-      patch.fair(loop, thin_plate);
-    }
+    if (options.fairing != HoleFairing::kNone) patch.fair(loop, options.fairing == HoleFairing::kThinPlate);
     stats.area_added += patch.area();
     for (const Triangle& t : patch.triangles()) {
       added_triangles.push_back(t);

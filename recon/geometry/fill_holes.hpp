@@ -31,10 +31,7 @@
 
 namespace bodyscan {
 
-// kAuto: a thin plate for holes whose rim is a cap's over a convex end (round and
-// bent out of its plane: the crown), a membrane for the rest (slots up the limbs,
-// windows in the flanks, twisted loops, where a thin plate balloons).
-enum class HoleFairing { kNone, kMembrane, kThinPlate, kAuto };
+enum class HoleFairing { kNone, kMembrane, kThinPlate };
 
 struct HoleFillOptions {
   // Loops with more boundary edges than this stay open (0 = fill every loop).

@@ -100,6 +100,22 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Ve
   return {c, d};
 }
 
+// Where a sampled profile's extreme is, made stable where the profile is flat (a
+// heavy waist, a wrist): the middle of the run of samples round sample k within
+// `tol` of it. The arg-min of a flat profile wanders with the scan's noise; the
+// middle of the flat run does not.
+size_t settle(const std::vector<double>& v, size_t k, double tol) {
+  size_t a = k, b = k;
+  while (a > 0 && std::abs(v[a - 1] - v[k]) <= tol) --a;
+  while (b + 1 < v.size() && std::abs(v[b + 1] - v[k]) <= tol) ++b;
+  return (a + b) / 2;
+}
+
+size_t arg_extreme(const std::vector<double>& v, bool largest) {
+  return static_cast<size_t>((largest ? std::max_element(v.begin(), v.end()) : std::min_element(v.begin(), v.end())) -
+                             v.begin());
+}
+
 // Whether a loop in the plane with normal n winds round p (the loop is the limb's
 // own, not a neighbour's that the nearest-loop rule fell back to).
 bool winds_round(const std::vector<Eigen::Vector3d>& loop, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
@@ -174,7 +190,7 @@ class Finder {
   // --- landmarks -------------------------------------------------------------
 
   Status find_axis() {
-    const std::vector<Ring> r = rings(at(0.55));
+    const std::vector<Ring>& r = rings(at(0.55));
     const Ring* best = nullptr;
     for (const Ring& x : r)
       if (!best || x.girth > best->girth) best = &x;
@@ -192,7 +208,7 @@ class Finder {
     for (double y = prev + step; y <= at(0.65); y += step) {
       if (merged(y)) {
         crotch_y_ = bisect(prev, y, merged);
-        const std::vector<Ring> r = rings(crotch_y_ + 0.5);
+        const std::vector<Ring>& r = rings(crotch_y_ + 0.5);
         double f = zc_, b = zc_;
         if (const Ring* m = midline(r, xc_)) m->crossing_z(xc_, &f, &b);
         landmark("crotch", {xc_, crotch_y_, 0.5 * (f + b)});
@@ -214,7 +230,7 @@ class Finder {
     const double armpit = bisect(y, last, arm);
     armpit_y_[s > 0 ? 0 : 1] = armpit;
     // The armpit: halfway across the last gap between arm and torso.
-    const std::vector<Ring> r = rings(armpit - 0.5);
+    const std::vector<Ring>& r = rings(armpit - 0.5);
     const Ring* a = side_ring(r, xc_, s, true);
     const Ring* t = midline(r, xc_);
     Eigen::Vector3d p(xc_ + s * 0.1 * h_, armpit, zc_);
@@ -244,13 +260,15 @@ class Finder {
 
   Status find_neck() {
     const double ya = std::max(armpit_y_[0], armpit_y_[1]);
-    double best = kInf;
+    std::vector<double> ys, gs;
+    std::vector<Eigen::Vector3d> cs;
     for (double y = ya + 0.04 * h_; y <= floor_ + h_ - 0.09 * h_; y += 2) {
-      const std::vector<Ring> r = rings(y);
-      const Ring* m = midline(r, xc_);
-      if (m && m->girth < best) best = m->girth, neck_y_ = y, neck_c_ = m->centroid;
+      const std::vector<Ring>& r = rings(y);
+      if (const Ring* m = midline(r, xc_)) ys.push_back(y), gs.push_back(m->girth), cs.push_back(m->centroid);
     }
-    if (!(best < kInf)) return not_found("measure: no neck found between the armpits and the head");
+    if (ys.empty()) return not_found("measure: no neck found between the armpits and the head");
+    const size_t k = settle(gs, arg_extreme(gs, false), 1.0);
+    neck_y_ = ys[k], neck_c_ = cs[k];
     landmark("neck_level", neck_c_);
     return Status();
   }
@@ -261,7 +279,7 @@ class Finder {
     double w0 = -1;
     const double ya = std::max(armpit_y_[0], armpit_y_[1]);
     for (double y = neck_y_; y > ya; y -= 2) {
-      const std::vector<Ring> r = rings(y);
+      const std::vector<Ring>& r = rings(y);
       const Ring* m = midline(r, xc_);
       if (!m) break;
       Eigen::Vector3d e = m->points.front();
@@ -315,12 +333,12 @@ class Finder {
   void find_neck_points() {
     const double y_snp = 0.5 * (lm("side_neck_point_left").y() + lm("side_neck_point_right").y());
     double f = neck_c_.z(), b = neck_c_.z();
-    const std::vector<Ring> rr = rings(y_snp);
+    const std::vector<Ring>& rr = rings(y_snp);
     if (const Ring* m = midline(rr, xc_)) m->crossing_z(xc_, &f, &b);
     landmark("back_neck_point", {xc_, y_snp, b});
     std::vector<Eigen::Vector2d> curve;  // (y, front z), top down
     for (double y = neck_y_; y >= y_snp - 0.08 * h_; y -= 2) {
-      const std::vector<Ring> r = rings(y);
+      const std::vector<Ring>& r = rings(y);
       double fz = 0, bz = 0;
       const Ring* m = midline(r, xc_);
       if (m && m->crossing_z(xc_, &fz, &bz)) curve.emplace_back(y, fz);
@@ -341,13 +359,19 @@ class Finder {
   void find_torso_levels() {
     const double ya = std::min(armpit_y_[0], armpit_y_[1]);
     // Bust: the chest's most forward point.
-    double best = -kInf;
-    for (double y = ya - 0.12 * h_; y <= ya - 0.01 * h_; y += 2) {
-      const std::vector<Ring> r = rings(y);
-      if (const Ring* m = midline(r, xc_); m && m->z_max > best) best = m->z_max, bust_y_ = y;
-    }
+    auto profile = [&](double y0, double y1, const std::function<double(const Ring&)>& f, bool largest, double tol,
+                       double fallback) {
+      std::vector<double> ys, vs;
+      for (double y = y0; y <= y1; y += 2) {
+        const std::vector<Ring>& r = rings(y);
+        if (const Ring* m = midline(r, xc_)) ys.push_back(y), vs.push_back(f(*m));
+      }
+      return ys.empty() ? fallback : ys[settle(vs, arg_extreme(vs, largest), tol)];
+    };
+    bust_y_ = profile(ya - 0.12 * h_, ya - 0.01 * h_, [](const Ring& m) { return m.z_max; }, true, 0.5,
+                      ya - 0.06 * h_);
     {
-      const std::vector<Ring> r = rings(bust_y_);
+      const std::vector<Ring>& r = rings(bust_y_);
       const Ring* m = midline(r, xc_);
       for (int s : {1, -1}) {
         Eigen::Vector3d p(xc_ + s * 0.05 * h_, bust_y_, zc_);
@@ -364,7 +388,7 @@ class Finder {
       const double xs = 0.5 * (lm("bust_point_left").x() - lm("bust_point_right").x());
       std::vector<Eigen::Vector2d> curve;
       for (double y = bust_y_; y >= bust_y_ - 0.1 * h_; y -= 2) {
-        const std::vector<Ring> r = rings(y);
+        const std::vector<Ring>& r = rings(y);
         double f = 0, b = 0, f2 = 0, b2 = 0;
         const Ring* m = midline(r, xc_);
         if (m && m->crossing_z(xb + xs, &f, &b) && m->crossing_z(xb - xs, &f2, &b2))
@@ -382,29 +406,22 @@ class Finder {
       landmark("underbust_front_point", {xc_, underbust_y_, front_z(underbust_y_)});
     }
     // Hip: the buttocks' greatest backward projection.
-    best = kInf;
-    hip_y_ = crotch_y_ + 0.08 * h_;
+    hip_y_ = profile(crotch_y_ + 0.01 * h_, crotch_y_ + 0.16 * h_, [](const Ring& m) { return m.z_min; }, false, 0.5,
+                     crotch_y_ + 0.08 * h_);
     Eigen::Vector3d hip_point(xc_, hip_y_, zc_);
-    for (double y = crotch_y_ + 0.01 * h_; y <= crotch_y_ + 0.16 * h_; y += 2) {
-      const std::vector<Ring> r = rings(y);
-      if (const Ring* m = midline(r, xc_); m && m->z_min < best) {
-        best = m->z_min, hip_y_ = y;
+    {
+      const std::vector<Ring>& r = rings(hip_y_);
+      if (const Ring* m = midline(r, xc_))
         for (const Eigen::Vector3d& p : m->points)
           if (p.z() == m->z_min) hip_point = p;
-      }
     }
     landmark("hip_back_point", hip_point);
     // Waist: the narrowest torso between hip and under-bust.
     double lo = std::max(hip_y_ + 0.04 * h_, at(0.55)), hi = std::min(underbust_y_ - 0.02 * h_, at(0.70));
     if (lo >= hi) lo = hip_y_ + 0.04 * h_, hi = underbust_y_ - 0.02 * h_;
-    best = kInf;
-    waist_y_ = 0.5 * (lo + hi);
-    for (double y = lo; y <= hi; y += 2) {
-      const std::vector<Ring> r = rings(y);
-      if (const Ring* m = midline(r, xc_); m && m->girth < best) best = m->girth, waist_y_ = y;
-    }
+    waist_y_ = profile(lo, hi, [](const Ring& m) { return m.girth; }, false, 2.0, 0.5 * (lo + hi));
     double f = zc_, b = zc_;
-    const std::vector<Ring> rr = rings(waist_y_);
+    const std::vector<Ring>& rr = rings(waist_y_);
     if (const Ring* m = midline(rr, xc_)) m->crossing_z(xc_, &f, &b);
     landmark("waist_back_point", {xc_, waist_y_, b});
     landmark("waist_front_point", {xc_, waist_y_, f});
@@ -412,7 +429,7 @@ class Finder {
 
   double front_z(double y) const {
     double f = zc_, b = zc_;
-    const std::vector<Ring> rr = rings(y);
+    const std::vector<Ring>& rr = rings(y);
     if (const Ring* m = midline(rr, xc_)) m->crossing_z(xc_, &f, &b);
     return f;
   }
@@ -519,7 +536,7 @@ class Finder {
     {
       double best = -kInf, yb = hip_y_;
       for (double y = crotch_y_ + 0.01 * h_; y <= waist_y_; y += 2) {
-        const std::vector<Ring> r = rings(y);
+        const std::vector<Ring>& r = rings(y);
         if (const Ring* m = midline(r, xc_); m && m->girth > best) best = m->girth, yb = y;
       }
       girth("max_hip_girth", "Maximum hip girth", "5.3.14", level_girth(yb, near(yb)), {"crotch", "waist_back_point"},
@@ -536,14 +553,16 @@ class Finder {
   void measure_leg(int s) {
     const std::string sd = side(s);
     auto extreme = [&](double y0, double y1, bool largest, double* y_at) {
-      double best = largest ? -kInf : kInf;
-      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      std::vector<double> ys, gs;
+      std::vector<Eigen::Vector3d> cs;
       for (double y = y0; y <= y1; y += 2) {
-        const std::vector<Ring> r = rings(y);
-        const Ring* l = leg(r, s);
-        if (l && (largest ? l->girth > best : l->girth < best)) best = l->girth, *y_at = y, c = l->centroid;
+        const std::vector<Ring>& r = rings(y);
+        if (const Ring* l = leg(r, s)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
       }
-      return c;
+      if (ys.empty()) return Eigen::Vector3d(xc_ + s * 0.05 * h_, *y_at, zc_);
+      const size_t k = settle(gs, arg_extreme(gs, largest), 1.0);
+      *y_at = ys[k];
+      return cs[k];
     };
     double ty = crotch_y_ - 0.02 * h_;
     const Eigen::Vector3d tc = extreme(crotch_y_ - 0.05 * h_, crotch_y_ - 0.005 * h_, true, &ty);
@@ -555,7 +574,7 @@ class Finder {
     std::vector<double> ys, gs;
     std::vector<Eigen::Vector3d> cs;
     for (double y = at(0.18); y <= at(0.36); y += 2) {
-      const std::vector<Ring> r = rings(y);
+      const std::vector<Ring>& r = rings(y);
       if (const Ring* l = leg(r, s)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
     }
     if (gs.size() < 10) {
@@ -570,13 +589,14 @@ class Finder {
       for (size_t j = i >= 5 ? i - 5 : 0; j < std::min(gs.size(), i + 6); ++j) minimum = minimum && gs[j] >= gs[i];
       if (minimum && i > 0 && i + 1 < gs.size() && gs[i] < deepest) deepest = gs[i], kk = i;
     }
-    if (!(deepest < kInf)) kk = static_cast<size_t>(std::min_element(gs.begin(), gs.end()) - gs.begin());
+    if (!(deepest < kInf)) kk = arg_extreme(gs, false);
+    kk = settle(gs, kk, 1.0);
     const double ky = ys[kk];
     const Eigen::Vector3d kc = cs[kk];
     double cy = at(0.2);
     const Eigen::Vector3d cc = extreme(at(0.10), ky, true, &cy);
     {
-      const std::vector<Ring> r = rings(ky);
+      const std::vector<Ring>& r = rings(ky);
       const Ring* l = leg(r, s);
       landmark("knee_" + sd, {kc.x(), ky, l ? l->z_max : kc.z()});
     }
@@ -585,7 +605,7 @@ class Finder {
     girth("knee_girth_" + sd, "Knee girth (" + sd + ")", "5.3.22", level_girth(ky, kc), {"knee_" + sd},
           "horizontal, the narrowest cut of the leg between calf and thigh (18-36 % of the height)");
     const double my = 0.5 * (crotch_y_ + ky);
-    const std::vector<Ring> mr = rings(my);
+    const std::vector<Ring>& mr = rings(my);
     const Ring* ml = leg(mr, s);
     girth("mid_thigh_girth_" + sd, "Mid-thigh girth (" + sd + ")", "5.3.21",
           ml ? level_girth(my, ml->centroid) : StatusOr<Girth>(not_found("no leg at mid-thigh")), {"crotch", "knee_" + sd},
@@ -604,7 +624,7 @@ class Finder {
     std::vector<Eigen::Vector3d> c;  // centroids, armpit downwards
     std::vector<double> g;
     for (double y = ya - 3; y > floor_; y -= 3) {
-      const std::vector<Ring> r = rings(y);
+      const std::vector<Ring>& r = rings(y);
       const Ring* a = side_ring(r, xc_, s, true);
       // Past the crotch the leg is on this side too: stop when the arm is gone, or
       // splits into fingers.
@@ -623,6 +643,7 @@ class Finder {
     size_t w = n - 4;
     for (size_t i = n * 55 / 100; i + 3 < n; ++i)
       if (g[i] < g[w]) w = i;
+    w = settle(g, w, 1.0);
     // Elbow: where the axis bends (two lines fitted to the centroids, wrist to armpit).
     size_t e = w / 2;
     double best = kInf;

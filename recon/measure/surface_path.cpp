@@ -43,6 +43,27 @@ struct Apex {
   bool left;
 };
 
+// The length of the polyline through the points at every `step` of arc length
+// along `path` (and its last point).
+double chord_length(const std::vector<Eigen::Vector3d>& path, double step) {
+  if (path.size() < 2) return 0;
+  double length = 0, carried = 0;  // arc length since the last chord point
+  Eigen::Vector3d last = path.front();
+  for (size_t i = 1; i < path.size(); ++i) {
+    const Eigen::Vector3d a = path[i - 1], b = path[i];
+    const double seg = (b - a).norm();
+    double at = step - carried;  // where along this segment the next chord point falls
+    while (at <= seg) {
+      const Eigen::Vector3d p = a + (at / seg) * (b - a);
+      length += (p - last).norm();
+      last = p;
+      at += step;
+    }
+    carried = seg - (at - step);
+  }
+  return length + (path.back() - last).norm();
+}
+
 }  // namespace
 
 class SurfacePaths::Impl {
@@ -115,6 +136,8 @@ class SurfacePaths::Impl {
         const std::vector<Flat> f = shorter ? flat : unfold(strip);
         const std::vector<Portal> p = shorter ? portals : make_portals(strip, f, out.from, out.to);
         trace(strip, p, shorter ? apexes : funnel(p), &out);
+        out.path_mm = out.value_mm;
+        if (options.tape_step_mm > 0) out.value_mm = chord_length(out.path, options.tape_step_mm);
         return out;
       }
     }

@@ -20,10 +20,11 @@ namespace bodyscan::pipeline {
 inline ReconstructOptions body_surface_options() {
   ReconstructOptions o;
   o.max_hole_area_fraction = 1.0;
-  // The unseen crown is a cap on a curved surface: a thin plate continues the
-  // curvature over it, where a membrane lays it 14 mm flat; the slot up the insides
-  // of the legs keeps the membrane, which a thin plate balloons (docs/measurements.md).
-  o.hole_fairing = HoleFairing::kAuto;
+  // What a scan leaves unseen (crown, flanks, shoulders' tops, the insides of the
+  // legs) is curved skin: a thin plate continues the curvature over it, where a
+  // membrane spans it flat - the crown 9-15 mm low. Measured both ways in
+  // docs/benchmarks.md §7.
+  o.hole_fairing = HoleFairing::kThinPlate;
   return o;
 }
 

@@ -31,8 +31,11 @@ TEST(SurfacePath, AroundACylinderItIsTheHelixOfTheUnrolledWall) {
   auto p = mesh_surface_path(body, a, b);
   ASSERT_TRUE(p.ok()) << p.status().message();
   const double expected = std::hypot(180 * side, 300.0);
-  EXPECT_NEAR(p->value_mm, expected, 1e-3);
-  EXPECT_NEAR(polyline_length(p->path), p->value_mm, 1e-6);
+  EXPECT_NEAR(p->path_mm, expected, 1e-3);
+  EXPECT_NEAR(polyline_length(p->path), p->path_mm, 1e-6);
+  // On smooth skin the tape's chords lose almost nothing (radius 150: 0.01 mm).
+  EXPECT_NEAR(p->value_mm, p->path_mm, 0.05);
+  EXPECT_LE(p->value_mm, p->path_mm + 1e-9);
   EXPECT_NEAR((p->path.front() - a).norm(), 0, 1e-3);
   EXPECT_NEAR((p->path.back() - b).norm(), 0, 1e-3);
   EXPECT_NEAR(p->straight_mm, (b - a).norm(), 1e-3);
@@ -53,8 +56,8 @@ TEST(SurfacePath, OnACoarsePrismTheStripIsPulledStraight) {
   const Eigen::Vector3d a(c[0].x(), 20, c[0].y()), b(c[5].x(), 380, c[5].y());
   auto p = mesh_surface_path(body, a, b);
   ASSERT_TRUE(p.ok()) << p.status().message();
-  EXPECT_NEAR(p->value_mm, std::hypot(5 * side, 360.0), 1e-3);
-  EXPECT_NEAR(polyline_length(p->path), p->value_mm, 1e-6);
+  EXPECT_NEAR(p->path_mm, std::hypot(5 * side, 360.0), 1e-3);
+  EXPECT_NEAR(polyline_length(p->path), p->path_mm, 1e-6);
 }
 
 // A cube of side 10 * n centred on (0, 50, 0) (y from 0 to 100 for n = 10), each face
@@ -95,17 +98,17 @@ TEST(SurfacePath, OverACubesEdgesItTakesTheShortestUnfolding) {
   // From the top's centre down a side face: unfolded about the top edge.
   auto p = mesh_surface_path(cube, {0, 100, 0}, {50, 30, 20});
   ASSERT_TRUE(p.ok()) << p.status().message();
-  EXPECT_NEAR(p->value_mm, std::hypot(50.0 + 70.0, 20.0), 1e-3);
+  EXPECT_NEAR(p->path_mm, std::hypot(50.0 + 70.0, 20.0), 1e-3);
   // Across the top between opposite faces (round the sides would be 190).
   auto q = mesh_surface_path(cube, {50, 70, -20}, {-50, 80, 30});
   ASSERT_TRUE(q.ok()) << q.status().message();
-  EXPECT_NEAR(q->value_mm, std::hypot(30.0 + 100.0 + 20.0, 50.0), 1e-3);
-  EXPECT_NEAR(polyline_length(q->path), q->value_mm, 1e-6);
+  EXPECT_NEAR(q->path_mm, std::hypot(30.0 + 100.0 + 20.0, 50.0), 1e-3);
+  EXPECT_NEAR(polyline_length(q->path), q->path_mm, 1e-6);
   // Past a corner: from one side face to the top's far corner region, the path may
   // not run through the corner vertex (270 degrees round it: never the shortest way).
   auto c = mesh_surface_path(cube, {50, 60, 40}, {40, 100, 20});
   ASSERT_TRUE(c.ok()) << c.status().message();
-  EXPECT_NEAR(c->value_mm, std::hypot(40.0 + 10.0, 20.0), 1e-3);
+  EXPECT_NEAR(c->path_mm, std::hypot(40.0 + 10.0, 20.0), 1e-3);
   for (const Eigen::Vector3d& x : c->path)
     EXPECT_GT((x - Eigen::Vector3d(50, 100, 50)).norm(), 1.0);
 }
@@ -119,9 +122,9 @@ TEST(SurfacePath, OnASphereItFollowsTheGreatCircle) {
     auto p = mesh_surface_path(sphere, a, b);
     ASSERT_TRUE(p.ok()) << p.status().message();
     // The polyhedron is inscribed: its geodesics run a little short of the sphere's.
-    EXPECT_NEAR(p->value_mm / (r * t), 1.0, 2e-3) << deg;
-    EXPECT_LE(p->value_mm, r * t * (1 + 1e-4)) << deg;
-    EXPECT_NEAR(polyline_length(p->path), p->value_mm, 1e-6);
+    EXPECT_NEAR(p->path_mm / (r * t), 1.0, 2e-3) << deg;
+    EXPECT_LE(p->path_mm, r * t * (1 + 1e-4)) << deg;
+    EXPECT_NEAR(polyline_length(p->path), p->path_mm, 1e-6);
     for (const Eigen::Vector3d& x : p->path) EXPECT_NEAR(x.norm(), r, 0.1);
   }
 }
@@ -133,7 +136,7 @@ TEST(SurfacePath, FlagsInventedSurfaceAndRefusesDisconnectedParts) {
     if (std::abs(body.vertices[i].y() - 200) < 1 && body.vertices[i].x() > 0) body.confidence[i] = 0;
   auto up = mesh_surface_path(body, {100, 50, 0}, {100, 350, 0});
   ASSERT_TRUE(up.ok()) << up.status().message();
-  EXPECT_NEAR(up->value_mm, 300, 1e-3);
+  EXPECT_NEAR(up->path_mm, 300, 1e-3);
   EXPECT_LT(up->min_confidence, 0.5f);
   auto other_side = mesh_surface_path(body, {-100, 50, 0}, {-100, 350, 0});
   ASSERT_TRUE(other_side.ok());
@@ -146,13 +149,46 @@ TEST(SurfacePath, FlagsInventedSurfaceAndRefusesDisconnectedParts) {
   EXPECT_FALSE(mesh_surface_path(TriangleMesh{}, {0, 0, 0}, {1, 1, 1}).ok());
 }
 
+// A flat sheet 400 x 60 mm rippled across its length like a scan's noise (0.4 mm
+// amplitude, 3 mm wavelength), gridded at 0.5 mm.
+TriangleMesh rippled_sheet() {
+  TriangleMesh m;
+  const int nx = 800, nz = 120;
+  for (int i = 0; i <= nx; ++i)
+    for (int k = 0; k <= nz; ++k)
+      m.vertices.emplace_back(0.5f * i, 0.4f * static_cast<float>(std::sin(2 * M_PI * 0.5 * i / 3.0)), 0.5f * k - 30);
+  auto at = [&](int i, int k) { return static_cast<uint32_t>(i * (nz + 1) + k); };
+  for (int i = 0; i < nx; ++i)
+    for (int k = 0; k < nz; ++k) {
+      m.triangles.push_back({at(i, k), at(i, k + 1), at(i + 1, k + 1)});
+      m.triangles.push_back({at(i, k), at(i + 1, k + 1), at(i + 1, k)});
+    }
+  return m;
+}
+
+TEST(SurfacePath, TheTapeBridgesRoughnessThePathFollows) {
+  const TriangleMesh sheet = rippled_sheet();
+  auto p = mesh_surface_path(sheet, {10, 0, 0}, {390, 0, 0});
+  ASSERT_TRUE(p.ok()) << p.status().message();
+  // The exact path rides every ripple: about 6.5 % long here.
+  EXPECT_GT(p->path_mm, 380 * 1.04);
+  // The tape, in 10 mm chords, is within 0.5 % of the flat length.
+  EXPECT_NEAR(p->value_mm, 380, 0.005 * 380);
+  // Without chords the value is the path.
+  SurfacePathOptions exact;
+  exact.tape_step_mm = 0;
+  auto q = mesh_surface_path(sheet, {10, 0, 0}, {390, 0, 0}, exact);
+  ASSERT_TRUE(q.ok());
+  EXPECT_DOUBLE_EQ(q->value_mm, q->path_mm);
+}
+
 TEST(SurfacePath, WithinOneTriangleItIsTheChord) {
   TriangleMesh t;
   t.vertices = {{0, 0, 0}, {100, 0, 0}, {0, 100, 0}};
   t.triangles = {{0, 1, 2}};
   auto p = mesh_surface_path(t, {10, 10, 5}, {40, 30, -5});
   ASSERT_TRUE(p.ok());
-  EXPECT_NEAR(p->value_mm, std::hypot(30.0, 20.0), 1e-5);
+  EXPECT_NEAR(p->path_mm, std::hypot(30.0, 20.0), 1e-5);
   EXPECT_EQ(p->path.size(), 2u);
 }
 
