@@ -658,7 +658,8 @@ class Finder {
     auto on_axis = [](const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& p) {
       return (o + (p - o).dot(d) * d).eval();
     };
-    const Eigen::Vector3d elbow_c = on_axis(uc, ud, c[e]), wrist_c = on_axis(fc, fd, c[w]);
+    const Eigen::Vector3d elbow_c = on_axis(uc, ud, c[e]);
+    Eigen::Vector3d wrist_c = on_axis(fc, fd, c[w]);
     // Outward: across the arm, in the frontal plane, away from the body.
     auto outward = [&](const Eigen::Vector3d& d) {
       Eigen::Vector3d o = -Eigen::Vector3d::UnitZ().cross(d);
@@ -672,8 +673,29 @@ class Finder {
         if ((p - centre).dot(out) > most) most = (p - centre).dot(out), best_p = p;
       return best_p;
     };
-    const std::vector<uint32_t> wt = triangles_near(wrist_c, 0.08 * h_);
-    StatusOr<Girth> wg = mesh_girth(mesh_, Plane{wrist_c, fd}, wrist_c, &wt);
+    // The wrist itself: the narrowest cut perpendicular to the forearm within 3 % of
+    // the height either side of the horizontal cuts' narrowest (which an inclined
+    // forearm blurs), settled in the middle of a flat minimum.
+    StatusOr<Girth> wg = not_found("no loop round the wrist");
+    {
+      const std::vector<uint32_t> wt = triangles_near(wrist_c, 0.07 * h_);
+      std::vector<double> gs;
+      std::vector<Girth> cuts;
+      std::vector<Eigen::Vector3d> at_cut;
+      for (double t = -0.03 * h_; t <= 0.03 * h_; t += 4) {
+        const Eigen::Vector3d p = wrist_c + t * fd;
+        StatusOr<Girth> g = mesh_girth(mesh_, Plane{p, fd}, p, &wt);
+        if (!g.ok() || !winds_round(g->loop, p, fd) || g->value_mm > 0.25 * h_) continue;
+        gs.push_back(g->value_mm);
+        cuts.push_back(std::move(*g));
+        at_cut.push_back(p);
+      }
+      if (!gs.empty()) {
+        const size_t k = settle(gs, arg_extreme(gs, false), 1.0);
+        wrist_c = at_cut[k];
+        wg = std::move(cuts[k]);
+      }
+    }
     const std::vector<uint32_t> et = triangles_near(elbow_c, 0.08 * h_);
     StatusOr<Girth> eg = mesh_girth(mesh_, Plane{elbow_c, ud}, elbow_c, &et);
     const Eigen::Vector3d wrist_p = wg.ok() ? outer_point(*wg, wrist_c, outward(fd)) : wrist_c;
