@@ -548,7 +548,8 @@ class Finder {
   }
 
   // The leg's horizontal loop on side s at height y, if any.
-  const Ring* leg(const std::vector<Ring>& r, int s) const { return side_ring(r, xc_, s, false); }
+  // Scraps of a cut (a toe, a fold of fill) are no leg: at least 6 % of the height round.
+  const Ring* leg(const std::vector<Ring>& r, int s) const { return side_ring(r, xc_, s, false, 0.06 * h_); }
 
   void measure_leg(int s) {
     const std::string sd = side(s);
