@@ -5,6 +5,7 @@
 //
 //   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR]
+//                     [--seed N]
 //
 // --save writes each scan's surface and the posed true body as PLY into DIR.
 //
@@ -55,6 +56,7 @@ struct Scan {
 
 HoleFairing g_fairing = pipeline::body_surface_options().hole_fairing;
 std::string g_save;
+uint64_t g_seed = 1;
 
 StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64_t seed, double sway, int every) {
   std::string path = rig_name;
@@ -94,7 +96,7 @@ const char* mark(double diff, double allow) {
 int run(const std::string& rig, const std::string& body, bool repeat, double sway, int every) {
   std::printf("\n== rig %s, body %s\n", rig.c_str(), body.empty() ? "(the rig's)" : body.c_str());
   auto t0 = Clock::now();
-  auto a = scan(rig, body, 1, 0, every);
+  auto a = scan(rig, body, g_seed, 0, every);
   if (!a.ok()) return std::fprintf(stderr, "scan: %s\n", a.status().message().c_str()), 1;
   std::printf("scan job %.0f s, mesh %zu triangles\n", secs(t0), a->mesh.triangles.size());
   if (!g_save.empty()) {
@@ -188,7 +190,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   for (const std::string& k : a->body->skipped) std::printf("skipped on the scan: %s\n", k.c_str());
 
   if (repeat) {
-    auto b = scan(rig, body, 2, sway, every);
+    auto b = scan(rig, body, g_seed + 1, sway, every);
     if (!b.ok()) return std::fprintf(stderr, "second scan: %s\n", b.status().message().c_str()), 1;
     double worst = 0;
     std::string worst_name;
@@ -201,7 +203,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
       if (d > worst) worst = d, worst_name = m.name;
     }
     std::sort(diffs.begin(), diffs.end());
-    std::printf("\nrepeatability (seed 2, sway %.0f mm): %zu measurements, median %.2f mm, largest %.2f mm (%s)\n", sway,
+    std::printf("\nrepeatability (seed +1, sway %.0f mm): %zu measurements, median %.2f mm, largest %.2f mm (%s)\n", sway,
                 diffs.size(), diffs.empty() ? 0.0 : diffs[diffs.size() / 2], worst, worst_name.c_str());
     for (const BodyMeasurement& m : a->body->measurements)
       if (const BodyMeasurement* o = b->body->find(m.name); o && std::abs(o->value_mm - m.value_mm) > 1.0)
@@ -225,6 +227,7 @@ int main(int argc, char** argv) {
     else if (a == "--sway" && i + 1 < argc) sway = std::atof(argv[++i]);
     else if (a == "--every" && i + 1 < argc) every = std::atoi(argv[++i]);
     else if (a == "--save" && i + 1 < argc) g_save = argv[++i];
+    else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--fairing" && i + 1 < argc) {
       const std::string f = argv[++i];
       g_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
