@@ -486,9 +486,7 @@ class Finder {
 
   void measure_torso() {
     const double ya = std::min(armpit_y_[0], armpit_y_[1]);
-    const Eigen::Vector3d axis(xc_, 0, zc_);
     auto near = [&](double y) { return Eigen::Vector3d(xc_, y, zc_); };
-    (void)axis;
     // Neck girth: the smallest loop round the neck over planes tilted forward and back.
     {
       const std::vector<uint32_t> tris = triangles_near(neck_c_, 0.08 * h_);
