@@ -85,6 +85,20 @@ size_t corner(const std::vector<Eigen::Vector2d>& c, int sign = 0) {
   return best;
 }
 
+// On a front profile sampled as (y, z), the sample lying farthest behind (at smaller
+// Z than) the chord joining its ends: a notch (the front neck point, the fold under
+// the bust). The ends count, at depth 0.
+size_t deepest_behind_chord(const std::vector<Eigen::Vector2d>& c) {
+  const Eigen::Vector2d a = c.front(), e = c.back();
+  size_t best = 0;
+  double deepest = kInf;
+  for (size_t i = 0; i < c.size(); ++i) {
+    const double chord_z = a.y() + (c[i].x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y());
+    if (c[i].y() - chord_z < deepest) deepest = c[i].y() - chord_z, best = i;
+  }
+  return best;
+}
+
 // Least-squares line through points: (centre, unit direction with y >= 0).
 std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Vector3d>& p, size_t b, size_t e,
                                                       double* residual = nullptr) {
@@ -245,16 +259,21 @@ class Finder {
   }
 
   // Triangles with a corner within r of c (for the tilted cuts).
-  std::vector<uint32_t> triangles_near(const Eigen::Vector3d& c, double r) const {
+  // (Among `among`, when given: a subset known to hold them all.)
+  std::vector<uint32_t> triangles_near(const Eigen::Vector3d& c, double r,
+                                       const std::vector<uint32_t>& among = {}) const {
     std::vector<uint32_t> out;
     const float r2 = static_cast<float>(r * r);
     const Vec3f cf = c.cast<float>();
-    for (uint32_t t = 0; t < mesh_.triangles.size(); ++t)
+    const size_t n = among.empty() ? mesh_.triangles.size() : among.size();
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t t = among.empty() ? static_cast<uint32_t>(i) : among[i];
       for (uint32_t v : mesh_.triangles[t])
         if ((mesh_.vertices[v] - cf).squaredNorm() <= r2) {
           out.push_back(t);
           break;
         }
+    }
     return out;
   }
 
@@ -346,12 +365,8 @@ class Finder {
     Eigen::Vector3d front(xc_, y_snp - 0.03 * h_, neck_c_.z());
     if (curve.size() >= 3) {
       // The notch: the front's deepest point behind the chord from neck to chest.
-      const Eigen::Vector2d a = curve.front(), e = curve.back();
-      double best = kInf;
-      for (const Eigen::Vector2d& c : curve) {
-        const double chord_z = a.y() + (c.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y());
-        if (c.y() - chord_z < best) best = c.y() - chord_z, front = {xc_, c.x(), c.y()};
-      }
+      const Eigen::Vector2d& c = curve[deepest_behind_chord(curve)];
+      front = {xc_, c.x(), c.y()};
     }
     landmark("front_neck_point", front);
   }
@@ -395,14 +410,7 @@ class Finder {
           curve.emplace_back(y, 0.5 * (f + f2));
       }
       underbust_y_ = bust_y_ - 0.05 * h_;
-      if (curve.size() >= 3) {
-        const Eigen::Vector2d a = curve.front(), e = curve.back();
-        double deepest = kInf;
-        for (const Eigen::Vector2d& c : curve) {
-          const double chord_z = a.y() + (c.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y());
-          if (c.y() - chord_z < deepest) deepest = c.y() - chord_z, underbust_y_ = c.x();
-        }
-      }
+      if (curve.size() >= 3) underbust_y_ = curve[deepest_behind_chord(curve)].x();
       landmark("underbust_front_point", {xc_, underbust_y_, front_z(underbust_y_)});
     }
     // Hip: the buttocks' greatest backward projection.
@@ -708,13 +716,16 @@ class Finder {
     // Close to the armpit the cut can reach the chest: then slide it toward the
     // elbow until its loop is the arm's alone (winds round the axis, and reaches no
     // farther than 5 % of the height from its own centre).
-    const std::vector<uint32_t> ut = triangles_near(mid, 0.07 * h_);
+    // Every cut's triangles (within reach of its point) come from one search round
+    // the whole slide rather than one pass over the mesh per cut.
+    const double cut_radius = 0.07 * h_, slide = 0.08 * h_;
+    const std::vector<uint32_t> slide_tris = triangles_near(mid, cut_radius + slide);
     StatusOr<Girth> ug = not_found("the cut never clears the chest");
-    for (double off = 0; off <= 0.08 * h_; off += 4) {
+    for (double off = 0; off <= slide; off += 4) {
       const Eigen::Vector3d p = mid - off * ud;
       // Cut within reach of the axis only: a loop running out of it is open, so
       // the chest never joins.
-      const std::vector<uint32_t> near_p = off == 0 ? ut : triangles_near(p, 0.07 * h_);
+      const std::vector<uint32_t> near_p = triangles_near(p, cut_radius, slide_tris);
       StatusOr<Girth> g = mesh_girth(mesh_, Plane{p, ud}, p, &near_p);
       if (!g.ok() || !winds_round(g->loop, p, ud)) continue;
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();
