@@ -53,10 +53,13 @@ const Ring* side_ring(const std::vector<Ring>& rings, double xc, int s, bool far
   return best;
 }
 
-size_t count_side(const std::vector<Ring>& rings, double xc, int s, double min_girth = 30) {
+// How many other loops of the cut (of a tape's girth at least min_girth) lie within
+// `reach` of the part's centre: fingers parting from a hand. A stray fold of the
+// reconstruction against the flank, far from the arm, is not counted.
+size_t parts_near(const std::vector<Ring>& rings, const Ring& part, double reach, double min_girth = 30) {
   size_t n = 0;
   for (const Ring& r : rings)
-    if (!r.spans_x(xc) && r.girth >= min_girth && s * (r.centroid.x() - xc) > 0) ++n;
+    if (&r != &part && r.girth >= min_girth && (r.centroid - part.centroid).norm() < reach) ++n;
   return n;
 }
 
@@ -636,7 +639,7 @@ class Finder {
       // Past the crotch the leg is on this side too: stop when the arm is gone, or
       // splits into fingers.
       if (!a || (y < crotch_y_ && std::abs(a->centroid.x() - xc_) < 0.1 * h_)) break;
-      if (count_side(r, xc_, s) > (y < crotch_y_ ? 2u : 1u)) break;
+      if (parts_near(r, *a, 0.06 * h_) > 0) break;
       if (!g.empty() && a->girth < 0.4 * *std::max_element(g.begin(), g.end())) break;
       c.push_back(a->centroid);
       g.push_back(a->girth);

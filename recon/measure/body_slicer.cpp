@@ -49,7 +49,9 @@ std::vector<Ring> BodySlicer::rings(double y) const {
   const std::vector<uint32_t>* tris = triangles_at(y);
   if (!tris) return out;
   const Plane plane{Eigen::Vector3d(0, y, 0), Eigen::Vector3d::UnitY()};
-  for (SectionLoop& loop : plane_section(mesh_, plane, tris)) {
+  std::vector<SectionLoop> loops = plane_section(mesh_, plane, tris);
+  drop_nested_loops(&loops, plane);
+  for (SectionLoop& loop : loops) {
     if (!loop.closed) continue;
     Ring r;
     std::vector<Eigen::Vector2d> flat;

@@ -86,6 +86,26 @@ double closed_length_of(const std::vector<V>& polygon) {
 }
 }  // namespace
 
+void drop_nested_loops(std::vector<SectionLoop>* loops, const Plane& plane) {
+  if (loops->size() < 2) return;
+  Eigen::Vector3d u, v;
+  plane_basis(plane.normal, &u, &v);
+  std::vector<char> nested(loops->size(), 0);
+  for (size_t i = 0; i < loops->size(); ++i) {
+    const SectionLoop& a = (*loops)[i];
+    if (!a.closed || a.points.empty()) continue;
+    for (size_t j = 0; j < loops->size() && !nested[i]; ++j)
+      nested[i] = j != i && (*loops)[j].closed && encloses((*loops)[j].points, a.points.front(), u, v);
+  }
+  size_t k = 0;
+  for (size_t i = 0; i < loops->size(); ++i)
+    if (!nested[i]) {
+      if (k != i) (*loops)[k] = std::move((*loops)[i]);
+      ++k;
+    }
+  loops->resize(k);
+}
+
 double closed_length(const std::vector<Eigen::Vector2d>& polygon) { return closed_length_of(polygon); }
 double closed_length(const std::vector<Eigen::Vector3d>& polygon) { return closed_length_of(polygon); }
 
@@ -103,6 +123,7 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
   loops.erase(std::remove_if(loops.begin(), loops.end(), [](const SectionLoop& l) { return !l.closed; }), loops.end());
   if (cut == 0) return not_found("girth: the plane does not cut the body");
   if (loops.empty()) return not_found("girth: the plane cuts only the body's open border, no closed loop to measure around");
+  drop_nested_loops(&loops, plane);
   size_t best = 0;
   if (near) {
     double best_d = std::numeric_limits<double>::infinity();

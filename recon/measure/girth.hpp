@@ -67,4 +67,10 @@ StatusOr<Arc> mesh_arc(const TriangleMesh& mesh, const Plane& plane, const Eigen
 // A unit vector pair spanning the plane: (u, v, normal) right-handed.
 void plane_basis(const Eigen::Vector3d& normal, Eigen::Vector3d* u, Eigen::Vector3d* v);
 
+// Drops the closed loops that lie inside another closed loop of the same cut. A
+// tape goes round the outside: a nested loop is a cavity's wall (a bubble the
+// reconstruction left inside the body) or the gap in a part that joins itself (an
+// arm resting on the hip, cut edge-on), never a part of the body of its own.
+void drop_nested_loops(std::vector<SectionLoop>* loops, const Plane& plane);
+
 }  // namespace bodyscan

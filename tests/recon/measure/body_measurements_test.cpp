@@ -6,6 +6,8 @@
 #include <map>
 
 #include "recon/io/ply.hpp"
+#include "recon/measure/body_slicer.hpp"
+#include "tests/shapes.hpp"
 #include "tests/test_meshes.hpp"
 
 namespace bodyscan {
@@ -141,6 +143,34 @@ TEST(BodyMeasurements, DoNotDependOnWhereTheBodyStands) {
   ASSERT_TRUE(c.ok());
   EXPECT_NEAR(c->find("stature")->value_mm, a->find("stature")->value_mm + 10, 1e-3);
   EXPECT_NEAR(c->find("waist_girth")->value_mm, a->find("waist_girth")->value_mm, 1.0);
+}
+
+TEST(BodyMeasurements, AStrayFoldBesideTheFlankDoesNotEndTheArm) {
+  // Scans sometimes keep a small fold of surface against the flank, below the
+  // armpit, a loop of its own in the cuts there. The arm's track must run past it to
+  // the hand: it once stopped there and put the wrist halfway up the arm.
+  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
+  ASSERT_TRUE(mesh.ok());
+  auto clean = measure_body(*mesh);
+  ASSERT_TRUE(clean.ok());
+  const Eigen::Vector3d armpit = clean->landmark("armpit_left")->position;
+  const double y = armpit.y() - 150;
+  const BodySlicer slicer(*mesh, 0, 1800);
+  const std::vector<Ring> cut = slicer.rings(y);
+  const Ring* torso = nullptr;
+  const Ring* arm = nullptr;
+  for (const Ring& r : cut) {
+    if (r.spans_x(0)) torso = &r;
+    else if (r.centroid.x() > 0 && (!arm || r.centroid.x() > arm->centroid.x())) arm = &r;
+  }
+  ASSERT_TRUE(torso && arm);
+  const Eigen::Vector2d at(torso->x_max + 12, torso->centroid.z());
+  ASSERT_GT(arm->x_min, at.x() + 40);  // clear of the arm
+  const TriangleMesh with_fold = testing::merged(*mesh, testing::prism(testing::circle(10, at, 90), at, y - 15, y + 15));
+  auto b = measure_body(with_fold);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  for (const char* name : {"wrist_girth_left", "upper_arm_girth_left", "outer_arm_length_left"})
+    EXPECT_NEAR(b->find(name)->value_mm, clean->find(name)->value_mm, 0.5) << name;
 }
 
 TEST(BodyMeasurements, RefusesWhatIsNotAStandingBody) {

@@ -85,6 +85,28 @@ TEST(MeshGirth, TheLoopMeantIsTheOneNearestThePoint) {
   EXPECT_LT(upper_arm->value_mm, 300);
 }
 
+TEST(MeshGirth, ACavityInsideTheBodyIsNeverTheLoop) {
+  // A bubble the reconstruction left inside the torso: its wall is a loop of the
+  // cut, inside the skin's. Even a point inside the bubble means the torso.
+  const TriangleMesh torso = prism(circle(150), {0, 0}, 0, 600);
+  const TriangleMesh bubble = prism(circle(40, {60, 0}, 360), {60, 0}, 250, 350);
+  const TriangleMesh body = merged(torso, bubble);
+  const Eigen::Vector3d in_bubble(60, 300, 0);
+  auto g = mesh_girth(body, horizontal(300), in_bubble);
+  ASSERT_TRUE(g.ok());
+  EXPECT_EQ(g->loops_cut, 2u);
+  EXPECT_NEAR(g->value_mm, 2 * M_PI * 150, 0.1);
+  // A part of its own beside the torso still counts.
+  const TriangleMesh arm = prism(circle(40, {230, 0}, 360), {230, 0}, 100, 600);
+  auto a = mesh_girth(merged(body, arm), horizontal(300), Eigen::Vector3d(230, 300, 0));
+  ASSERT_TRUE(a.ok());
+  EXPECT_NEAR(a->value_mm, 2 * M_PI * 40, 0.1);
+  std::vector<SectionLoop> loops = plane_section(merged(body, arm), horizontal(300));
+  ASSERT_EQ(loops.size(), 3u);
+  drop_nested_loops(&loops, horizontal(300));
+  EXPECT_EQ(loops.size(), 2u);
+}
+
 TEST(MeshGirth, ClearErrors) {
   const TriangleMesh body = prism(circle(150), {0, 0}, 0, 400);
   auto miss = mesh_girth(body, horizontal(500));
