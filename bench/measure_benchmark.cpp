@@ -10,8 +10,10 @@
 // --save writes each scan's surface and the posed true body as PLY into DIR.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
-// 9 mm off on large girths, 4 mm on small girths and heights, 5 mm on lengths; the
-// tables mark each difference against half of that (must) and a sixth (aim).
+// 9 mm off on large girths, 4 mm on small girths and heights, 5 mm on lengths. The
+// issue's must for the fixed planes is half of that, its aim a sixth; for the
+// automatic set the must is the allowance itself. Marks: aim (a sixth), must
+// (half), iso (the allowance), OVER.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -171,7 +173,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
 
   if (!again.ok()) return std::fprintf(stderr, "scan set: %s\n", again.status().message().c_str()), 1;
   std::printf("\n%-24s %6s %8s %8s %7s %6s  %s\n", "automatic set", "ISO", "truth", "scan", "diff", "allow", "");
-  size_t n = 0, must = 0, aim = 0;
+  size_t n = 0, iso = 0, must = 0, aim = 0;
   for (const BodyMeasurement& m : truth->measurements) {
     const BodyMeasurement* s = a->body->find(m.name);
     if (!s) {
@@ -180,13 +182,15 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
     }
     const double d = s->value_mm - m.value_mm, al = allowance(m);
     ++n;
+    iso += std::abs(d) <= al;
     must += std::abs(d) <= al / 2;
     aim += std::abs(d) <= al / 6;
     std::printf("%-24s %6s %8.1f %8.1f %+7.2f %6.1f  %s%s\n", m.name.c_str(), m.iso_clause.c_str(), m.value_mm,
                 s->value_mm, d, al, std::abs(d) <= al ? (std::abs(d) <= al / 2 ? mark(d, al) : "iso") : "OVER",
                 s->crosses_filled_hole() ? "  (crosses fill)" : "");
   }
-  std::printf("%zu measurements: %zu within half the ISO allowance, %zu within a sixth\n", n, must, aim);
+  std::printf("%zu measurements: %zu within the ISO allowance, %zu within half, %zu within a sixth\n", n, iso, must,
+              aim);
   for (const std::string& k : a->body->skipped) std::printf("skipped on the scan: %s\n", k.c_str());
 
   if (repeat) {
