@@ -14,6 +14,9 @@ packages=(
   nlohmann-json3-dev   # rig descriptions, API documents (hw, server)
   libembree-dev        # ray casting for the simulated rig (hw/sim)
   libpng-dev           # camera images (recon/io)
+  libdraco-dev libtinygltf-dev  # glTF binary with Draco, Draco point clouds (storage/formats)
+  libcairo2-dev        # measurement sheets as PDF (storage/formats)
+  libsqlite3-dev       # the scan archive's index (storage/archive)
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 if [[ "${1:-}" == "--bench" ]]; then

@@ -7,6 +7,8 @@
 
 #include "recon/io/ply.hpp"
 #include "recon/surface/reconstruct.hpp"
+#include "storage/formats/draco_files.hpp"
+#include "storage/formats/mesh_files.hpp"
 
 namespace bodyscan::cli {
 
@@ -21,7 +23,7 @@ void usage(FILE* out) {
       "Every option left out is chosen from the data (scale, density, noise).\n"
       "\n"
       "options:\n"
-      "  -o, --output FILE      output mesh (.ply)\n"
+      "  -o, --output FILE      output mesh: .ply, .glb (glTF binary, Draco, metres), .obj or .stl (mm)\n"
       "  --sigma S              tangential kernel size in units of the local point\n"
       "                         spacing (thesis sigma_user; default: from the noise)\n"
       "  --normal-sigma S       kernel size across the surface, same units (default: auto)\n"
@@ -128,12 +130,8 @@ int run_reconstruct(int argc, char** argv) {
     usage(stderr);
     return 2;
   }
-  if (ends_with(out, ".glb")) {
-    std::fputs("bodyscan reconstruct: .glb output is not available in this build yet; write .ply\n", stderr);
-    return 2;
-  }
-  if (!ends_with(out, ".ply")) {
-    std::fprintf(stderr, "bodyscan reconstruct: output '%s' must end in .ply\n", out.c_str());
+  if (!ends_with(out, ".ply") && !ends_with(out, ".glb") && !ends_with(out, ".obj") && !ends_with(out, ".stl")) {
+    std::fprintf(stderr, "bodyscan reconstruct: output '%s' must end in .ply, .glb, .obj or .stl\n", out.c_str());
     return 2;
   }
 
@@ -171,7 +169,24 @@ int run_reconstruct(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan reconstruct: %s: %s\n", in.c_str(), rec.status().message().c_str());
     return 1;
   }
-  const Status written = write_ply(out, rec->mesh, ascii ? PlyFormat::kAscii : PlyFormat::kBinaryLittleEndian);
+  Status written;
+  std::string glb_note;
+  if (ends_with(out, ".glb")) {
+    auto glb = storage::write_glb(out, rec->mesh);
+    if (glb.ok()) {
+      char b[160];
+      std::snprintf(b, sizeof b, " (%.2f MB, %d-bit positions, largest vertex error %.3f mm)",
+                    static_cast<double>(glb->bytes.size()) / 1e6, glb->position_bits, glb->max_error_mm);
+      glb_note = b;
+    }
+    written = glb.status();
+  } else if (ends_with(out, ".obj")) {
+    written = storage::write_obj(out, rec->mesh);
+  } else if (ends_with(out, ".stl")) {
+    written = storage::write_stl(out, rec->mesh);
+  } else {
+    written = write_ply(out, rec->mesh, ascii ? PlyFormat::kAscii : PlyFormat::kBinaryLittleEndian);
+  }
   if (!written.ok()) {
     std::fprintf(stderr, "bodyscan reconstruct: %s\n", written.message().c_str());
     return 1;
@@ -194,7 +209,7 @@ int run_reconstruct(int argc, char** argv) {
     std::printf("time        %.2f s total (neighbours %.2f, normals %.2f, orientation %.2f, "
                 "kernels %.2f, field %.2f, mesh %.2f)\n",
                 total, s.t_neighbours, s.t_normals, s.t_orientation, s.t_kernels, s.t_field, s.t_mesh);
-    std::printf("wrote       %s\n", out.c_str());
+    std::printf("wrote       %s%s\n", out.c_str(), glb_note.c_str());
   }
   return 0;
 }

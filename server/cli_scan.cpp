@@ -18,7 +18,7 @@ void usage(FILE* out) {
       "Calibrates the rig from what its cameras see (dot grid, frame lights, lasers on\n"
       "the frame's poles), scans the subject, turns the laser stripes into one point\n"
       "cloud, reconstructs a closed surface and measures it. Writes DIR/points.ply,\n"
-      "DIR/mesh.ply, DIR/measurements.json (docs/measurements.md),\n"
+      "DIR/mesh.ply, DIR/mesh.glb, DIR/measurements.json (docs/measurements.md),\n"
       "DIR/calibration.json and DIR/scan.json.\n"
       "\n"
       "  --rig RIG        sim (the thesis rig and the demo body), thesis, square,\n"
@@ -154,7 +154,7 @@ int run_scan(int argc, char** argv) {
                   result->body->skipped.size(), result->body->landmarks.size());
     }
     std::printf("wrote %s/points.ply%s%s, calibration.json, scan.json\n", out.c_str(),
-                result->mesh.triangles.empty() ? "" : ", mesh.ply", result->body ? ", measurements.json" : "");
+                result->mesh.triangles.empty() ? "" : ", mesh.ply, mesh.glb", result->body ? ", measurements.json" : "");
   }
   if (!result->measure_error.empty()) {
     std::fprintf(stderr, "bodyscan scan: warning: no automatic measurements: %s\n", result->measure_error.c_str());

@@ -8,6 +8,7 @@
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/ply.hpp"
 #include "server/pipeline/measurements_json.hpp"
+#include "storage/formats/draco_files.hpp"
 
 namespace bodyscan::pipeline {
 
@@ -73,7 +74,12 @@ Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
   const std::filesystem::path d(dir);
   RETURN_IF_ERROR(write_file_atomically((d / "calibration.json").string(), to_json(r.calibration).dump(2)));
   RETURN_IF_ERROR(write_ply((d / "points.ply").string(), r.cloud));
-  if (!r.mesh.triangles.empty()) RETURN_IF_ERROR(write_ply((d / "mesh.ply").string(), r.mesh));
+  nlohmann::json glb;
+  if (!r.mesh.triangles.empty()) {
+    RETURN_IF_ERROR(write_ply((d / "mesh.ply").string(), r.mesh));
+    ASSIGN_OR_RETURN(storage::DracoEncoded e, storage::write_glb((d / "mesh.glb").string(), r.mesh));
+    glb = {{"bytes", e.bytes.size()}, {"position_bits", e.position_bits}, {"max_error_mm", e.max_error_mm}};
+  }
   if (r.body) {
     nlohmann::json m = measurements_document("mesh.ply", "mesh");
     add_body_measurements(*r.body, &m);
@@ -81,6 +87,7 @@ Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
   }
   nlohmann::json j;
   j["points"] = r.cloud.size();
+  if (!glb.is_null()) j["mesh_glb"] = glb;
   j["frames"] = r.scan.frames;
   j["frames_unseen"] = r.scan.frames_unseen;
   j["frames_without_plane"] = r.scan.frames_without_plane;

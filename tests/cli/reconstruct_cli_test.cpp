@@ -13,6 +13,7 @@
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/geometry/sample_surface.hpp"
 #include "recon/io/ply.hpp"
+#include "storage/formats/draco_files.hpp"
 #include "tests/cli/cli_runner.hpp"
 #include "tests/test_data.hpp"
 
@@ -158,11 +159,35 @@ TEST_F(ReconstructCli, UsageErrorsExitTwo) {
   }
   EXPECT_EQ(bodyscan("reconstruct " + in, dir_).exit_code, 2);                            // no output
   EXPECT_EQ(bodyscan("reconstruct -o " + quote(path("m.ply")), dir_).exit_code, 2);     // no input
-  EXPECT_EQ(bodyscan("reconstruct " + in + " -o " + quote(path("m.obj")), dir_).exit_code, 2);
+  EXPECT_EQ(bodyscan("reconstruct " + in + " -o " + quote(path("m.off")), dir_).exit_code, 2);
   EXPECT_EQ(bodyscan("reconstruct " + in + " " + in + " -o " + quote(path("m.ply")), dir_).exit_code, 2);
   EXPECT_EQ(bodyscan("frobnicate", dir_).exit_code, 2);  // unknown command
   EXPECT_EQ(bodyscan("", dir_).exit_code, 2);            // no command
   EXPECT_FALSE(std::filesystem::exists(path("m.ply")));
+}
+
+TEST_F(ReconstructCli, WritesGlbObjAndStl) {
+  PointCloud cloud = fibonacci_sphere(1000, 50.0);
+  ASSERT_TRUE(write_ply(path("sphere.ply"), cloud).ok());
+  const std::string in = quote(path("sphere.ply"));
+  const CliResult ply = bodyscan("reconstruct " + in + " -q -o " + quote(path("m.ply")), dir_);
+  ASSERT_EQ(ply.exit_code, 0) << ply.err;
+  auto mesh = read_ply_mesh(path("m.ply"));
+  ASSERT_TRUE(mesh.ok());
+  const CliResult glb = bodyscan("reconstruct " + in + " -o " + quote(path("m.glb")), dir_);
+  ASSERT_EQ(glb.exit_code, 0) << glb.err;
+  EXPECT_NE(glb.out.find("largest vertex error"), std::string::npos) << glb.out;
+  auto back = storage::decode_glb(slurp(path("m.glb")));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->num_triangles(), mesh->num_triangles());
+  // Half a millimetre of rounding on a 50 mm ball: the volume within 0.5 %.
+  EXPECT_NEAR(signed_volume(*back), signed_volume(*mesh), 5e-3 * signed_volume(*mesh));
+  for (const char* ext : {"obj", "stl"}) {
+    const CliResult r = bodyscan("reconstruct " + in + " -q -o " + quote(path(std::string("m.") + ext)), dir_);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_GT(std::filesystem::file_size(path(std::string("m.") + ext)), 10000u) << ext;
+  }
+  EXPECT_EQ(std::filesystem::file_size(path("m.stl")), 84 + 50 * mesh->num_triangles());
 }
 
 TEST_F(ReconstructCli, HelpExitsZero) {

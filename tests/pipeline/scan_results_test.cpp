@@ -8,10 +8,16 @@
 
 #include "recon/io/ply.hpp"
 #include "server/pipeline/scan_job.hpp"
+#include "storage/formats/draco_files.hpp"
 #include "tests/test_data.hpp"
 
 namespace bodyscan::pipeline {
 namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 nlohmann::json read_json(const std::string& path) {
   std::ifstream in(path);
@@ -43,6 +49,13 @@ TEST(ScanResults, MeasurementsSitBesideTheMesh) {
   EXPECT_EQ(j["landmarks"].size(), m->landmarks.size());
   EXPECT_TRUE(std::filesystem::exists(dir + "/mesh.ply"));
   EXPECT_FALSE(read_json(dir + "/scan.json").contains("surface_error"));
+  // The browser's copy: a Draco glTF binary, checked on the way out.
+  auto glb = storage::decode_glb(slurp(dir + "/mesh.glb"));
+  ASSERT_TRUE(glb.ok()) << glb.status().message();
+  EXPECT_EQ(glb->num_triangles(), body->num_triangles());
+  const nlohmann::json info = read_json(dir + "/scan.json")["mesh_glb"];
+  EXPECT_EQ(info["bytes"].get<size_t>(), std::filesystem::file_size(dir + "/mesh.glb"));
+  EXPECT_LE(info["max_error_mm"].get<double>(), 0.5);
 }
 
 TEST(ScanResults, AFailedSurfaceKeepsTheCloudAndSaysWhy) {

@@ -66,7 +66,9 @@ TEST_P(BodyMeasurementsTest, TakesTheWholeSet) {
     EXPECT_FALSE(m->definition.empty()) << name;
     EXPECT_EQ(m->min_confidence, 1.f) << name;  // a mesh without confidence: all measured
     for (const std::string& l : m->landmarks) EXPECT_NE(b.landmark(l), nullptr) << name << " uses " << l;
-    if (m->kind == "girth") EXPECT_TRUE(m->closed) << name;
+    if (m->kind == "girth") {
+      EXPECT_TRUE(m->closed) << name;
+    }
   }
 }
 

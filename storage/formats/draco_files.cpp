@@ -1,0 +1,222 @@
+#include "storage/formats/draco_files.hpp"
+
+#include <draco/compression/decode.h>
+#include <draco/compression/encode.h>
+#include <draco/io/gltf_decoder.h>
+#include <draco/io/gltf_encoder.h>
+#include <draco/mesh/mesh.h>
+#include <draco/point_cloud/point_cloud.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "recon/io/atomic_file.hpp"
+
+namespace bodyscan::storage {
+
+namespace {
+
+constexpr float kToMetres = 0.001f;
+constexpr int kMaxPositionBits = 26;
+
+Status from_draco(const draco::Status& s, const std::string& what) {
+  return internal_error(what + ": " + s.error_msg_string());
+}
+
+// The fewest bits whose quantisation step keeps every point within `max_error` of
+// where it was: Draco spreads 2^bits - 1 steps over the largest side of the
+// bounding box, and a point moves at most half a step along each axis.
+int position_bits(const std::vector<Vec3f>& p, double max_error_mm) {
+  Vec3f lo = Vec3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
+  for (const Vec3f& v : p) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const double extent = p.empty() ? 1.0 : std::max(1e-3, static_cast<double>((hi - lo).maxCoeff()));
+  const double steps = std::sqrt(3.0) * extent / (2 * max_error_mm);
+  return std::clamp(static_cast<int>(std::ceil(std::log2(steps + 1))), 1, kMaxPositionBits);
+}
+
+// The largest distance from a point of `a` to the nearest point of `b` and back
+// (vertex sets in mm), looked up in a grid of `cell`-sized cubes: pairs farther
+// apart than one cell count as infinitely far, which fails any check.
+double max_displacement(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b, double cell) {
+  auto one_way = [cell](const std::vector<Vec3f>& from, const std::vector<Vec3f>& to) {
+    if (from.empty()) return 0.0;
+    if (to.empty()) return std::numeric_limits<double>::infinity();
+    auto key = [cell](const Vec3f& v, int dx, int dy, int dz) {
+      const auto c = [cell](float x, int d) { return static_cast<int64_t>(std::floor(x / cell)) + d + (1 << 20); };
+      return (c(v.x(), dx) << 42) | (c(v.y(), dy) << 21) | c(v.z(), dz);
+    };
+    std::vector<std::pair<int64_t, uint32_t>> grid(to.size());
+    for (size_t i = 0; i < to.size(); ++i) grid[i] = {key(to[i], 0, 0, 0), static_cast<uint32_t>(i)};
+    std::sort(grid.begin(), grid.end());
+    double worst = 0;
+    for (const Vec3f& p : from) {
+      double best = std::numeric_limits<double>::infinity();
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const int64_t k = key(p, dx, dy, dz);
+            auto it = std::lower_bound(grid.begin(), grid.end(), std::make_pair(k, uint32_t{0}));
+            for (; it != grid.end() && it->first == k; ++it) best = std::min(best, static_cast<double>((to[it->second] - p).norm()));
+          }
+      worst = std::max(worst, best);
+    }
+    return worst;
+  };
+  return std::max(one_way(a, b), one_way(b, a));
+}
+
+int add_attribute(draco::PointCloud* pc, draco::GeometryAttribute::Type type, const std::vector<Vec3f>& values,
+                  float scale) {
+  draco::GeometryAttribute ga;
+  ga.Init(type, nullptr, 3, draco::DT_FLOAT32, false, sizeof(float) * 3, 0);
+  const int id = pc->AddAttribute(ga, true, static_cast<uint32_t>(values.size()));
+  draco::PointAttribute* att = pc->attribute(id);
+  for (size_t i = 0; i < values.size(); ++i) {
+    const Vec3f v = values[i] * scale;
+    att->SetAttributeValue(draco::AttributeValueIndex(static_cast<uint32_t>(i)), v.data());
+  }
+  return id;
+}
+
+// Positions (and normals) of every point of a decoded Draco geometry, in mm.
+std::vector<Vec3f> read_attribute(const draco::PointCloud& pc, draco::GeometryAttribute::Type type, float scale) {
+  std::vector<Vec3f> out;
+  const draco::PointAttribute* att = pc.GetNamedAttribute(type);
+  if (!att) return out;
+  out.resize(pc.num_points());
+  for (draco::PointIndex i(0); i < pc.num_points(); ++i) {
+    float v[3] = {0, 0, 0};
+    att->ConvertValue<float, 3>(att->mapped_index(i), v);
+    out[i.value()] = Vec3f(v[0], v[1], v[2]) * scale;
+  }
+  return out;
+}
+
+bool usable_normals(const std::vector<Vec3f>& normals, size_t n, const DracoOptions& o) {
+  return o.normals && normals.size() == n && n > 0;
+}
+
+}  // namespace
+
+StatusOr<TriangleMesh> decode_glb(std::string_view bytes) {
+  draco::DecoderBuffer buffer;
+  buffer.Init(bytes.data(), bytes.size());
+  draco::GltfDecoder decoder;
+  auto decoded = decoder.DecodeFromBuffer(&buffer);
+  if (!decoded.ok()) return invalid_argument("glb: not a glTF binary this reader understands (" + decoded.status().error_msg_string() + ")");
+  const draco::Mesh& dm = *decoded.value();
+  TriangleMesh mesh;
+  mesh.vertices = read_attribute(dm, draco::GeometryAttribute::POSITION, 1000.f);
+  if (mesh.vertices.empty()) return invalid_argument("glb: the mesh has no positions");
+  mesh.normals = read_attribute(dm, draco::GeometryAttribute::NORMAL, 1.f);
+  mesh.triangles.reserve(dm.num_faces());
+  for (draco::FaceIndex f(0); f < dm.num_faces(); ++f) {
+    const draco::Mesh::Face& face = dm.face(f);
+    mesh.triangles.push_back({face[0].value(), face[1].value(), face[2].value()});
+  }
+  return mesh;
+}
+
+StatusOr<DracoEncoded> encode_glb(const TriangleMesh& mesh, const DracoOptions& options) {
+  if (mesh.empty()) return invalid_argument("glb: the mesh has no triangles");
+  if (!mesh.is_consistent()) return invalid_argument("glb: the mesh's indices or attributes are inconsistent");
+  if (!(options.max_error_mm > 0)) return invalid_argument("glb: the largest error allowed must be positive");
+  for (int bits = position_bits(mesh.vertices, options.max_error_mm); bits <= kMaxPositionBits; ++bits) {
+    draco::Mesh dm;
+    dm.set_num_points(static_cast<uint32_t>(mesh.num_vertices()));
+    add_attribute(&dm, draco::GeometryAttribute::POSITION, mesh.vertices, kToMetres);
+    if (usable_normals(mesh.normals, mesh.num_vertices(), options))
+      add_attribute(&dm, draco::GeometryAttribute::NORMAL, mesh.normals, 1.f);
+    dm.SetNumFaces(mesh.num_triangles());
+    for (size_t f = 0; f < mesh.num_triangles(); ++f) {
+      const Triangle& t = mesh.triangles[f];
+      dm.SetFace(draco::FaceIndex(static_cast<uint32_t>(f)),
+                 {draco::PointIndex(t[0]), draco::PointIndex(t[1]), draco::PointIndex(t[2])});
+    }
+    draco::DracoCompressionOptions co;
+    co.compression_level = options.compression_level;
+    co.quantization_position.SetQuantizationBits(bits);
+    co.quantization_bits_normal = options.normal_bits;
+    dm.SetCompressionEnabled(true);
+    dm.SetCompressionOptions(co);
+    draco::GltfEncoder encoder;
+    draco::EncoderBuffer out;
+    const draco::Status s = encoder.EncodeToBuffer(dm, &out);
+    if (!s.ok()) return from_draco(s, "glb: Draco could not encode the mesh");
+
+    DracoEncoded e;
+    e.bytes.assign(out.data(), out.size());
+    e.position_bits = bits;
+    auto back = decode_glb(e.bytes);
+    if (!back.ok()) return internal_error("glb: the encoding does not decode: " + back.status().message());
+    if (back->num_triangles() != mesh.num_triangles())
+      return internal_error("glb: decoding gave " + std::to_string(back->num_triangles()) + " triangles, not " +
+                            std::to_string(mesh.num_triangles()));
+    e.vertices = back->num_vertices();
+    e.triangles = back->num_triangles();
+    e.max_error_mm = max_displacement(mesh.vertices, back->vertices, std::max(1.0, 2 * options.max_error_mm));
+    if (e.max_error_mm <= options.max_error_mm) return e;
+  }
+  return internal_error("glb: no quantisation keeps the vertices within " + std::to_string(options.max_error_mm) + " mm");
+}
+
+StatusOr<PointCloud> decode_drc(std::string_view bytes) {
+  draco::DecoderBuffer buffer;
+  buffer.Init(bytes.data(), bytes.size());
+  draco::Decoder decoder;
+  auto decoded = decoder.DecodePointCloudFromBuffer(&buffer);
+  if (!decoded.ok()) return invalid_argument("drc: not a Draco file this reader understands (" + decoded.status().error_msg_string() + ")");
+  PointCloud cloud;
+  cloud.positions = read_attribute(*decoded.value(), draco::GeometryAttribute::POSITION, 1000.f);
+  if (cloud.positions.empty() && decoded.value()->num_points() > 0) return invalid_argument("drc: the points have no positions");
+  cloud.normals = read_attribute(*decoded.value(), draco::GeometryAttribute::NORMAL, 1.f);
+  return cloud;
+}
+
+StatusOr<DracoEncoded> encode_drc(const PointCloud& cloud, const DracoOptions& options) {
+  if (cloud.empty()) return invalid_argument("drc: the point cloud is empty");
+  if (!(options.max_error_mm > 0)) return invalid_argument("drc: the largest error allowed must be positive");
+  for (int bits = position_bits(cloud.positions, options.max_error_mm); bits <= kMaxPositionBits; ++bits) {
+    draco::PointCloud pc;
+    pc.set_num_points(static_cast<uint32_t>(cloud.size()));
+    add_attribute(&pc, draco::GeometryAttribute::POSITION, cloud.positions, kToMetres);
+    if (usable_normals(cloud.normals, cloud.size(), options))
+      add_attribute(&pc, draco::GeometryAttribute::NORMAL, cloud.normals, 1.f);
+    draco::Encoder encoder;
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.normal_bits);
+    const int speed = 10 - std::clamp(options.compression_level, 0, 10);
+    encoder.SetSpeedOptions(speed, speed);
+    draco::EncoderBuffer out;
+    const draco::Status s = encoder.EncodePointCloudToBuffer(pc, &out);
+    if (!s.ok()) return from_draco(s, "drc: Draco could not encode the points");
+    DracoEncoded e;
+    e.bytes.assign(out.data(), out.size());
+    e.position_bits = bits;
+    auto back = decode_drc(e.bytes);
+    if (!back.ok()) return internal_error("drc: the encoding does not decode: " + back.status().message());
+    if (back->size() != cloud.size())
+      return internal_error("drc: decoding gave " + std::to_string(back->size()) + " points, not " + std::to_string(cloud.size()));
+    e.vertices = back->size();
+    e.max_error_mm = max_displacement(cloud.positions, back->positions, std::max(1.0, 2 * options.max_error_mm));
+    if (e.max_error_mm <= options.max_error_mm) return e;
+  }
+  return internal_error("drc: no quantisation keeps the points within " + std::to_string(options.max_error_mm) + " mm");
+}
+
+StatusOr<DracoEncoded> write_glb(const std::string& path, const TriangleMesh& mesh, const DracoOptions& options) {
+  ASSIGN_OR_RETURN(DracoEncoded e, encode_glb(mesh, options));
+  RETURN_IF_ERROR(write_file_atomically(path, e.bytes));
+  return e;
+}
+
+StatusOr<DracoEncoded> write_drc(const std::string& path, const PointCloud& cloud, const DracoOptions& options) {
+  ASSIGN_OR_RETURN(DracoEncoded e, encode_drc(cloud, options));
+  RETURN_IF_ERROR(write_file_atomically(path, e.bytes));
+  return e;
+}
+
+}  // namespace bodyscan::storage
