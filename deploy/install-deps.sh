@@ -15,9 +15,10 @@ packages=(
   libembree-dev        # ray casting for the simulated rig (hw/sim)
   libpng-dev           # camera images (recon/io)
   libdraco-dev libtinygltf-dev  # glTF binary with Draco, Draco point clouds (storage/formats)
-  libcairo2-dev        # measurement sheets as PDF (storage/formats)
+  libcairo2-dev fonts-dejavu-core  # measurement sheets as PDF (storage/formats)
   libsqlite3-dev       # the scan archive's index (storage/archive)
   libgtest-dev libgmock-dev libbenchmark-dev
+  poppler-utils        # pdftotext: the tests read the PDF sheets back
 )
 if [[ "${1:-}" == "--bench" ]]; then
   packages+=(python3-open3d python3-numpy time)

@@ -8,6 +8,7 @@ int run_reconstruct(int argc, char** argv);
 int run_sim(int argc, char** argv);
 int run_scan(int argc, char** argv);
 int run_measure(int argc, char** argv);
+int run_sheet(int argc, char** argv);
 }
 
 namespace {
@@ -20,6 +21,7 @@ void print_usage(FILE* out) {
       "  scan --rig sim --out DIR        calibrate, scan and reconstruct on the simulated rig\n"
       "  sim render --rig RIG --out DIR  what the simulated rig's cameras see (PNG + index)\n"
       "  measure FILE.ply --girth-y Y    a girth (or --plane, --distance) as JSON\n"
+      "  sheet MESH.ply -o OUT.pdf       the measurement sheet (PDF, CSV or JSON)\n"
       "\n"
       "Run 'bodyscan <command> --help' for a command's options.\n",
       out);
@@ -40,6 +42,7 @@ int main(int argc, char** argv) {
   if (cmd == "scan") return bodyscan::cli::run_scan(argc - 1, argv + 1);
   if (cmd == "sim") return bodyscan::cli::run_sim(argc - 1, argv + 1);
   if (cmd == "measure") return bodyscan::cli::run_measure(argc - 1, argv + 1);
+  if (cmd == "sheet") return bodyscan::cli::run_sheet(argc - 1, argv + 1);
   std::fprintf(stderr, "bodyscan: unknown command '%s'\n", cmd.c_str());
   print_usage(stderr);
   return 2;

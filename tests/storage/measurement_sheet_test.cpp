@@ -1,0 +1,164 @@
+#include "storage/formats/measurement_sheet.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "recon/io/ply.hpp"
+#include "tests/test_data.hpp"
+
+namespace bodyscan::storage {
+namespace {
+
+struct Fixture {
+  TriangleMesh mesh;
+  MeasurementSheet sheet;
+};
+
+const Fixture& fixture() {
+  static const Fixture f = [] {
+    Fixture x;
+    auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/female_average.ply");
+    EXPECT_TRUE(mesh.ok());
+    x.mesh = *mesh;
+    auto body = measure_body(x.mesh);
+    EXPECT_TRUE(body.ok());
+    x.sheet.customer_ref = "C-0042";
+    x.sheet.scan_id = "s-20261122-001";
+    x.sheet.taken_at = "2026-11-22T10:15:00Z";
+    x.sheet.operator_name = "Ana";
+    x.sheet.entries = sheet_entries(*body);
+    return x;
+  }();
+  return f;
+}
+
+// RFC 4180 rows (quoted fields may hold commas, quotes and line breaks).
+std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
+  std::vector<std::vector<std::string>> rows(1);
+  std::string field;
+  bool quoted = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') field += '"', ++i;
+      else if (c == '"') quoted = false;
+      else field += c;
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      rows.back().push_back(field), field.clear();
+    } else if (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') {
+      rows.back().push_back(field), field.clear(), rows.emplace_back(), ++i;
+    } else {
+      field += c;
+    }
+  }
+  if (rows.back().empty()) rows.pop_back();
+  return rows;
+}
+
+SheetEntry saved(const std::string& name, const std::string& label, double mm) {
+  SheetEntry e;
+  e.name = name, e.label = label, e.kind = "girth", e.value_mm = mm, e.source = "saved by Ana";
+  return e;
+}
+
+TEST(MeasurementSheet, UnitsConvertAndRound) {
+  EXPECT_EQ(format_length(812.345, LengthUnit::kMillimetre), "812.3");
+  EXPECT_EQ(format_length(812.345, LengthUnit::kCentimetre), "81.23");
+  EXPECT_EQ(format_length(254.0, LengthUnit::kInch), "10.00");
+  EXPECT_EQ(*parse_length_unit("inch"), LengthUnit::kInch);
+  EXPECT_EQ(*parse_length_unit("cm"), LengthUnit::kCentimetre);
+  EXPECT_FALSE(parse_length_unit("furlong").ok());
+}
+
+TEST(MeasurementSheet, CsvHasOneRowPerMeasurementKeyedByClauseAndName) {
+  const Fixture& f = fixture();
+  const auto rows = parse_csv(sheet_csv(f.sheet, LengthUnit::kCentimetre));
+  ASSERT_EQ(rows.size(), f.sheet.entries.size() + 1);
+  EXPECT_EQ(rows[0][0], "iso_clause");
+  EXPECT_EQ(rows[0][1], "name");
+  for (size_t i = 0; i < f.sheet.entries.size(); ++i) {
+    const SheetEntry& e = f.sheet.entries[i];
+    ASSERT_EQ(rows[i + 1].size(), 10u);
+    EXPECT_EQ(rows[i + 1][0], e.iso_clause);
+    EXPECT_EQ(rows[i + 1][1], e.name);
+    EXPECT_NEAR(std::stod(rows[i + 1][3]), e.value_mm / 10, 0.005 + 1e-9);
+    EXPECT_EQ(rows[i + 1][4], "cm");
+    EXPECT_EQ(rows[i + 1][7], "C-0042");
+  }
+}
+
+TEST(MeasurementSheet, CsvQuotesAndDefusesWhatPeopleType) {
+  MeasurementSheet s;
+  s.customer_ref = "=HYPERLINK(\"http://evil\")";
+  s.entries.push_back(saved("user_1", "Sleeve, \"left\"\nto cuff", 612.0));
+  const auto rows = parse_csv(sheet_csv(s, LengthUnit::kMillimetre));
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[1][2], "Sleeve, \"left\"\nto cuff");
+  EXPECT_EQ(rows[1][7], "'=HYPERLINK(\"http://evil\")");  // never a live formula
+}
+
+TEST(MeasurementSheet, JsonCarriesTheSameValues) {
+  const Fixture& f = fixture();
+  const nlohmann::json j = sheet_json(f.sheet, LengthUnit::kInch);
+  EXPECT_EQ(j["schema"], "bodyscan.sheet/1");
+  EXPECT_EQ(j["unit"], "in");
+  ASSERT_EQ(j["measurements"].size(), f.sheet.entries.size());
+  for (size_t i = 0; i < f.sheet.entries.size(); ++i)
+    EXPECT_NEAR(j["measurements"][i]["value"].get<double>(), f.sheet.entries[i].value_mm / 25.4, 0.005 + 1e-9);
+  EXPECT_EQ(j["by_clause"]["5.3.10"], "waist_girth");
+  EXPECT_EQ(j["by_clause"]["5.1.1"], "stature");
+}
+
+std::string pdf_text(const std::string& pdf) {
+  const std::string dir = testing::temp_dir();
+  {
+    std::ofstream(dir + "/sheet.pdf", std::ios::binary) << pdf;
+  }
+  const std::string cmd = "pdftotext -layout " + dir + "/sheet.pdf " + dir + "/sheet.txt 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << "pdftotext (poppler-utils) reads the sheet back";
+  std::ifstream in(dir + "/sheet.txt");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(MeasurementSheet, PdfShowsTheCustomerTheTableAndTheSilhouettes) {
+  const Fixture& f = fixture();
+  auto pdf = sheet_pdf(f.sheet, f.mesh, LengthUnit::kCentimetre);
+  ASSERT_TRUE(pdf.ok()) << pdf.status().message();
+  ASSERT_EQ(pdf->rfind("%PDF-", 0), 0u);
+  const std::string text = pdf_text(*pdf);
+  EXPECT_NE(text.find("C-0042"), std::string::npos) << text;
+  EXPECT_NE(text.find("2026-11-22"), std::string::npos);
+  for (const SheetEntry& e : f.sheet.entries) {
+    EXPECT_NE(text.find(e.label), std::string::npos) << e.label;
+    EXPECT_NE(text.find(format_length(e.value_mm, LengthUnit::kCentimetre)), std::string::npos) << e.label;
+  }
+  // One page, and the silhouettes are images on it: a sheet without the mesh is smaller.
+  auto bare = sheet_pdf(f.sheet, TriangleMesh{}, LengthUnit::kCentimetre);
+  ASSERT_TRUE(bare.ok());
+  EXPECT_GT(pdf->size(), bare->size() + 5000);
+  EXPECT_EQ(text.find("page 2"), std::string::npos);
+}
+
+TEST(MeasurementSheet, ALongListRunsOnToMorePages) {
+  const Fixture& f = fixture();
+  MeasurementSheet s = f.sheet;
+  for (int i = 0; i < 60; ++i)
+    s.entries.push_back(saved("user_" + std::to_string(i), "Saved line " + std::to_string(i), 500.0 + i));
+  auto pdf = sheet_pdf(s, f.mesh, LengthUnit::kMillimetre);
+  ASSERT_TRUE(pdf.ok());
+  const std::string text = pdf_text(*pdf);
+  EXPECT_NE(text.find("page 2"), std::string::npos);
+  EXPECT_NE(text.find("Saved line 59"), std::string::npos);
+  EXPECT_NE(text.find("559.0"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace bodyscan::storage
