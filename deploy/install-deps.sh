@@ -17,6 +17,7 @@ packages=(
   libdraco-dev libtinygltf-dev  # glTF binary with Draco, Draco point clouds (storage/formats)
   libcairo2-dev fonts-dejavu-core  # measurement sheets as PDF (storage/formats)
   libsqlite3-dev       # the scan archive's index (storage/archive)
+  libsodium-dev        # checksums of archived files; password hashing (server)
   libgtest-dev libgmock-dev libbenchmark-dev
   poppler-utils        # pdftotext: the tests read the PDF sheets back
 )
