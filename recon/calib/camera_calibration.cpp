@@ -94,23 +94,34 @@ StatusOr<CameraCalibration> calibrate_camera(const std::string& camera_id, const
   auto side = identify_side(*ordered, *front);
   if (!side.ok()) return fail("which side of the frame", side.status());
 
+  std::array<std::array<Eigen::Vector2d, 2>, 4> markers = name_markers(*ordered, *side);
+  for (auto& pole : markers)
+    for (Eigen::Vector2d& p : pole) p = lens.correct(p);
+  return camera_from_markers(camera_id, images.lights_on.width, images.lights_on.height, frame, lens, *side, markers);
+}
+
+StatusOr<CameraCalibration> camera_from_markers(const std::string& camera_id, int width, int height,
+                                                const ReferenceFrame& frame, const LensCorrection& lens,
+                                                FrameSide side,
+                                                const std::array<std::array<Eigen::Vector2d, 2>, 4>& markers) {
+  auto fail = [&](const std::string& step, const Status& s) {
+    return Status(s.code(), "camera '" + camera_id + "': " + step + ": " + s.message());
+  };
   CameraCalibration cal;
   cal.camera_id = camera_id;
-  cal.width = images.lights_on.width;
-  cal.height = images.lights_on.height;
+  cal.width = width;
+  cal.height = height;
   cal.frame = frame;
   cal.lens = lens;
-  cal.side = *side;
-  cal.markers = name_markers(*ordered, *side);
-  for (auto& pole : cal.markers)
-    for (Eigen::Vector2d& p : pole) p = lens.correct(p);
+  cal.side = side;
+  cal.markers = markers;
   for (bool top : {false, true}) {
     std::vector<Eigen::Vector2d> image, plane;
     for (Pole p : kPoles) {
       if (is_top(p) != top) continue;
       for (int i = 0; i < 2; ++i) {
         image.push_back(cal.markers[static_cast<size_t>(p)][static_cast<size_t>(i)]);
-        const Eigen::Vector3d w = frame.light(p, *side, i);
+        const Eigen::Vector3d w = frame.light(p, side, i);
         plane.emplace_back(w.x(), w.z());
       }
     }

@@ -476,6 +476,8 @@ std::vector<GridDot> index_grid(const std::vector<Dot>& dots, const GridOptions&
 // ---- LensCorrection -------------------------------------------------------------
 
 struct LensCorrection::State {
+  std::vector<GridDot> dots;  // what the splines were fitted to
+  LensOptions options;
   PlateSpline forward, inverse;  // captured -> ideal, ideal -> captured
   Table forward_table, inverse_table;
   std::vector<RemapEntry> remap;  // per output pixel
@@ -528,6 +530,8 @@ StatusOr<LensCorrection> LensCorrection::fit(const std::vector<GridDot>& dots, i
   }
 
   auto state = std::make_shared<State>();
+  state->dots = dots;
+  state->options = o;
   std::optional<PlateSpline> forward = PlateSpline::fit(captured, ideal, o.smoothing, o.degree);
   std::optional<PlateSpline> inverse = PlateSpline::fit(ideal, captured, o.smoothing, o.degree);
   if (!forward || !inverse) return invalid_argument("lens correction: the splines cannot be fitted (coincident dots?)");
@@ -661,6 +665,16 @@ StatusOr<std::vector<uint16_t>> LensCorrection::remap(const ImageView& image) co
     }
   });
   return out;
+}
+
+const std::vector<GridDot>& LensCorrection::grid_dots() const {
+  static const std::vector<GridDot> none;
+  return state_ ? state_->dots : none;
+}
+
+const LensOptions& LensCorrection::options() const {
+  static const LensOptions defaults;
+  return state_ ? state_->options : defaults;
 }
 
 StatusOr<LensCorrection> calibrate_lens(const ImageView& image, const LensOptions& o) {

@@ -127,6 +127,11 @@ class LensCorrection {
   // RMS distance (pixels) between held-out dots' corrected and ideal positions: the
   // correction's accuracy between dots, centroid noise included.
   double held_out_rms_px() const { return held_out_rms_; }
+  // What fit() was given (empty for the identity): fitting them again with the
+  // same options and image size gives this correction again, exactly.
+  const std::vector<GridDot>& grid_dots() const;
+  const LensOptions& options() const;
+  void set_dots_found(int n) { dots_found_ = n; }  // for a correction rebuilt from its dots
 
  private:
   struct State;

@@ -8,6 +8,7 @@
 
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "recon/geometry/point_cloud.hpp"
@@ -76,6 +77,12 @@ class ScanProcessor {
   StatusOr<PointCloud> finish();
   const ScanStats& stats() const { return stats_; }
   const ScanOptions& options() const { return options_; }
+
+  // The frames' stripe samples and planes, compressed (scan_recording.hpp): call
+  // before finish(). load_recording() puts a recording in place of consumed frames,
+  // so that finish() makes the same cloud again; with another ScanOptions, a new one.
+  std::string recording() const;
+  Status load_recording(std::string_view bytes);
 
  private:
   struct FrameRecord {

@@ -8,6 +8,7 @@
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/ply.hpp"
 #include "server/pipeline/measurements_json.hpp"
+#include "server/pipeline/scan_recording.hpp"
 #include "storage/formats/draco_files.hpp"
 
 namespace bodyscan::pipeline {
@@ -15,6 +16,40 @@ namespace bodyscan::pipeline {
 namespace {
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// From the cloud on: the surface, then the automatic measurements.
+Status surface_and_measure(const ScanJobOptions& options, ScanJobResult* out) {
+  if (out->cloud.size() < 1000) {
+    return failed_precondition("the scan gave " + std::to_string(out->cloud.size()) +
+                               " points: is someone standing in the frame, and are the lasers on? " +
+                               (out->scan.first_plane_error.empty() ? "" : "(first frame error: " +
+                                                                              out->scan.first_plane_error + ")"));
+  }
+  if (options.reconstruct) {
+    ReconstructOptions ro = options.surface;
+    if (!ro.progress) ro.progress = options.progress;
+    // The view-angle step leaves quick normals (fixed k) in the cloud for viewers;
+    // the surface estimates its own, sized to the noise, and turns them to the cameras.
+    if (ro.normal_source == NormalSource::kAuto && out->cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
+    StatusOr<ReconstructResult> r = reconstruct_surface(out->cloud, ro);
+    if (r.ok()) {
+      out->mesh = std::move(r->mesh);
+      out->surface = r->stats;
+    } else {
+      out->surface_error = r.status().message();
+    }
+  }
+  if (options.measure && !out->mesh.triangles.empty()) {
+    BodyMeasureOptions mo;
+    // The floor the subject stands on: the bottom frame's tubing lies on it, its
+    // light centres (world Y = 0) half a tube up.
+    mo.floor_y = -0.5 * out->calibration.frame.tube;
+    StatusOr<BodyMeasurements> body = measure_body(out->mesh, mo);
+    if (body.ok()) out->body = std::move(*body);
+    else out->measure_error = body.status().message();
+  }
+  return Status::Ok();
 }
 }  // namespace
 
@@ -32,38 +67,33 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& optio
   RETURN_IF_ERROR(acquire_scan(
       rig, [&](Shot&& s) { return processor.consume(std::move(s)); }, options.every, options.progress,
       out.calibration.sweep_reversed));
+  if (options.record_raw) {
+    out.raw_record = calibration_record(out.calibration);
+    out.raw_record["scan_options"] = {{"max_view_deg", scan_options.view.max_view_deg}, {"every", options.every}};
+    out.raw_stripes = processor.recording();
+  }
   ASSIGN_OR_RETURN(out.cloud, processor.finish());
   out.scan = processor.stats();
   out.scan_seconds = seconds_since(t0);
-  if (out.cloud.size() < 1000) {
-    return failed_precondition("the scan gave " + std::to_string(out.cloud.size()) +
-                               " points: is someone standing in the frame, and are the lasers on? " +
-                               (out.scan.first_plane_error.empty() ? "" : "(first frame error: " +
-                                                                             out.scan.first_plane_error + ")"));
-  }
-  if (options.reconstruct) {
-    ReconstructOptions ro = options.surface;
-    if (!ro.progress) ro.progress = options.progress;
-    // The view-angle step leaves quick normals (fixed k) in the cloud for viewers;
-    // the surface estimates its own, sized to the noise, and turns them to the cameras.
-    if (ro.normal_source == NormalSource::kAuto && out.cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
-    StatusOr<ReconstructResult> r = reconstruct_surface(out.cloud, ro);
-    if (r.ok()) {
-      out.mesh = std::move(r->mesh);
-      out.surface = r->stats;
-    } else {
-      out.surface_error = r.status().message();
-    }
-  }
-  if (options.measure && !out.mesh.triangles.empty()) {
-    BodyMeasureOptions mo;
-    // The floor the subject stands on: the bottom frame's tubing lies on it, its
-    // light centres (world Y = 0) half a tube up.
-    if (rig.description) mo.floor_y = -0.5 * rig.description->frame.tube;
-    StatusOr<BodyMeasurements> body = measure_body(out.mesh, mo);
-    if (body.ok()) out.body = std::move(*body);
-    else out.measure_error = body.status().message();
-  }
+  RETURN_IF_ERROR(surface_and_measure(options, &out));
+  return out;
+}
+
+StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string_view stripes, const ScanJobOptions& options) {
+  ScanJobResult out;
+  ASSIGN_OR_RETURN(out.calibration, calibration_from_record(record));
+  const auto t0 = std::chrono::steady_clock::now();
+  ScanOptions scan_options = options.scan;
+  const nlohmann::json used = record.value("scan_options", nlohmann::json::object());
+  scan_options.view.max_view_deg = options.max_view_deg.value_or(used.value("max_view_deg", 90.0));
+  ScanProcessor processor(out.calibration, scan_options);
+  RETURN_IF_ERROR(processor.load_recording(stripes));
+  out.raw_record = record;
+  out.raw_stripes = std::string(stripes);
+  ASSIGN_OR_RETURN(out.cloud, processor.finish());
+  out.scan = processor.stats();
+  out.scan_seconds = seconds_since(t0);
+  RETURN_IF_ERROR(surface_and_measure(options, &out));
   return out;
 }
 

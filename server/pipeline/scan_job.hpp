@@ -3,8 +3,11 @@
 // surface, write the results.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "recon/geometry/triangle_mesh.hpp"
 #include "recon/measure/body_measurements.hpp"
@@ -37,6 +40,7 @@ struct ScanJobOptions {
   bool reconstruct = true;
   ReconstructOptions surface = body_surface_options();
   bool measure = true;  // the automatic set on the surface (measure_body)
+  bool record_raw = true;  // keep the raw record (scan_recording.hpp) in the result
   ProgressFn progress;  // stages: calibration..., scan, surface...
 };
 
@@ -51,6 +55,10 @@ struct ScanJobResult {
   std::string surface_error;
   std::optional<BodyMeasurements> body;  // the automatic set, when measured
   std::string measure_error;             // why it could not be (the surface is kept)
+  // The raw record, to reprocess the scan later: the calibration record (with the
+  // scan options used, "scan_options") and the frames' stripes, compressed.
+  nlohmann::json raw_record;
+  std::string raw_stripes;
   double calibration_seconds = 0;  // acquisition and processing
   double scan_seconds = 0;         // acquisition and processing
 };
@@ -58,6 +66,11 @@ struct ScanJobResult {
 // Errors when calibration or the scan fails, or the scan gives no usable cloud; a
 // failed reconstruction is reported in surface_error, the cloud kept.
 StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& options = {});
+
+// The scan again from its raw record: the cloud, surface and measurements as
+// `options` makes them now (the scan options recorded, unless overridden).
+StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string_view stripes,
+                                       const ScanJobOptions& options = {});
 
 // DIR/points.ply, DIR/mesh.ply (when reconstructed), DIR/measurements.json (when
 // measured; docs/measurements.md), DIR/calibration.json and DIR/scan.json (the

@@ -63,6 +63,32 @@ TEST(ScanJob, PointsLieOnTheBodyFromEveryCamera) {
                                         (s.degrees_per_step < 0 ? -1 : 1), 0.001);
   }
   for (int i = 0; i < rig->controller().num_lasers(); ++i) EXPECT_FALSE(rig->controller().laser_on(i));
+
+  // The raw record makes the same cloud again, point for point, without a frame:
+  // the calibration rebuilt from its dots and markers, the stripes replayed.
+  ASSERT_FALSE(result->raw_stripes.empty());
+  const std::string record_text = result->raw_record.dump();  // as archived
+  auto again = reprocess_scan(nlohmann::json::parse(record_text), result->raw_stripes, options);
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  ASSERT_EQ(again->cloud.size(), cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_EQ(again->cloud.positions[i], cloud.positions[i]) << i;
+    ASSERT_EQ(again->cloud.confidence[i], cloud.confidence[i]) << i;
+  }
+  EXPECT_EQ(again->scan.frames, result->scan.frames);
+  EXPECT_DOUBLE_EQ(again->scan.fourth_point_rms_mm, result->scan.fourth_point_rms_mm);
+  std::printf("[ scan job ] raw record: %zu bytes of stripes for %zu frames, %zu bytes of calibration\n",
+              result->raw_stripes.size(), result->scan.frames, record_text.size());
+  // Damaged records say so.
+  std::string cut = result->raw_stripes.substr(0, result->raw_stripes.size() / 2);
+  auto broken = reprocess_scan(result->raw_record, cut, options);
+  ASSERT_FALSE(broken.ok());
+  EXPECT_NE(broken.status().message().find("scan record"), std::string::npos) << broken.status().message();
+  nlohmann::json no_cameras = result->raw_record;
+  no_cameras.erase("cameras");
+  auto missing = reprocess_scan(no_cameras, result->raw_stripes, options);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.status().message().find("calibration record"), std::string::npos) << missing.status().message();
 }
 
 TEST(ScanJob, TheSquareRigDropsGrazingViewsAsItsDescriptionAsks) {
