@@ -4,6 +4,14 @@
 #include <cstdlib>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <memory>
+#include <optional>
+
+#include "hw/rig_description.hpp"
+#include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/sim_backend.hpp"
 
@@ -19,7 +27,8 @@ void usage(FILE* out) {
       "the frame's poles), scans the subject, turns the laser stripes into one point\n"
       "cloud, reconstructs a closed surface and measures it. Writes DIR/points.ply,\n"
       "DIR/mesh.ply, DIR/mesh.glb, DIR/measurements.json (docs/measurements.md),\n"
-      "DIR/calibration.json and DIR/scan.json.\n"
+      "DIR/calibration.json, DIR/scan.json and DIR/raw/ (the raw record that\n"
+      "`bodyscan reprocess` makes the scan again from).\n"
       "\n"
       "  --rig RIG        sim (the thesis rig and the demo body), thesis, square,\n"
       "                   or a rig description file (JSON)\n"
@@ -34,6 +43,11 @@ void usage(FILE* out) {
       "                   body; default: the rig description's processing\n"
       "                   .max_view_deg, else 90: keep them all)\n"
       "  --no-surface     stop at the point cloud\n"
+      "  --archive DIR    also store the scan in the archive in DIR (created;\n"
+      "                   docs/archive.md); --out is then optional\n"
+      "  --customer ID    the archived scan's customer (default: a new one)\n"
+      "  --new-customer NAME  a new customer with this name\n"
+      "  --operator NAME  who runs the scan (the archive's audit log)\n"
       "  -q, --quiet      print only errors\n",
       out);
 }
@@ -41,7 +55,7 @@ void usage(FILE* out) {
 }  // namespace
 
 int run_scan(int argc, char** argv) {
-  std::string rig_arg, body, out;
+  std::string rig_arg, body, out, archive_dir, customer_id, new_customer, operator_name = "cli";
   pipeline::ScanJobOptions options;
   bool quiet = false;
   for (int i = 1; i < argc; ++i) {
@@ -56,6 +70,13 @@ int run_scan(int argc, char** argv) {
     if (a == "--help" || a == "-h") {
       usage(stdout);
       return 0;
+    } else if (a == "--archive" || a == "--customer" || a == "--new-customer" || a == "--operator") {
+      const char* v = value();
+      if (!v) return 2;
+      if (a == "--archive") archive_dir = v;
+      if (a == "--customer") customer_id = v;
+      if (a == "--new-customer") new_customer = v;
+      if (a == "--operator") operator_name = v;
     } else if (a == "--rig" || a == "--body" || a == "--out" || a == "--every" || a == "--method" ||
                a == "--max-view") {
       const char* v = value();
@@ -98,9 +119,13 @@ int run_scan(int argc, char** argv) {
       return 2;
     }
   }
-  if (rig_arg.empty() || out.empty()) {
-    std::fprintf(stderr, "bodyscan scan: --rig and --out are required\n");
+  if (rig_arg.empty() || (out.empty() && archive_dir.empty())) {
+    std::fprintf(stderr, "bodyscan scan: --rig and --out (or --archive) are required\n");
     usage(stderr);
+    return 2;
+  }
+  if (archive_dir.empty() && (!customer_id.empty() || !new_customer.empty())) {
+    std::fprintf(stderr, "bodyscan scan: --customer and --new-customer go with --archive\n");
     return 2;
   }
   auto sim = pipeline::open_simulated_rig(rig_arg, body);
@@ -108,6 +133,37 @@ int run_scan(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan scan: %s\n", sim.status().message().c_str());
     return 1;
   }
+  // Into the archive: the scan is recorded as running before the rig moves, so
+  // that a crash leaves a scan the next start marks failed, never a silent gap.
+  std::unique_ptr<storage::Archive> archive;
+  std::string scan_id;
+  if (!archive_dir.empty()) {
+    auto opened = storage::Archive::open(archive_dir);
+    if (!opened.ok()) {
+      std::fprintf(stderr, "bodyscan scan: %s\n", opened.status().message().c_str());
+      return 1;
+    }
+    archive = std::move(*opened);
+    if (customer_id.empty()) {
+      auto c = archive->add_customer(new_customer.empty() ? std::nullopt : std::optional<std::string>(new_customer),
+                                     std::nullopt, operator_name);
+      if (!c.ok()) {
+        std::fprintf(stderr, "bodyscan scan: %s\n", c.status().message().c_str());
+        return 1;
+      }
+      customer_id = c->id;
+    }
+    auto id = archive->begin_scan(customer_id, operator_name,
+                                  nlohmann::json::parse(hw::to_json((*sim)->description()), nullptr, false), "");
+    if (!id.ok()) {
+      std::fprintf(stderr, "bodyscan scan: %s\n", id.status().message().c_str());
+      return 1;
+    }
+    scan_id = *id;
+  }
+  auto fail_archived = [&](const std::string& why) {
+    if (archive) archive->end_scan(scan_id, storage::ScanStatus::kFailed, why);
+  };
   std::string last_stage;
   int last_percent = -1;
   if (!quiet) {
@@ -128,13 +184,25 @@ int run_scan(int argc, char** argv) {
   auto result = pipeline::run_scan_job(pipeline::rig_handle(**sim), options);
   if (!quiet && !last_stage.empty()) std::fprintf(stderr, "\n");
   if (!result.ok()) {
+    fail_archived(result.status().message());
     std::fprintf(stderr, "bodyscan scan: %s\n", result.status().message().c_str());
     return 1;
   }
-  const Status w = pipeline::write_scan_results(*result, out);
-  if (!w.ok()) {
-    std::fprintf(stderr, "bodyscan scan: %s\n", w.message().c_str());
-    return 1;
+  if (!out.empty()) {
+    const Status w = pipeline::write_scan_results(*result, out);
+    if (!w.ok()) {
+      fail_archived("could not write the results: " + w.message());
+      std::fprintf(stderr, "bodyscan scan: %s\n", w.message().c_str());
+      return 1;
+    }
+  }
+  if (archive) {
+    const Status stored = pipeline::archive_scan(*archive, scan_id, *result, options);
+    if (!stored.ok()) {
+      fail_archived("could not store the results: " + stored.message());
+      std::fprintf(stderr, "bodyscan scan: %s\n", stored.message().c_str());
+      return 1;
+    }
   }
   if (!quiet) {
     for (const CameraCalibration& c : result->calibration.cameras) {
@@ -153,8 +221,10 @@ int run_scan(int argc, char** argv) {
       std::printf("measurements: %zu taken (%zu skipped), %zu landmarks\n", result->body->measurements.size(),
                   result->body->skipped.size(), result->body->landmarks.size());
     }
-    std::printf("wrote %s/points.ply%s%s, calibration.json, scan.json\n", out.c_str(),
-                result->mesh.triangles.empty() ? "" : ", mesh.ply, mesh.glb", result->body ? ", measurements.json" : "");
+    if (!out.empty())
+      std::printf("wrote %s/points.ply%s%s, calibration.json, scan.json, raw/\n", out.c_str(),
+                  result->mesh.triangles.empty() ? "" : ", mesh.ply, mesh.glb", result->body ? ", measurements.json" : "");
+    if (archive) std::printf("archived scan %s for customer %s in %s\n", scan_id.c_str(), customer_id.c_str(), archive_dir.c_str());
   }
   if (!result->measure_error.empty()) {
     std::fprintf(stderr, "bodyscan scan: warning: no automatic measurements: %s\n", result->measure_error.c_str());
@@ -162,6 +232,90 @@ int run_scan(int argc, char** argv) {
   if (!result->surface_error.empty()) {
     std::fprintf(stderr, "bodyscan scan: the point cloud is saved in %s, but the surface failed: %s\n", out.c_str(),
                  result->surface_error.c_str());
+    return 1;
+  }
+  return 0;
+}
+
+int run_reprocess(int argc, char** argv) {
+  std::string in, out;
+  pipeline::ScanJobOptions options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::puts(
+          "usage: bodyscan reprocess SCAN_DIR --out DIR [--method ray|homography] [--max-view DEG] [--no-surface]\n"
+          "\n"
+          "Makes a scan again from the raw record `bodyscan scan` left in SCAN_DIR/raw\n"
+          "(calibration and stripe samples; no camera frames), with today's processing,\n"
+          "and writes the results into DIR as `bodyscan scan` does. Archived scans:\n"
+          "`bodyscan archive DIR reprocess SCAN`.");
+      return 0;
+    } else if ((a == "--out" || a == "--method" || a == "--max-view") && i + 1 < argc) {
+      const std::string v = argv[++i];
+      if (a == "--out") out = v;
+      if (a == "--method") {
+        if (v == "ray") options.scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
+        else if (v == "homography") options.scan.triangulate.method = TriangulationMethod::kLaserHomography;
+        else {
+          std::fprintf(stderr, "bodyscan reprocess: --method is ray or homography, not '%s'\n", v.c_str());
+          return 2;
+        }
+      }
+      if (a == "--max-view") {
+        char* end = nullptr;
+        const double deg = std::strtod(v.c_str(), &end);
+        if (end == v.c_str() || *end != '\0' || !(deg > 0 && deg <= 90)) {
+          std::fprintf(stderr, "bodyscan reprocess: --max-view expects degrees in (0, 90], got '%s'\n", v.c_str());
+          return 2;
+        }
+        options.max_view_deg = deg;
+      }
+    } else if (a == "--no-surface") {
+      options.reconstruct = false;
+    } else if (!a.empty() && a[0] != '-' && in.empty()) {
+      in = a;
+    } else {
+      std::fprintf(stderr, "bodyscan reprocess: unexpected '%s'\n", a.c_str());
+      return 2;
+    }
+  }
+  if (in.empty() || out.empty()) {
+    std::fprintf(stderr, "usage: bodyscan reprocess SCAN_DIR --out DIR (see --help)\n");
+    return 2;
+  }
+  auto slurp = [](const std::string& path) -> std::optional<std::string> {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return std::nullopt;
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  };
+  const auto record = slurp(in + "/raw/" + pipeline::kRawRecordFile);
+  const auto stripes = slurp(in + "/raw/" + pipeline::kRawStripesFile);
+  if (!record || !stripes) {
+    std::fprintf(stderr, "bodyscan reprocess: %s/raw/ has no raw record (%s, %s); was it written by bodyscan scan?\n",
+                 in.c_str(), pipeline::kRawRecordFile, pipeline::kRawStripesFile);
+    return 1;
+  }
+  const nlohmann::json j = nlohmann::json::parse(*record, nullptr, false);
+  if (j.is_discarded()) {
+    std::fprintf(stderr, "bodyscan reprocess: %s/raw/%s is not JSON\n", in.c_str(), pipeline::kRawRecordFile);
+    return 1;
+  }
+  auto result = pipeline::reprocess_scan(j, *stripes, options);
+  if (!result.ok()) {
+    std::fprintf(stderr, "bodyscan reprocess: %s\n", result.status().message().c_str());
+    return 1;
+  }
+  const Status w = pipeline::write_scan_results(*result, out);
+  if (!w.ok()) {
+    std::fprintf(stderr, "bodyscan reprocess: %s\n", w.message().c_str());
+    return 1;
+  }
+  std::printf("reprocessed: %zu points%s, written to %s\n", result->cloud.size(),
+              result->mesh.triangles.empty() ? "" : (", " + std::to_string(result->mesh.num_triangles()) + " triangles").c_str(),
+              out.c_str());
+  if (!result->surface_error.empty()) {
+    std::fprintf(stderr, "bodyscan reprocess: the surface failed: %s\n", result->surface_error.c_str());
     return 1;
   }
   return 0;

@@ -9,6 +9,8 @@ int run_sim(int argc, char** argv);
 int run_scan(int argc, char** argv);
 int run_measure(int argc, char** argv);
 int run_sheet(int argc, char** argv);
+int run_reprocess(int argc, char** argv);
+int run_archive(int argc, char** argv);
 }
 
 namespace {
@@ -22,6 +24,8 @@ void print_usage(FILE* out) {
       "  sim render --rig RIG --out DIR  what the simulated rig's cameras see (PNG + index)\n"
       "  measure FILE.ply --girth-y Y    a girth (or --plane, --distance) as JSON\n"
       "  sheet MESH.ply -o OUT.pdf       the measurement sheet (PDF, CSV or JSON)\n"
+      "  reprocess SCAN_DIR --out DIR    a scan again from its raw record\n"
+      "  archive DIR list|show|verify|export|erase|reprocess|sheet ...  the scan archive\n"
       "\n"
       "Run 'bodyscan <command> --help' for a command's options.\n",
       out);
@@ -43,6 +47,8 @@ int main(int argc, char** argv) {
   if (cmd == "sim") return bodyscan::cli::run_sim(argc - 1, argv + 1);
   if (cmd == "measure") return bodyscan::cli::run_measure(argc - 1, argv + 1);
   if (cmd == "sheet") return bodyscan::cli::run_sheet(argc - 1, argv + 1);
+  if (cmd == "reprocess") return bodyscan::cli::run_reprocess(argc - 1, argv + 1);
+  if (cmd == "archive") return bodyscan::cli::run_archive(argc - 1, argv + 1);
   std::fprintf(stderr, "bodyscan: unknown command '%s'\n", cmd.c_str());
   print_usage(stderr);
   return 2;

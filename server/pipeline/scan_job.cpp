@@ -97,23 +97,27 @@ StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string
   return out;
 }
 
-Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return io_error("cannot create '" + dir + "': " + ec.message());
-  const std::filesystem::path d(dir);
-  RETURN_IF_ERROR(write_file_atomically((d / "calibration.json").string(), to_json(r.calibration).dump(2)));
-  RETURN_IF_ERROR(write_ply((d / "points.ply").string(), r.cloud));
+StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r) {
+  ScanFiles f;
+  f.results["calibration.json"] = to_json(r.calibration).dump(2);
+  if (!r.raw_stripes.empty()) {
+    f.raw[kRawRecordFile] = r.raw_record.dump();
+    f.raw[kRawStripesFile] = r.raw_stripes;
+  }
+  f.results["points.ply"] = encode_ply(r.cloud, PlyFormat::kBinaryLittleEndian);
+  ASSIGN_OR_RETURN(storage::DracoEncoded drc, storage::encode_drc(r.cloud));
+  f.results["points.drc"] = std::move(drc.bytes);
   nlohmann::json glb;
   if (!r.mesh.triangles.empty()) {
-    RETURN_IF_ERROR(write_ply((d / "mesh.ply").string(), r.mesh));
-    ASSIGN_OR_RETURN(storage::DracoEncoded e, storage::write_glb((d / "mesh.glb").string(), r.mesh));
+    f.results["mesh.ply"] = encode_ply(r.mesh, PlyFormat::kBinaryLittleEndian);
+    ASSIGN_OR_RETURN(storage::DracoEncoded e, storage::encode_glb(r.mesh));
     glb = {{"bytes", e.bytes.size()}, {"position_bits", e.position_bits}, {"max_error_mm", e.max_error_mm}};
+    f.results["mesh.glb"] = std::move(e.bytes);
   }
   if (r.body) {
     nlohmann::json m = measurements_document("mesh.ply", "mesh");
     add_body_measurements(*r.body, &m);
-    RETURN_IF_ERROR(write_file_atomically((d / "measurements.json").string(), m.dump(1)));
+    f.results["measurements.json"] = m.dump(1);
   }
   nlohmann::json j;
   j["points"] = r.cloud.size();
@@ -148,7 +152,21 @@ Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
                  {"holes_filled", r.surface.holes_filled},
                  {"seconds", r.surface.total_seconds()}};
   }
-  return write_file_atomically((d / "scan.json").string(), j.dump(2));
+  f.results["scan.json"] = j.dump(2);
+  return f;
+}
+
+Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
+  ASSIGN_OR_RETURN(ScanFiles files, scan_result_files(r));
+  const std::filesystem::path d(dir);
+  std::error_code ec;
+  std::filesystem::create_directories(d / "raw", ec);
+  if (ec) return io_error("cannot create '" + (d / "raw").string() + "': " + ec.message());
+  for (const auto& [name, bytes] : files.raw) RETURN_IF_ERROR(write_file_atomically((d / "raw" / name).string(), bytes));
+  // scan.json last: its presence says the rest is there.
+  for (const auto& [name, bytes] : files.results)
+    if (name != "scan.json") RETURN_IF_ERROR(write_file_atomically((d / name).string(), bytes));
+  return write_file_atomically((d / "scan.json").string(), files.results["scan.json"]);
 }
 
 }  // namespace bodyscan::pipeline

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -72,9 +73,22 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& optio
 StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string_view stripes,
                                        const ScanJobOptions& options = {});
 
+inline constexpr const char* kRawRecordFile = "record.json";   // in DIR/raw and the archive's raw/
+inline constexpr const char* kRawStripesFile = "stripes.bin";
+
+// Every file a scan leaves, as bytes: the results (calibration.json, points.ply,
+// points.drc, mesh.ply, mesh.glb, measurements.json, scan.json, as far as the job
+// got) and the raw record (record.json, stripes.bin). The GLB and the Draco cloud
+// are checked by decoding them again (storage/formats/draco_files.hpp).
+struct ScanFiles {
+  std::map<std::string, std::string> results, raw;
+};
+StatusOr<ScanFiles> scan_result_files(const ScanJobResult& result);
+
 // DIR/points.ply, DIR/mesh.ply (when reconstructed), DIR/measurements.json (when
 // measured; docs/measurements.md), DIR/calibration.json and DIR/scan.json (the
-// figures), each written atomically. Creates DIR.
+// figures), DIR/raw/record.json and DIR/raw/stripes.bin (the raw record, for
+// `bodyscan reprocess`), each written atomically. Creates DIR.
 Status write_scan_results(const ScanJobResult& result, const std::string& dir);
 
 }  // namespace bodyscan::pipeline

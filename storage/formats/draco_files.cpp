@@ -2,13 +2,16 @@
 
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
-#include <draco/io/gltf_decoder.h>
 #include <draco/io/gltf_encoder.h>
 #include <draco/mesh/mesh.h>
 #include <draco/point_cloud/point_cloud.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <map>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -39,28 +42,40 @@ int position_bits(const std::vector<Vec3f>& p, double max_error_mm) {
 
 // The largest distance from a point of `a` to the nearest point of `b` and back
 // (vertex sets in mm), looked up in a grid of `cell`-sized cubes: pairs farther
-// apart than one cell count as infinitely far, which fails any check.
+// apart than one cell count as infinitely far, which fails any check. A point's own
+// cell is searched first; its neighbours only when the nearest found is farther
+// than the cell's nearest wall.
 double max_displacement(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b, double cell) {
   auto one_way = [cell](const std::vector<Vec3f>& from, const std::vector<Vec3f>& to) {
     if (from.empty()) return 0.0;
     if (to.empty()) return std::numeric_limits<double>::infinity();
-    auto key = [cell](const Vec3f& v, int dx, int dy, int dz) {
-      const auto c = [cell](float x, int d) { return static_cast<int64_t>(std::floor(x / cell)) + d + (1 << 20); };
-      return (c(v.x(), dx) << 42) | (c(v.y(), dy) << 21) | c(v.z(), dz);
+    auto coord = [cell](float x) { return static_cast<int64_t>(std::floor(x / cell)); };
+    auto key = [](int64_t x, int64_t y, int64_t z) {
+      return ((x + (1 << 20)) << 42) | ((y + (1 << 20)) << 21) | (z + (1 << 20));
     };
     std::vector<std::pair<int64_t, uint32_t>> grid(to.size());
-    for (size_t i = 0; i < to.size(); ++i) grid[i] = {key(to[i], 0, 0, 0), static_cast<uint32_t>(i)};
+    for (size_t i = 0; i < to.size(); ++i)
+      grid[i] = {key(coord(to[i].x()), coord(to[i].y()), coord(to[i].z())), static_cast<uint32_t>(i)};
     std::sort(grid.begin(), grid.end());
+    auto search = [&](const Vec3f& p, int64_t k, double* best) {
+      auto it = std::lower_bound(grid.begin(), grid.end(), std::make_pair(k, uint32_t{0}));
+      for (; it != grid.end() && it->first == k; ++it) *best = std::min(*best, static_cast<double>((to[it->second] - p).norm()));
+    };
     double worst = 0;
     for (const Vec3f& p : from) {
+      const int64_t cx = coord(p.x()), cy = coord(p.y()), cz = coord(p.z());
       double best = std::numeric_limits<double>::infinity();
-      for (int dx = -1; dx <= 1; ++dx)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dz = -1; dz <= 1; ++dz) {
-            const int64_t k = key(p, dx, dy, dz);
-            auto it = std::lower_bound(grid.begin(), grid.end(), std::make_pair(k, uint32_t{0}));
-            for (; it != grid.end() && it->first == k; ++it) best = std::min(best, static_cast<double>((to[it->second] - p).norm()));
-          }
+      search(p, key(cx, cy, cz), &best);
+      double wall = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 3; ++k) {
+        const double lo = p[k] - static_cast<double>((k == 0 ? cx : k == 1 ? cy : cz)) * cell;
+        wall = std::min({wall, lo, cell - lo});
+      }
+      if (best > wall)
+        for (int dx = -1; dx <= 1; ++dx)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dz = -1; dz <= 1; ++dz)
+              if (dx || dy || dz) search(p, key(cx + dx, cy + dy, cz + dz), &best);
       worst = std::max(worst, best);
     }
     return worst;
@@ -99,25 +114,76 @@ bool usable_normals(const std::vector<Vec3f>& normals, size_t n, const DracoOpti
   return o.normals && normals.size() == n && n > 0;
 }
 
-}  // namespace
 
-StatusOr<TriangleMesh> decode_glb(std::string_view bytes) {
-  draco::DecoderBuffer buffer;
-  buffer.Init(bytes.data(), bytes.size());
-  draco::GltfDecoder decoder;
-  auto decoded = decoder.DecodeFromBuffer(&buffer);
-  if (!decoded.ok()) return invalid_argument("glb: not a glTF binary this reader understands (" + decoded.status().error_msg_string() + ")");
-  const draco::Mesh& dm = *decoded.value();
+// Positions, normals and triangles of a Draco mesh; `ids` maps glTF attribute
+// names to the Draco attributes' unique ids (the extension's "attributes").
+StatusOr<TriangleMesh> from_draco_mesh(const draco::Mesh& dm, const std::map<std::string, int>& ids) {
+  auto find = [&](const char* name, draco::GeometryAttribute::Type type) -> const draco::PointAttribute* {
+    const auto it = ids.find(name);
+    return it != ids.end() ? dm.GetAttributeByUniqueId(static_cast<uint32_t>(it->second)) : dm.GetNamedAttribute(type);
+  };
+  auto read = [&](const draco::PointAttribute* att, float scale) {
+    std::vector<Vec3f> out;
+    if (!att || att->num_components() != 3) return out;
+    out.resize(dm.num_points());
+    for (draco::PointIndex i(0); i < dm.num_points(); ++i) {
+      float v[3] = {0, 0, 0};
+      att->ConvertValue<float, 3>(att->mapped_index(i), v);
+      out[i.value()] = Vec3f(v[0], v[1], v[2]) * scale;
+    }
+    return out;
+  };
   TriangleMesh mesh;
-  mesh.vertices = read_attribute(dm, draco::GeometryAttribute::POSITION, 1000.f);
+  mesh.vertices = read(find("POSITION", draco::GeometryAttribute::POSITION), 1000.f);
   if (mesh.vertices.empty()) return invalid_argument("glb: the mesh has no positions");
-  mesh.normals = read_attribute(dm, draco::GeometryAttribute::NORMAL, 1.f);
+  mesh.normals = read(find("NORMAL", draco::GeometryAttribute::NORMAL), 1.f);
   mesh.triangles.reserve(dm.num_faces());
   for (draco::FaceIndex f(0); f < dm.num_faces(); ++f) {
     const draco::Mesh::Face& face = dm.face(f);
     mesh.triangles.push_back({face[0].value(), face[1].value(), face[2].value()});
   }
   return mesh;
+}
+
+}  // namespace
+
+StatusOr<TriangleMesh> decode_glb(std::string_view bytes) {
+  // The container (glTF 2.0 §4.4): a 12-byte header, a JSON chunk, a BIN chunk.
+  auto bad = [](const std::string& why) { return invalid_argument("glb: not a glTF binary this reader understands (" + why + ")"); };
+  auto u32 = [&](size_t at) {
+    uint32_t v = 0;
+    std::memcpy(&v, bytes.data() + at, 4);
+    return v;
+  };
+  if (bytes.size() < 20 || u32(0) != 0x46546C67u) return bad("no glTF header");
+  if (u32(4) != 2) return bad("glTF version " + std::to_string(u32(4)) + ", not 2");
+  if (u32(8) > bytes.size()) return bad("the file is cut short");
+  const uint32_t json_len = u32(12);
+  if (u32(16) != 0x4E4F534Au || 20ull + json_len > bytes.size()) return bad("no JSON chunk");
+  const nlohmann::json j = nlohmann::json::parse(bytes.substr(20, json_len), nullptr, false);
+  if (j.is_discarded()) return bad("its JSON chunk does not parse");
+  const size_t bin_at = 20 + ((json_len + 3) & ~3u);
+  if (bin_at + 8 > bytes.size() || u32(bin_at + 4) != 0x004E4942u) return bad("no BIN chunk");
+  const std::string_view bin = bytes.substr(bin_at + 8, std::min<size_t>(u32(bin_at), bytes.size() - bin_at - 8));
+  try {
+    const nlohmann::json& prim = j.at("meshes").at(0).at("primitives").at(0);
+    if (!prim.contains("extensions") || !prim["extensions"].contains("KHR_draco_mesh_compression"))
+      return bad("the mesh is not Draco-compressed");
+    const nlohmann::json& ext = prim["extensions"]["KHR_draco_mesh_compression"];
+    const nlohmann::json& view = j.at("bufferViews").at(ext.at("bufferView").get<size_t>());
+    const size_t offset = view.value("byteOffset", size_t{0}), length = view.at("byteLength").get<size_t>();
+    if (offset + length > bin.size()) return bad("a buffer view runs past the binary chunk");
+    draco::DecoderBuffer buffer;
+    buffer.Init(bin.data() + offset, length);
+    draco::Decoder decoder;
+    auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
+    if (!decoded.ok()) return bad("Draco: " + decoded.status().error_msg_string());
+    std::map<std::string, int> ids;
+    for (const auto& [name, id] : ext.at("attributes").items()) ids[name] = id.get<int>();
+    return from_draco_mesh(*decoded.value(), ids);
+  } catch (const nlohmann::json::exception& e) {
+    return bad(std::string("a field is missing: ") + e.what());
+  }
 }
 
 StatusOr<DracoEncoded> encode_glb(const TriangleMesh& mesh, const DracoOptions& options) {
@@ -205,6 +271,77 @@ StatusOr<DracoEncoded> encode_drc(const PointCloud& cloud, const DracoOptions& o
     if (e.max_error_mm <= options.max_error_mm) return e;
   }
   return internal_error("drc: no quantisation keeps the points within " + std::to_string(options.max_error_mm) + " mm");
+}
+
+StatusOr<TriangleMesh> decode_mesh_drc(std::string_view bytes) {
+  draco::DecoderBuffer buffer;
+  buffer.Init(bytes.data(), bytes.size());
+  draco::Decoder decoder;
+  auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
+  if (!decoded.ok()) return invalid_argument("drc: not a Draco mesh this reader understands (" + decoded.status().error_msg_string() + ")");
+  const draco::Mesh& dm = *decoded.value();
+  TriangleMesh mesh;
+  mesh.vertices = read_attribute(dm, draco::GeometryAttribute::POSITION, 1000.f);
+  if (mesh.vertices.empty()) return invalid_argument("drc: the mesh has no positions");
+  if (const draco::PointAttribute* c = dm.GetNamedAttribute(draco::GeometryAttribute::GENERIC)) {
+    mesh.confidence.resize(dm.num_points());
+    for (draco::PointIndex i(0); i < dm.num_points(); ++i) {
+      float v = 1;
+      c->ConvertValue<float, 1>(c->mapped_index(i), &v);
+      mesh.confidence[i.value()] = v;
+    }
+  }
+  mesh.triangles.reserve(dm.num_faces());
+  for (draco::FaceIndex f(0); f < dm.num_faces(); ++f) {
+    const draco::Mesh::Face& face = dm.face(f);
+    mesh.triangles.push_back({face[0].value(), face[1].value(), face[2].value()});
+  }
+  return mesh;
+}
+
+StatusOr<DracoEncoded> encode_mesh_drc(const TriangleMesh& mesh, const DracoOptions& options) {
+  if (mesh.empty()) return invalid_argument("drc: the mesh has no triangles");
+  if (!mesh.is_consistent()) return invalid_argument("drc: the mesh's indices or attributes are inconsistent");
+  if (!(options.max_error_mm > 0)) return invalid_argument("drc: the largest error allowed must be positive");
+  for (int bits = position_bits(mesh.vertices, options.max_error_mm); bits <= kMaxPositionBits; ++bits) {
+    draco::Mesh dm;
+    dm.set_num_points(static_cast<uint32_t>(mesh.num_vertices()));
+    add_attribute(&dm, draco::GeometryAttribute::POSITION, mesh.vertices, kToMetres);
+    if (!mesh.confidence.empty()) {
+      draco::GeometryAttribute ga;
+      ga.Init(draco::GeometryAttribute::GENERIC, nullptr, 1, draco::DT_FLOAT32, false, sizeof(float), 0);
+      const int id = dm.AddAttribute(ga, true, static_cast<uint32_t>(mesh.num_vertices()));
+      for (size_t i = 0; i < mesh.num_vertices(); ++i)
+        dm.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(static_cast<uint32_t>(i)), &mesh.confidence[i]);
+    }
+    dm.SetNumFaces(mesh.num_triangles());
+    for (size_t f = 0; f < mesh.num_triangles(); ++f) {
+      const Triangle& t = mesh.triangles[f];
+      dm.SetFace(draco::FaceIndex(static_cast<uint32_t>(f)),
+                 {draco::PointIndex(t[0]), draco::PointIndex(t[1]), draco::PointIndex(t[2])});
+    }
+    draco::Encoder encoder;
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::GENERIC, 8);
+    const int speed = 10 - std::clamp(options.compression_level, 0, 10);
+    encoder.SetSpeedOptions(speed, speed);
+    draco::EncoderBuffer out;
+    const draco::Status s = encoder.EncodeMeshToBuffer(dm, &out);
+    if (!s.ok()) return from_draco(s, "drc: Draco could not encode the mesh");
+    DracoEncoded e;
+    e.bytes.assign(out.data(), out.size());
+    e.position_bits = bits;
+    auto back = decode_mesh_drc(e.bytes);
+    if (!back.ok()) return internal_error("drc: the encoding does not decode: " + back.status().message());
+    if (back->num_triangles() != mesh.num_triangles())
+      return internal_error("drc: decoding gave " + std::to_string(back->num_triangles()) + " triangles, not " +
+                            std::to_string(mesh.num_triangles()));
+    e.vertices = back->num_vertices();
+    e.triangles = back->num_triangles();
+    e.max_error_mm = max_displacement(mesh.vertices, back->vertices, std::max(1.0, 2 * options.max_error_mm));
+    if (e.max_error_mm <= options.max_error_mm) return e;
+  }
+  return internal_error("drc: no quantisation keeps the vertices within " + std::to_string(options.max_error_mm) + " mm");
 }
 
 StatusOr<DracoEncoded> write_glb(const std::string& path, const TriangleMesh& mesh, const DracoOptions& options) {

@@ -22,7 +22,10 @@ namespace bodyscan::storage {
 struct DracoOptions {
   double max_error_mm = 0.5;  // largest distance a vertex or point may move
   int compression_level = 7;  // Draco's speed/size trade-off, 0 (fast) .. 10 (small)
-  bool normals = true;        // carry vertex/point normals when the model has them
+  // Carry vertex/point normals when the model has them. Off by default: on a body
+  // scan they are 45 % of the GLB (8-bit octahedral), and a viewer computes them
+  // from the triangles in a few tens of milliseconds (docs/benchmarks.md §8).
+  bool normals = false;
   int normal_bits = 8;
 };
 
@@ -42,6 +45,14 @@ StatusOr<TriangleMesh> decode_glb(std::string_view bytes);
 // A Draco point cloud: positions, and normals when present.
 StatusOr<DracoEncoded> encode_drc(const PointCloud& cloud, const DracoOptions& options = {});
 StatusOr<PointCloud> decode_drc(std::string_view bytes);
+
+// A mesh for keeping (the archive's copy, which measurements are taken on): Draco's
+// own format, positions within `max_error_mm` (use a hundredth of a millimetre:
+// far below the scan's noise), the per-vertex confidence (which parts hole filling
+// invented) as an 8-bit generic attribute, no normals (they follow from the
+// triangles). About a tenth of the binary PLY.
+StatusOr<DracoEncoded> encode_mesh_drc(const TriangleMesh& mesh, const DracoOptions& options);
+StatusOr<TriangleMesh> decode_mesh_drc(std::string_view bytes);
 
 // Encoded, checked, and written whole or not at all.
 StatusOr<DracoEncoded> write_glb(const std::string& path, const TriangleMesh& mesh, const DracoOptions& options = {});

@@ -1,0 +1,76 @@
+#include "server/pipeline/archive_scan.hpp"
+
+#include <fstream>
+
+#include "server/pipeline/measurements_json.hpp"
+#include "storage/formats/draco_files.hpp"
+
+namespace bodyscan::pipeline {
+
+nlohmann::json algorithm_versions(const ScanJobOptions& options) {
+  return {{"planes", to_string(options.scan.planes)},
+          {"triangulation", to_string(options.scan.triangulate.method)},
+          {"surface", options.reconstruct ? "anisotropic-kernels-1" : "none"},
+          {"hole_fairing", options.surface.hole_fairing == HoleFairing::kThinPlate ? "thin-plate" : "membrane"},
+          {"measurements", options.measure ? kBodyMeasurementsAlgorithm : "none"}};
+}
+
+namespace {
+
+StatusOr<storage::ScanResults> to_results(const ScanJobResult& result, const ScanJobOptions& options) {
+  ASSIGN_OR_RETURN(ScanFiles files, scan_result_files(result));
+  storage::ScanResults out;
+  out.files = std::move(files.results);
+  // The archive keeps the surface as Draco within 0.01 mm (a tenth of the PLY's
+  // size, docs/archive.md); the served copy is mesh.glb.
+  if (out.files.erase("mesh.ply")) {
+    storage::DracoOptions keep;
+    keep.max_error_mm = kArchivedMeshErrorMm;
+    ASSIGN_OR_RETURN(storage::DracoEncoded drc, storage::encode_mesh_drc(result.mesh, keep));
+    out.files[kArchivedMeshFile] = std::move(drc.bytes);
+  }
+  out.algorithms = algorithm_versions(options);
+  if (!result.surface_error.empty()) out.note = "surface failed: " + result.surface_error;
+  else if (!result.measure_error.empty()) out.note = "no automatic measurements: " + result.measure_error;
+  if (result.body)
+    for (const BodyMeasurement& m : result.body->measurements) {
+      storage::MeasurementRecord r;
+      r.name = m.name, r.label = m.label, r.kind = m.kind, r.iso_clause = m.iso_clause, r.value_mm = m.value_mm;
+      r.geometry = to_json(m);
+      out.measurements.push_back(std::move(r));
+    }
+  return out;
+}
+
+StatusOr<std::string> read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return io_error(path + ": cannot open");
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+Status archive_scan(storage::Archive& archive, const std::string& scan_id, const ScanJobResult& result,
+                    const ScanJobOptions& options) {
+  ASSIGN_OR_RETURN(storage::ScanResults results, to_results(result, options));
+  if (!result.raw_stripes.empty()) {
+    RETURN_IF_ERROR(archive.put_raw(scan_id, kRawRecordFile, result.raw_record.dump()));
+    RETURN_IF_ERROR(archive.put_raw(scan_id, kRawStripesFile, result.raw_stripes));
+  }
+  return archive.complete_scan(scan_id, results);
+}
+
+StatusOr<int> reprocess_archived_scan(storage::Archive& archive, const std::string& scan_id,
+                                      const ScanJobOptions& options, const std::string& actor) {
+  ASSIGN_OR_RETURN(std::string record_path, archive.file_path(scan_id, -1, kRawRecordFile));
+  ASSIGN_OR_RETURN(std::string stripes_path, archive.file_path(scan_id, -1, kRawStripesFile));
+  ASSIGN_OR_RETURN(std::string record_text, read_all(record_path));
+  ASSIGN_OR_RETURN(std::string stripes, read_all(stripes_path));
+  const nlohmann::json record = nlohmann::json::parse(record_text, nullptr, false);
+  if (record.is_discarded()) return invalid_argument("scan " + scan_id + ": its raw record is not JSON");
+  ASSIGN_OR_RETURN(ScanJobResult result, reprocess_scan(record, stripes, options));
+  ASSIGN_OR_RETURN(storage::ScanResults results, to_results(result, options));
+  return archive.add_version(scan_id, results, actor);
+}
+
+}  // namespace bodyscan::pipeline

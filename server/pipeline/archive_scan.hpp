@@ -1,0 +1,30 @@
+// A scan job's results into the archive (storage/archive): the raw record as the
+// scan's raw data, every result file as version 1 (or a new version when the scan
+// is reprocessed), the automatic measurements as records with their geometry.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+#include "server/pipeline/scan_job.hpp"
+#include "storage/archive/archive.hpp"
+
+namespace bodyscan::pipeline {
+
+// The surface the archive keeps (storage::encode_mesh_drc), and its precision.
+inline constexpr const char* kArchivedMeshFile = "mesh.drc";
+inline constexpr double kArchivedMeshErrorMm = 0.01;
+
+// The algorithms a result came from, recorded with each version.
+nlohmann::json algorithm_versions(const ScanJobOptions& options);
+
+// Completes a running scan with the job's results (raw data first).
+Status archive_scan(storage::Archive& archive, const std::string& scan_id, const ScanJobResult& result,
+                    const ScanJobOptions& options);
+// Reprocesses an archived scan from its raw record with `options` and keeps the
+// results as a new version. Returns the version.
+StatusOr<int> reprocess_archived_scan(storage::Archive& archive, const std::string& scan_id,
+                                      const ScanJobOptions& options, const std::string& actor);
+
+}  // namespace bodyscan::pipeline
