@@ -12,7 +12,7 @@ nlohmann::json algorithm_versions(const ScanJobOptions& options) {
           {"triangulation", to_string(options.scan.triangulate.method)},
           {"surface", options.reconstruct ? "anisotropic-kernels-1" : "none"},
           {"hole_fairing", options.surface.hole_fairing == HoleFairing::kThinPlate ? "thin-plate" : "membrane"},
-          {"measurements", options.measure ? kBodyMeasurementsAlgorithm : "none"}};
+          {"measurements", options.measure && options.reconstruct ? kBodyMeasurementsAlgorithm : "none"}};
 }
 
 namespace {

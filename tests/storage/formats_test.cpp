@@ -5,6 +5,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <tuple>
 #include <sstream>
 
 #include "recon/io/ply.hpp"
@@ -108,6 +110,38 @@ TEST(Drc, ACloudComesBackWithinHalfAMillimetre) {
   EXPECT_LT(e->bytes.size(), cloud.size() * 12 / 3);  // well under a third of raw float positions
   EXPECT_FALSE(decode_drc("DRACO?").ok());
   EXPECT_EQ(encode_drc(PointCloud{}).status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(MeshDrc, TheArchivedSurfaceKeepsItsShapeAndConfidence) {
+  TriangleMesh mesh = body();
+  mesh.confidence.resize(mesh.num_vertices());
+  for (size_t i = 0; i < mesh.num_vertices(); ++i) mesh.confidence[i] = static_cast<float>(i % 101) / 100.f;
+  DracoOptions keep;
+  keep.max_error_mm = 0.01;
+  auto e = encode_mesh_drc(mesh, keep);
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  EXPECT_LE(e->max_error_mm, 0.01);
+  EXPECT_LT(e->bytes.size(), encode_ply(mesh, PlyFormat::kBinaryLittleEndian).size() / 5);
+  auto back = decode_mesh_drc(e->bytes);
+  ASSERT_TRUE(back.ok());
+  ASSERT_EQ(back->num_triangles(), mesh.num_triangles());
+  ASSERT_EQ(back->confidence.size(), back->num_vertices());
+  // Confidence survives to 8 bits: match each decoded vertex to its original by position.
+  std::map<std::tuple<int, int, int>, float> by_place;
+  for (size_t i = 0; i < mesh.num_vertices(); ++i)
+    by_place[{static_cast<int>(std::lround(mesh.vertices[i].x() * 10)), static_cast<int>(std::lround(mesh.vertices[i].y() * 10)),
+              static_cast<int>(std::lround(mesh.vertices[i].z() * 10))}] = mesh.confidence[i];
+  size_t matched = 0;
+  for (size_t i = 0; i < back->num_vertices(); ++i) {
+    const Vec3f& v = back->vertices[i];
+    auto it = by_place.find({static_cast<int>(std::lround(v.x() * 10)), static_cast<int>(std::lround(v.y() * 10)),
+                             static_cast<int>(std::lround(v.z() * 10))});
+    if (it == by_place.end()) continue;
+    ++matched;
+    EXPECT_NEAR(back->confidence[i], it->second, 1.0 / 255 + 1e-6);
+  }
+  EXPECT_GT(matched, back->num_vertices() * 9 / 10);
+  EXPECT_FALSE(decode_mesh_drc("not draco").ok());
 }
 
 TEST(MeshFiles, ObjAndStlCarryTheMeshExactly) {
