@@ -558,7 +558,13 @@ class Finder {
 
   // The leg's horizontal loop on side s at height y, if any.
   // Scraps of a cut (a toe, a fold of fill) are no leg: at least 6 % of the height round.
-  const Ring* leg(const std::vector<Ring>& r, int s) const { return side_ring(r, xc_, s, false, 0.06 * h_); }
+  // The leg's loop at a level, when it is whole there: a leg cut in pieces (a slit
+  // a scan can leave behind the ankle splits the heel from the rest) is no level to
+  // measure at.
+  const Ring* leg(const std::vector<Ring>& r, int s) const {
+    const Ring* l = side_ring(r, xc_, s, false, 0.06 * h_);
+    return l && parts_near(r, *l, 0.06 * h_) == 0 ? l : nullptr;
+  }
 
   void measure_leg(int s) {
     const std::string sd = side(s);

@@ -175,6 +175,30 @@ TEST(BodyMeasurements, AStrayFoldBesideTheFlankDoesNotEndTheArm) {
     EXPECT_NEAR(b->find(name)->value_mm, clean->find(name)->value_mm, 0.5) << name;
 }
 
+TEST(BodyMeasurements, ALegCutInPiecesIsNoLevelToMeasureAt) {
+  // A scan can leave a slit behind the ankle that cuts the heel off in the
+  // horizontal cuts there; the piece nearer the midline was taken for the leg, and
+  // the minimum leg girth came out 33 mm small (male_muscular, left). A loop beside
+  // the ankle, inside it, stands for that piece.
+  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
+  ASSERT_TRUE(mesh.ok());
+  auto clean = measure_body(*mesh);
+  ASSERT_TRUE(clean.ok());
+  const double y = 85;  // within the minimum leg girth's window, 4 % of the height up
+  const BodySlicer slicer(*mesh, 0, 1800);
+  const Ring* ankle = nullptr;
+  const std::vector<Ring> cut = slicer.rings(y);
+  for (const Ring& r : cut)
+    if (r.centroid.x() > 0) ankle = &r;
+  ASSERT_TRUE(ankle);
+  const Eigen::Vector2d at(ankle->x_min - 25, ankle->centroid.z());
+  const TriangleMesh split = testing::merged(*mesh, testing::prism(testing::circle(20, at, 120), at, y - 20, y + 20));
+  auto b = measure_body(split);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  EXPECT_NEAR(b->find("min_leg_girth_left")->value_mm, clean->find("min_leg_girth_left")->value_mm, 0.5);
+  EXPECT_NEAR(b->find("calf_girth_left")->value_mm, clean->find("calf_girth_left")->value_mm, 0.5);
+}
+
 TEST(BodyMeasurements, RefusesWhatIsNotAStandingBody) {
   EXPECT_FALSE(measure_body(TriangleMesh{}).ok());
   auto ball = measure_body(testing::icosphere(3, 900));
