@@ -123,6 +123,7 @@ int run_archive(int argc, char** argv) {
     auto r = ar.scan(args[2]);
     if (!r.ok()) return fail(r.status());
     nlohmann::json j = {{"id", r->id}, {"customer", r->customer_id}, {"operator", r->operator_name},
+                        {"calibration", r->calibration_id}, {"rig", r->rig},
                         {"status", to_string(r->status)}, {"status_reason", r->status_reason},
                         {"started_at", r->started_at}, {"finished_at", r->finished_at},
                         {"current_version", r->current_version}, {"raw", files_json(r->raw)},

@@ -197,6 +197,11 @@ int run_scan(int argc, char** argv) {
     }
   }
   if (archive) {
+    // The calibration this scan ran on, as its own record (the server calibrates
+    // once and scans many times against it).
+    auto cal = archive->add_calibration(nlohmann::json::parse(hw::to_json((*sim)->description()), nullptr, false),
+                                        pipeline::to_json(result->calibration), operator_name);
+    if (cal.ok()) archive->set_scan_calibration(scan_id, *cal);
     const Status stored = pipeline::archive_scan(*archive, scan_id, *result, options);
     if (!stored.ok()) {
       fail_archived("could not store the results: " + stored.message());

@@ -580,6 +580,16 @@ Status Archive::put_raw(const std::string& scan_id, const std::string& name, std
   return tx.commit();
 }
 
+Status Archive::set_scan_calibration(const std::string& scan_id, const std::string& calibration_id) {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(ScanRecord r, impl_->record(scan_id));
+  if (r.status != ScanStatus::kRunning) return failed_precondition("archive: scan '" + scan_id + "' is not running");
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("UPDATE scans SET calibration_id = ? WHERE id = ?"));
+  const Status s = st.bind(1, calibration_id).bind(2, scan_id).run();
+  if (s.code() == StatusCode::kInvalidArgument) return not_found("archive: no calibration '" + calibration_id + "'");
+  return s;
+}
+
 Status Archive::complete_scan(const std::string& scan_id, const ScanResults& results) {
   {
     std::lock_guard lock(impl_->mu);

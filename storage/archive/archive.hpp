@@ -138,6 +138,8 @@ class Archive {
   StatusOr<std::string> begin_scan(const std::string& customer_id, const std::string& operator_name,
                                    const nlohmann::json& rig, const std::string& calibration_id);
   Status put_raw(const std::string& scan_id, const std::string& name, std::string_view bytes);
+  // The calibration a running scan uses, when it was made for it (after begin_scan).
+  Status set_scan_calibration(const std::string& scan_id, const std::string& calibration_id);
   Status complete_scan(const std::string& scan_id, const ScanResults& results);
   // kFailed or kCancelled, with the reason; partial results are removed, raw data kept.
   Status end_scan(const std::string& scan_id, ScanStatus status, const std::string& reason);

@@ -46,6 +46,8 @@ TEST(ArchiveCli, AScanIsArchivedAndMadeAgainFromItsRawRecord) {
   EXPECT_NE(re.out.find("version 2"), std::string::npos) << re.out;
   const nlohmann::json shown = nlohmann::json::parse(bodyscan("archive " + A + " show " + scan, dir).out);
   ASSERT_EQ(shown["versions"].size(), 2u);
+  EXPECT_EQ(shown["calibration"].get<std::string>().rfind("k_", 0), 0u);  // the calibration it ran on
+  EXPECT_EQ(shown["rig"]["name"], "thesis");
   EXPECT_EQ(shown["versions"][0]["algorithms"]["surface"], "none");
   EXPECT_EQ(shown["raw"].size(), 2u);
   const CliResult verify = bodyscan("archive " + A + " verify", dir);

@@ -167,8 +167,10 @@ TEST(Archive, AFailedScanSaysWhyAndKeepsNoFiles) {
   EXPECT_FALSE(fs::exists(fs::path(dir) / "scans" / id));
   EXPECT_EQ(ar.complete_scan(id, results(1)).code(), StatusCode::kFailedPrecondition);
   EXPECT_EQ(ar.begin_scan("c_nobody", "op", kRig, "").status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(ar.set_scan_calibration(id, "k_none").code(), StatusCode::kFailedPrecondition);  // not running
   EXPECT_EQ(ar.put_raw(id, "x", "y").code(), StatusCode::kFailedPrecondition);
   const std::string other = *ar.begin_scan(c.id, "op", kRig, "");
+  EXPECT_EQ(ar.set_scan_calibration(other, "k_none").code(), StatusCode::kNotFound);
   ScanResults evil = results(3);
   evil.files["../../escape"] = "x";
   EXPECT_EQ(ar.complete_scan(other, evil).code(), StatusCode::kInvalidArgument);
