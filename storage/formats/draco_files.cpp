@@ -115,6 +115,56 @@ bool usable_normals(const std::vector<Vec3f>& normals, size_t n, const DracoOpti
 }
 
 
+// What a check decodes: the positions (mm) and how many triangles (or points).
+struct Decoded {
+  std::vector<Vec3f> positions;
+  size_t count = 0;
+};
+
+// The encoding loop every format shares: from the fewest position bits that can
+// keep every vertex within the error allowed, encode, decode again, compare every
+// vertex, and take one more bit until the decoded positions are within it.
+// `count`: the triangles of a mesh, or the points of a cloud (`is_mesh` false).
+template <typename Encode, typename Decode>
+StatusOr<DracoEncoded> encode_checked(const std::string& what, const std::vector<Vec3f>& positions, size_t count,
+                                      bool is_mesh, const DracoOptions& options, Encode&& encode, Decode&& decode) {
+  if (!(options.max_error_mm > 0)) return invalid_argument(what + ": the largest error allowed must be positive");
+  for (int bits = position_bits(positions, options.max_error_mm); bits <= kMaxPositionBits; ++bits) {
+    DracoEncoded e;
+    ASSIGN_OR_RETURN(e.bytes, encode(bits));
+    e.position_bits = bits;
+    auto back = decode(e.bytes);
+    if (!back.ok()) return internal_error(what + ": the encoding does not decode: " + back.status().message());
+    if (back->count != count)
+      return internal_error(what + ": decoding gave " + std::to_string(back->count) + " elements, not " + std::to_string(count));
+    e.vertices = back->positions.size();
+    e.triangles = is_mesh ? count : 0;
+    e.max_error_mm = max_displacement(positions, back->positions, std::max(1.0, 2 * options.max_error_mm));
+    if (e.max_error_mm <= options.max_error_mm) return e;
+  }
+  return internal_error(what + ": no quantisation keeps the vertices within " + std::to_string(options.max_error_mm) + " mm");
+}
+
+// Positions (in metres) and triangles.
+void to_draco_mesh(const TriangleMesh& mesh, draco::Mesh* out) {
+  draco::Mesh& dm = *out;
+  dm.set_num_points(static_cast<uint32_t>(mesh.num_vertices()));
+  add_attribute(&dm, draco::GeometryAttribute::POSITION, mesh.vertices, kToMetres);
+  dm.SetNumFaces(mesh.num_triangles());
+  for (size_t f = 0; f < mesh.num_triangles(); ++f) {
+    const Triangle& t = mesh.triangles[f];
+    dm.SetFace(draco::FaceIndex(static_cast<uint32_t>(f)),
+               {draco::PointIndex(t[0]), draco::PointIndex(t[1]), draco::PointIndex(t[2])});
+  }
+}
+
+// Draco's own encoder: positions at `bits`, speed from the compression level.
+void configure(const DracoOptions& options, int bits, draco::Encoder* encoder) {
+  encoder->SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
+  const int speed = 10 - std::clamp(options.compression_level, 0, 10);
+  encoder->SetSpeedOptions(speed, speed);
+}
+
 // Positions, normals and triangles of a Draco mesh; `ids` maps glTF attribute
 // names to the Draco attributes' unique ids (the extension's "attributes").
 StatusOr<TriangleMesh> from_draco_mesh(const draco::Mesh& dm, const std::map<std::string, int>& ids) {
@@ -189,44 +239,29 @@ StatusOr<TriangleMesh> decode_glb(std::string_view bytes) {
 StatusOr<DracoEncoded> encode_glb(const TriangleMesh& mesh, const DracoOptions& options) {
   if (mesh.empty()) return invalid_argument("glb: the mesh has no triangles");
   if (!mesh.is_consistent()) return invalid_argument("glb: the mesh's indices or attributes are inconsistent");
-  if (!(options.max_error_mm > 0)) return invalid_argument("glb: the largest error allowed must be positive");
-  for (int bits = position_bits(mesh.vertices, options.max_error_mm); bits <= kMaxPositionBits; ++bits) {
-    draco::Mesh dm;
-    dm.set_num_points(static_cast<uint32_t>(mesh.num_vertices()));
-    add_attribute(&dm, draco::GeometryAttribute::POSITION, mesh.vertices, kToMetres);
-    if (usable_normals(mesh.normals, mesh.num_vertices(), options))
-      add_attribute(&dm, draco::GeometryAttribute::NORMAL, mesh.normals, 1.f);
-    dm.SetNumFaces(mesh.num_triangles());
-    for (size_t f = 0; f < mesh.num_triangles(); ++f) {
-      const Triangle& t = mesh.triangles[f];
-      dm.SetFace(draco::FaceIndex(static_cast<uint32_t>(f)),
-                 {draco::PointIndex(t[0]), draco::PointIndex(t[1]), draco::PointIndex(t[2])});
-    }
-    draco::DracoCompressionOptions co;
-    co.compression_level = options.compression_level;
-    co.quantization_position.SetQuantizationBits(bits);
-    co.quantization_bits_normal = options.normal_bits;
-    dm.SetCompressionEnabled(true);
-    dm.SetCompressionOptions(co);
-    draco::GltfEncoder encoder;
-    draco::EncoderBuffer out;
-    const draco::Status s = encoder.EncodeToBuffer(dm, &out);
-    if (!s.ok()) return from_draco(s, "glb: Draco could not encode the mesh");
-
-    DracoEncoded e;
-    e.bytes.assign(out.data(), out.size());
-    e.position_bits = bits;
-    auto back = decode_glb(e.bytes);
-    if (!back.ok()) return internal_error("glb: the encoding does not decode: " + back.status().message());
-    if (back->num_triangles() != mesh.num_triangles())
-      return internal_error("glb: decoding gave " + std::to_string(back->num_triangles()) + " triangles, not " +
-                            std::to_string(mesh.num_triangles()));
-    e.vertices = back->num_vertices();
-    e.triangles = back->num_triangles();
-    e.max_error_mm = max_displacement(mesh.vertices, back->vertices, std::max(1.0, 2 * options.max_error_mm));
-    if (e.max_error_mm <= options.max_error_mm) return e;
-  }
-  return internal_error("glb: no quantisation keeps the vertices within " + std::to_string(options.max_error_mm) + " mm");
+  return encode_checked(
+      "glb", mesh.vertices, mesh.num_triangles(), true, options,
+      [&](int bits) -> StatusOr<std::string> {
+        draco::Mesh dm;
+        to_draco_mesh(mesh, &dm);
+        if (usable_normals(mesh.normals, mesh.num_vertices(), options))
+          add_attribute(&dm, draco::GeometryAttribute::NORMAL, mesh.normals, 1.f);
+        draco::DracoCompressionOptions co;
+        co.compression_level = options.compression_level;
+        co.quantization_position.SetQuantizationBits(bits);
+        co.quantization_bits_normal = options.normal_bits;
+        dm.SetCompressionEnabled(true);
+        dm.SetCompressionOptions(co);
+        draco::GltfEncoder encoder;
+        draco::EncoderBuffer out;
+        const draco::Status st = encoder.EncodeToBuffer(dm, &out);
+        if (!st.ok()) return from_draco(st, "glb: Draco could not encode the mesh");
+        return std::string(out.data(), out.size());
+      },
+      [](std::string_view bytes) -> StatusOr<Decoded> {
+        ASSIGN_OR_RETURN(TriangleMesh back, decode_glb(bytes));
+        return Decoded{std::move(back.vertices), back.num_triangles()};
+      });
 }
 
 StatusOr<PointCloud> decode_drc(std::string_view bytes) {
@@ -244,33 +279,27 @@ StatusOr<PointCloud> decode_drc(std::string_view bytes) {
 
 StatusOr<DracoEncoded> encode_drc(const PointCloud& cloud, const DracoOptions& options) {
   if (cloud.empty()) return invalid_argument("drc: the point cloud is empty");
-  if (!(options.max_error_mm > 0)) return invalid_argument("drc: the largest error allowed must be positive");
-  for (int bits = position_bits(cloud.positions, options.max_error_mm); bits <= kMaxPositionBits; ++bits) {
-    draco::PointCloud pc;
-    pc.set_num_points(static_cast<uint32_t>(cloud.size()));
-    add_attribute(&pc, draco::GeometryAttribute::POSITION, cloud.positions, kToMetres);
-    if (usable_normals(cloud.normals, cloud.size(), options))
-      add_attribute(&pc, draco::GeometryAttribute::NORMAL, cloud.normals, 1.f);
-    draco::Encoder encoder;
-    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
-    encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.normal_bits);
-    const int speed = 10 - std::clamp(options.compression_level, 0, 10);
-    encoder.SetSpeedOptions(speed, speed);
-    draco::EncoderBuffer out;
-    const draco::Status s = encoder.EncodePointCloudToBuffer(pc, &out);
-    if (!s.ok()) return from_draco(s, "drc: Draco could not encode the points");
-    DracoEncoded e;
-    e.bytes.assign(out.data(), out.size());
-    e.position_bits = bits;
-    auto back = decode_drc(e.bytes);
-    if (!back.ok()) return internal_error("drc: the encoding does not decode: " + back.status().message());
-    if (back->size() != cloud.size())
-      return internal_error("drc: decoding gave " + std::to_string(back->size()) + " points, not " + std::to_string(cloud.size()));
-    e.vertices = back->size();
-    e.max_error_mm = max_displacement(cloud.positions, back->positions, std::max(1.0, 2 * options.max_error_mm));
-    if (e.max_error_mm <= options.max_error_mm) return e;
-  }
-  return internal_error("drc: no quantisation keeps the points within " + std::to_string(options.max_error_mm) + " mm");
+  return encode_checked(
+      "drc", cloud.positions, cloud.size(), false, options,
+      [&](int bits) -> StatusOr<std::string> {
+        draco::PointCloud pc;
+        pc.set_num_points(static_cast<uint32_t>(cloud.size()));
+        add_attribute(&pc, draco::GeometryAttribute::POSITION, cloud.positions, kToMetres);
+        if (usable_normals(cloud.normals, cloud.size(), options))
+          add_attribute(&pc, draco::GeometryAttribute::NORMAL, cloud.normals, 1.f);
+        draco::Encoder encoder;
+        configure(options, bits, &encoder);
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.normal_bits);
+        draco::EncoderBuffer out;
+        const draco::Status st = encoder.EncodePointCloudToBuffer(pc, &out);
+        if (!st.ok()) return from_draco(st, "drc: Draco could not encode the points");
+        return std::string(out.data(), out.size());
+      },
+      [](std::string_view bytes) -> StatusOr<Decoded> {
+        ASSIGN_OR_RETURN(PointCloud back, decode_drc(bytes));
+        const size_t n = back.size();
+        return Decoded{std::move(back.positions), n};
+      });
 }
 
 StatusOr<TriangleMesh> decode_mesh_drc(std::string_view bytes) {
@@ -302,46 +331,30 @@ StatusOr<TriangleMesh> decode_mesh_drc(std::string_view bytes) {
 StatusOr<DracoEncoded> encode_mesh_drc(const TriangleMesh& mesh, const DracoOptions& options) {
   if (mesh.empty()) return invalid_argument("drc: the mesh has no triangles");
   if (!mesh.is_consistent()) return invalid_argument("drc: the mesh's indices or attributes are inconsistent");
-  if (!(options.max_error_mm > 0)) return invalid_argument("drc: the largest error allowed must be positive");
-  for (int bits = position_bits(mesh.vertices, options.max_error_mm); bits <= kMaxPositionBits; ++bits) {
-    draco::Mesh dm;
-    dm.set_num_points(static_cast<uint32_t>(mesh.num_vertices()));
-    add_attribute(&dm, draco::GeometryAttribute::POSITION, mesh.vertices, kToMetres);
-    if (!mesh.confidence.empty()) {
-      draco::GeometryAttribute ga;
-      ga.Init(draco::GeometryAttribute::GENERIC, nullptr, 1, draco::DT_FLOAT32, false, sizeof(float), 0);
-      const int id = dm.AddAttribute(ga, true, static_cast<uint32_t>(mesh.num_vertices()));
-      for (size_t i = 0; i < mesh.num_vertices(); ++i)
-        dm.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(static_cast<uint32_t>(i)), &mesh.confidence[i]);
-    }
-    dm.SetNumFaces(mesh.num_triangles());
-    for (size_t f = 0; f < mesh.num_triangles(); ++f) {
-      const Triangle& t = mesh.triangles[f];
-      dm.SetFace(draco::FaceIndex(static_cast<uint32_t>(f)),
-                 {draco::PointIndex(t[0]), draco::PointIndex(t[1]), draco::PointIndex(t[2])});
-    }
-    draco::Encoder encoder;
-    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
-    encoder.SetAttributeQuantization(draco::GeometryAttribute::GENERIC, 8);
-    const int speed = 10 - std::clamp(options.compression_level, 0, 10);
-    encoder.SetSpeedOptions(speed, speed);
-    draco::EncoderBuffer out;
-    const draco::Status s = encoder.EncodeMeshToBuffer(dm, &out);
-    if (!s.ok()) return from_draco(s, "drc: Draco could not encode the mesh");
-    DracoEncoded e;
-    e.bytes.assign(out.data(), out.size());
-    e.position_bits = bits;
-    auto back = decode_mesh_drc(e.bytes);
-    if (!back.ok()) return internal_error("drc: the encoding does not decode: " + back.status().message());
-    if (back->num_triangles() != mesh.num_triangles())
-      return internal_error("drc: decoding gave " + std::to_string(back->num_triangles()) + " triangles, not " +
-                            std::to_string(mesh.num_triangles()));
-    e.vertices = back->num_vertices();
-    e.triangles = back->num_triangles();
-    e.max_error_mm = max_displacement(mesh.vertices, back->vertices, std::max(1.0, 2 * options.max_error_mm));
-    if (e.max_error_mm <= options.max_error_mm) return e;
-  }
-  return internal_error("drc: no quantisation keeps the vertices within " + std::to_string(options.max_error_mm) + " mm");
+  return encode_checked(
+      "drc", mesh.vertices, mesh.num_triangles(), true, options,
+      [&](int bits) -> StatusOr<std::string> {
+        draco::Mesh dm;
+        to_draco_mesh(mesh, &dm);
+        if (!mesh.confidence.empty()) {
+          draco::GeometryAttribute ga;
+          ga.Init(draco::GeometryAttribute::GENERIC, nullptr, 1, draco::DT_FLOAT32, false, sizeof(float), 0);
+          const int id = dm.AddAttribute(ga, true, static_cast<uint32_t>(mesh.num_vertices()));
+          for (size_t i = 0; i < mesh.num_vertices(); ++i)
+            dm.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(static_cast<uint32_t>(i)), &mesh.confidence[i]);
+        }
+        draco::Encoder encoder;
+        configure(options, bits, &encoder);
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::GENERIC, 8);
+        draco::EncoderBuffer out;
+        const draco::Status st = encoder.EncodeMeshToBuffer(dm, &out);
+        if (!st.ok()) return from_draco(st, "drc: Draco could not encode the mesh");
+        return std::string(out.data(), out.size());
+      },
+      [](std::string_view bytes) -> StatusOr<Decoded> {
+        ASSIGN_OR_RETURN(TriangleMesh back, decode_mesh_drc(bytes));
+        return Decoded{std::move(back.vertices), back.num_triangles()};
+      });
 }
 
 StatusOr<DracoEncoded> write_glb(const std::string& path, const TriangleMesh& mesh, const DracoOptions& options) {
