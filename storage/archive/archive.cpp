@@ -125,7 +125,7 @@ nlohmann::json file_json(const ArchivedFile& f) { return {{"name", f.name}, {"by
 struct Archive::Impl {
   fs::path dir;
   int lock_fd = -1;
-  Database db;
+  mutable Database db;  // const queries prepare statements too
   mutable std::mutex mu;
   RecoveryReport recovery;
 
@@ -202,7 +202,7 @@ struct Archive::Impl {
   }
 
   StatusOr<std::vector<ArchivedFile>> files(const std::string& scan, int version) const {
-    ASSIGN_OR_RETURN(Statement st, const_cast<Database&>(db).prepare(
+    ASSIGN_OR_RETURN(Statement st, db.prepare(
                                        "SELECT name, bytes, blake2b FROM scan_files WHERE scan_id = ? AND version = ? "
                                        "ORDER BY name"));
     st.bind(1, scan).bind(2, version);
@@ -216,7 +216,7 @@ struct Archive::Impl {
   }
 
   StatusOr<ScanRecord> record(const std::string& id) const {
-    ASSIGN_OR_RETURN(Statement st, const_cast<Database&>(db).prepare(
+    ASSIGN_OR_RETURN(Statement st, db.prepare(
                                        "SELECT id, customer_id, operator, IFNULL(calibration_id, ''), status, "
                                        "status_reason, started_at, IFNULL(finished_at, ''), rig, current_version "
                                        "FROM scans WHERE id = ?"));
@@ -229,7 +229,7 @@ struct Archive::Impl {
     r.status_reason = st.text(5), r.started_at = st.text(6), r.finished_at = st.text(7);
     r.rig = nlohmann::json::parse(st.text(8), nullptr, false);
     r.current_version = static_cast<int>(st.integer(9));
-    ASSIGN_OR_RETURN(Statement vs, const_cast<Database&>(db).prepare(
+    ASSIGN_OR_RETURN(Statement vs, db.prepare(
                                        "SELECT version, created_at, algorithms, note FROM scan_versions "
                                        "WHERE scan_id = ? ORDER BY version"));
     vs.bind(1, id);
