@@ -10,10 +10,12 @@
 #include <vector>
 
 #include "recon/io/atomic_file.hpp"
+#include "recon/io/ply.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "storage/archive/archive.hpp"
 #include "storage/formats/draco_files.hpp"
 #include "storage/formats/measurement_sheet.hpp"
+#include "storage/formats/mesh_files.hpp"
 
 namespace bodyscan::cli {
 
@@ -33,6 +35,7 @@ void usage(FILE* out) {
       "  erase CUSTOMER --yes     deletes a customer and everything derived from them\n"
       "  delete-scan SCAN --yes   deletes one scan\n"
       "  reprocess SCAN           the scan again from its raw record, as a new version\n"
+      "  mesh SCAN -o OUT         the scan's surface as .ply, .obj, .stl (mm) or .glb\n"
       "  sheet SCAN -o OUT [--unit mm|cm|in]\n"
       "                           the measurement sheet (.pdf, .csv or .json)\n"
       "\n"
@@ -84,8 +87,8 @@ int run_archive(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan archive %s: expected %zu argument(s)\n", cmd.c_str(), n - 2);
     return false;
   };
-  static const std::vector<std::string> known = {"list", "customers", "show", "verify", "export",
-                                                 "erase", "delete-scan", "reprocess", "sheet"};
+  static const std::vector<std::string> known = {"list",  "customers",   "show",      "verify", "export",
+                                                 "erase", "delete-scan", "reprocess", "mesh",   "sheet"};
   if (std::find(known.begin(), known.end(), cmd) == known.end()) {
     std::fprintf(stderr, "bodyscan archive: unknown command '%s'\n", cmd.c_str());
     usage(stderr);
@@ -176,6 +179,33 @@ int run_archive(int argc, char** argv) {
     std::printf("scan %s: version %d\n", args[2].c_str(), *v);
     return 0;
   }
+  auto ends = [&](const char* suffix) {
+    return out.size() >= std::strlen(suffix) && out.compare(out.size() - std::strlen(suffix), std::string::npos, suffix) == 0;
+  };
+  auto surface = [&](const std::string& scan) -> StatusOr<TriangleMesh> {
+    ASSIGN_OR_RETURN(std::string path, ar.file_path(scan, 0, pipeline::kArchivedMeshFile));
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return storage::decode_mesh_drc(bytes);
+  };
+  if (cmd == "mesh") {
+    if (!need(3)) return 2;
+    if (!ends(".ply") && !ends(".obj") && !ends(".stl") && !ends(".glb")) {
+      std::fprintf(stderr, "bodyscan archive mesh: -o OUT must end in .ply, .obj, .stl or .glb\n");
+      return 2;
+    }
+    auto mesh = surface(args[2]);
+    if (!mesh.ok()) return fail(mesh.status());
+    Status w;
+    if (ends(".ply")) w = write_ply(out, *mesh);
+    else if (ends(".obj")) w = storage::write_obj(out, *mesh);
+    else if (ends(".stl")) w = storage::write_stl(out, *mesh);
+    else w = storage::write_glb(out, *mesh).status();
+    if (!w.ok()) return fail(w);
+    ar.log(actor, "export mesh", "scan", args[2], out);
+    std::printf("wrote %s: %zu triangles\n", out.c_str(), mesh->num_triangles());
+    return 0;
+  }
   // sheet
   if (!need(3)) return 2;
   auto unit = storage::parse_length_unit(unit_text);
@@ -206,20 +236,14 @@ int run_archive(int argc, char** argv) {
     sheet.entries.push_back(std::move(e));
   }
   std::string bytes;
-  auto ends = [&](const char* s) { return out.size() >= std::strlen(s) && out.compare(out.size() - std::strlen(s), std::string::npos, s) == 0; };
   if (ends(".csv")) {
     bytes = storage::sheet_csv(sheet, *unit);
   } else if (ends(".json")) {
     bytes = storage::sheet_json(sheet, *unit).dump(1);
   } else if (ends(".pdf")) {
     TriangleMesh mesh;
-    auto path = ar.file_path(r->id, 0, pipeline::kArchivedMeshFile);
-    if (path.ok()) {
-      std::ifstream in(*path, std::ios::binary);
-      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      auto m = storage::decode_mesh_drc(bytes);
-      if (m.ok()) mesh = std::move(*m);
-    }
+    auto m = surface(r->id);
+    if (m.ok()) mesh = std::move(*m);
     auto pdf = storage::sheet_pdf(sheet, mesh, *unit);
     if (!pdf.ok()) return fail(pdf.status());
     bytes = std::move(*pdf);

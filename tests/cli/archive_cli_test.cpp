@@ -3,7 +3,15 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
+#include <random>
+#include <thread>
 #include <sstream>
 #include <string>
 
@@ -55,6 +63,45 @@ TEST(ArchiveCli, AScanIsArchivedAndMadeAgainFromItsRawRecord) {
   EXPECT_NE(verify.out.find("consistent"), std::string::npos) << verify.out;
 }
 
+// SIGKILL during real scans (the simulated rig, every 12th step): the next start
+// finds each killed scan marked failed with the reason, and the scans before it whole.
+TEST(ArchiveCli, AScanKilledMidwayIsMarkedFailedAndNothingElseIsLost) {
+  const std::string dir = testing::temp_dir(), archive = dir + "/A";
+  const CliResult first = bodyscan("scan --rig sim --every 12 --no-surface -q --archive " + quote(archive), dir);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  std::mt19937 rng(7);
+  for (int k = 0; k < 2; ++k) {
+    const pid_t pid = fork();
+    if (pid == 0) {
+      const int null = open("/dev/null", O_WRONLY);
+      dup2(null, 1), dup2(null, 2);
+      execl(BODYSCAN_BIN, BODYSCAN_BIN, "scan", "--rig", "sim", "--every", "12", "--no-surface", "-q", "--archive",
+            archive.c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500 + rng() % 3000));
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the scan ended before the kill; kill sooner";
+  }
+  const CliResult verify = bodyscan("archive " + quote(archive) + " verify", dir);
+  ASSERT_EQ(verify.exit_code, 0) << verify.err;
+  const CliResult list = bodyscan("archive " + quote(archive) + " list", dir);
+  std::istringstream lines(list.out);
+  std::string line;
+  size_t complete = 0, failed = 0;
+  while (std::getline(lines, line)) {
+    complete += line.find(" complete ") != std::string::npos;
+    if (line.find(" failed ") != std::string::npos) {
+      ++failed;
+      EXPECT_NE(line.find("interrupted"), std::string::npos) << line;
+    }
+  }
+  EXPECT_EQ(complete, 1u) << list.out;
+  EXPECT_EQ(failed, 2u) << list.out;
+}
+
 TEST(ArchiveCli, SheetExportAndErasure) {
   const std::string dir = testing::temp_dir();
   std::string customer, scan;
@@ -85,6 +132,18 @@ TEST(ArchiveCli, SheetExportAndErasure) {
   const CliResult pdf = bodyscan("archive " + A + " sheet " + scan + " -o " + quote(dir + "/s.pdf"), dir);
   ASSERT_EQ(pdf.exit_code, 0) << pdf.err;
   EXPECT_EQ(slurp(dir + "/s.pdf").rfind("%PDF-", 0), 0u);
+
+  for (const char* ext : {"ply", "obj", "stl", "glb"}) {
+    const std::string file = dir + "/m." + ext;
+    const CliResult m = bodyscan("archive " + A + " mesh " + scan + " -o " + quote(file), dir);
+    ASSERT_EQ(m.exit_code, 0) << ext << ": " << m.err;
+    EXPECT_NE(m.out.find("107024 triangles"), std::string::npos) << m.out;
+  }
+  auto ply = read_ply_mesh(dir + "/m.ply");
+  ASSERT_TRUE(ply.ok());
+  EXPECT_EQ(ply->num_triangles(), 107024u);
+  EXPECT_EQ(std::filesystem::file_size(dir + "/m.stl"), 84 + 50 * 107024u);
+  EXPECT_EQ(bodyscan("archive " + A + " mesh " + scan + " -o " + quote(dir + "/m.docx"), dir).exit_code, 2);
 
   const CliResult exported = bodyscan("archive " + A + " export " + customer + " " + quote(dir + "/X") + " --actor admin", dir);
   ASSERT_EQ(exported.exit_code, 0) << exported.err;
