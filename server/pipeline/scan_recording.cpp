@@ -239,9 +239,9 @@ Status ScanProcessor::load_recording(std::string_view bytes) {
     return bad("the compressed data is damaged");
   Reader rd(raw);
   uint64_t frames, unseen, without, far, samples, fourth_n, count;
-  ScanStats st;
+  double fourth_ss;
   if (!rd.get(&frames) || !rd.get(&unseen) || !rd.get(&without) || !rd.get(&far) || !rd.get(&samples) ||
-      !rd.get(&fourth_ss_) || !rd.get(&fourth_n) || !rd.get(&count))
+      !rd.get(&fourth_ss) || !rd.get(&fourth_n) || !rd.get(&count))
     return bad("cut short");
   std::vector<FrameRecord> records;
   for (uint64_t i = 0; i < count; ++i) {
@@ -296,6 +296,7 @@ Status ScanProcessor::load_recording(std::string_view bytes) {
   stats_ = {};
   stats_.frames = frames, stats_.frames_unseen = unseen, stats_.frames_without_plane = without;
   stats_.far_bottom_estimated = far, stats_.samples = samples;
+  fourth_ss_ = fourth_ss;
   fourth_n_ = fourth_n;
   if (fourth_n_ > 0) stats_.fourth_point_rms_mm = std::sqrt(fourth_ss_ / static_cast<double>(fourth_n_));
   return Status::Ok();

@@ -410,11 +410,7 @@ struct Archive::Impl {
 Archive::Archive(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Archive::~Archive() = default;
 const RecoveryReport& Archive::recovery() const { return impl_->recovery; }
-const std::string& Archive::dir() const {
-  static thread_local std::string s;
-  s = impl_->dir.string();
-  return s;
-}
+std::string Archive::dir() const { return impl_->dir.string(); }
 
 StatusOr<std::unique_ptr<Archive>> Archive::open(const std::string& dir_in) {
   if (sodium_init() < 0) return internal_error("archive: libsodium failed to start");

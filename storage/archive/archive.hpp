@@ -115,7 +115,7 @@ class Archive {
   static StatusOr<std::unique_ptr<Archive>> open(const std::string& dir);
   ~Archive();
   const RecoveryReport& recovery() const;
-  const std::string& dir() const;
+  std::string dir() const;
 
   // Customers.
   StatusOr<Customer> add_customer(const std::optional<std::string>& name, const std::optional<std::string>& contact,
