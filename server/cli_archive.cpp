@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -184,8 +183,7 @@ int run_archive(int argc, char** argv) {
   };
   auto surface = [&](const std::string& scan) -> StatusOr<TriangleMesh> {
     ASSIGN_OR_RETURN(std::string path, ar.file_path(scan, 0, pipeline::kArchivedMeshFile));
-    std::ifstream in(path, std::ios::binary);
-    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSIGN_OR_RETURN(std::string bytes, read_whole_file(path));
     return storage::decode_mesh_drc(bytes);
   };
   if (cmd == "mesh") {

@@ -6,11 +6,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include <fstream>
 #include <memory>
 #include <optional>
 
 #include "hw/rig_description.hpp"
+#include "recon/io/atomic_file.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/sim_backend.hpp"
@@ -289,14 +289,9 @@ int run_reprocess(int argc, char** argv) {
     std::fprintf(stderr, "usage: bodyscan reprocess SCAN_DIR --out DIR (see --help)\n");
     return 2;
   }
-  auto slurp = [](const std::string& path) -> std::optional<std::string> {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return std::nullopt;
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  };
-  const auto record = slurp(in + "/raw/" + pipeline::kRawRecordFile);
-  const auto stripes = slurp(in + "/raw/" + pipeline::kRawStripesFile);
-  if (!record || !stripes) {
+  const auto record = read_whole_file(in + "/raw/" + pipeline::kRawRecordFile);
+  const auto stripes = read_whole_file(in + "/raw/" + pipeline::kRawStripesFile);
+  if (!record.ok() || !stripes.ok()) {
     std::fprintf(stderr, "bodyscan reprocess: %s/raw/ has no raw record (%s, %s); was it written by bodyscan scan?\n",
                  in.c_str(), pipeline::kRawRecordFile, pipeline::kRawStripesFile);
     return 1;

@@ -13,6 +13,23 @@ namespace {
 std::string errno_text(int error) { return std::generic_category().message(error); }
 }  // namespace
 
+StatusOr<std::string> read_whole_file(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) {
+    const int error = errno;
+    return not_found(path + ": cannot open: " + errno_text(error));
+  }
+  std::string bytes;
+  char buffer[1 << 16];
+  size_t n = 0;
+  while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) bytes.append(buffer, n);
+  const bool failed = std::ferror(f) != 0;
+  const int error = errno;
+  std::fclose(f);
+  if (failed) return io_error(path + ": cannot read: " + errno_text(error));
+  return bytes;
+}
+
 Status write_file_atomically(const std::string& path, std::string_view bytes) {
   // A reader (or a crash) must never see half a file: write beside the target,
   // make it durable, then rename over the target in one step.

@@ -13,4 +13,8 @@ namespace bodyscan {
 // the system refused.
 Status write_file_atomically(const std::string& path, std::string_view bytes);
 
+// A whole file's bytes; not found when it cannot be opened, an I/O error when it
+// cannot be read to its end.
+StatusOr<std::string> read_whole_file(const std::string& path);
+
 }  // namespace bodyscan

@@ -5,7 +5,6 @@
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 
 #include "recon/io/atomic_file.hpp"
@@ -81,9 +80,7 @@ Status write_png(const std::string& path, const GrayImage& image, int compressio
 }
 
 StatusOr<GrayImage> read_png(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return not_found(path + ": cannot open");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSIGN_OR_RETURN(const std::string bytes, read_whole_file(path));
   if (bytes.size() < 8 || png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, 8) != 0) {
     return invalid_argument(path + ": not a PNG file");
   }

@@ -1,7 +1,6 @@
 #include "server/pipeline/archive_scan.hpp"
 
-#include <fstream>
-
+#include "recon/io/atomic_file.hpp"
 #include "server/pipeline/measurements_json.hpp"
 #include "storage/formats/draco_files.hpp"
 
@@ -42,11 +41,6 @@ StatusOr<storage::ScanResults> to_results(const ScanJobResult& result, const Sca
   return out;
 }
 
-StatusOr<std::string> read_all(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return io_error(path + ": cannot open");
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
 
 }  // namespace
 
@@ -64,8 +58,8 @@ StatusOr<int> reprocess_archived_scan(storage::Archive& archive, const std::stri
                                       const ScanJobOptions& options, const std::string& actor) {
   ASSIGN_OR_RETURN(std::string record_path, archive.file_path(scan_id, -1, kRawRecordFile));
   ASSIGN_OR_RETURN(std::string stripes_path, archive.file_path(scan_id, -1, kRawStripesFile));
-  ASSIGN_OR_RETURN(std::string record_text, read_all(record_path));
-  ASSIGN_OR_RETURN(std::string stripes, read_all(stripes_path));
+  ASSIGN_OR_RETURN(std::string record_text, read_whole_file(record_path));
+  ASSIGN_OR_RETURN(std::string stripes, read_whole_file(stripes_path));
   const nlohmann::json record = nlohmann::json::parse(record_text, nullptr, false);
   if (record.is_discarded()) return invalid_argument("scan " + scan_id + ": its raw record is not JSON");
   ASSIGN_OR_RETURN(ScanJobResult result, reprocess_scan(record, stripes, options));
