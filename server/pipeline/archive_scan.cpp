@@ -2,7 +2,6 @@
 
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/measurements_json.hpp"
-#include "storage/formats/draco_files.hpp"
 
 namespace bodyscan::pipeline {
 
@@ -17,17 +16,11 @@ nlohmann::json algorithm_versions(const ScanJobOptions& options) {
 namespace {
 
 StatusOr<storage::ScanResults> to_results(const ScanJobResult& result, const ScanJobOptions& options) {
-  ASSIGN_OR_RETURN(ScanFiles files, scan_result_files(result));
+  // The archive keeps the surface as Draco within 0.01 mm (docs/archive.md); the
+  // served copy is mesh.glb.
+  ASSIGN_OR_RETURN(ScanFiles files, scan_result_files(result, SurfaceFile::kArchiveDraco));
   storage::ScanResults out;
   out.files = std::move(files.results);
-  // The archive keeps the surface as Draco within 0.01 mm (a tenth of the PLY's
-  // size, docs/archive.md); the served copy is mesh.glb.
-  if (out.files.erase("mesh.ply")) {
-    storage::DracoOptions keep;
-    keep.max_error_mm = kArchivedMeshErrorMm;
-    ASSIGN_OR_RETURN(storage::DracoEncoded drc, storage::encode_mesh_drc(result.mesh, keep));
-    out.files[kArchivedMeshFile] = std::move(drc.bytes);
-  }
   out.algorithms = algorithm_versions(options);
   if (!result.surface_error.empty()) out.note = "surface failed: " + result.surface_error;
   else if (!result.measure_error.empty()) out.note = "no automatic measurements: " + result.measure_error;

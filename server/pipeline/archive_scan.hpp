@@ -12,10 +12,6 @@
 
 namespace bodyscan::pipeline {
 
-// The surface the archive keeps (storage::encode_mesh_drc), and its precision.
-inline constexpr const char* kArchivedMeshFile = "mesh.drc";
-inline constexpr double kArchivedMeshErrorMm = 0.01;
-
 // The algorithms a result came from, recorded with each version.
 nlohmann::json algorithm_versions(const ScanJobOptions& options);
 

@@ -97,7 +97,7 @@ StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string
   return out;
 }
 
-StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r) {
+StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surface) {
   ScanFiles f;
   f.results["calibration.json"] = to_json(r.calibration).dump(2);
   if (!r.raw_stripes.empty()) {
@@ -109,7 +109,14 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r) {
   f.results["points.drc"] = std::move(drc.bytes);
   nlohmann::json glb;
   if (!r.mesh.triangles.empty()) {
-    f.results["mesh.ply"] = encode_ply(r.mesh, PlyFormat::kBinaryLittleEndian);
+    if (surface == SurfaceFile::kPly) {
+      f.results["mesh.ply"] = encode_ply(r.mesh, PlyFormat::kBinaryLittleEndian);
+    } else {
+      storage::DracoOptions keep;
+      keep.max_error_mm = kArchivedMeshErrorMm;
+      ASSIGN_OR_RETURN(storage::DracoEncoded drc, storage::encode_mesh_drc(r.mesh, keep));
+      f.results[kArchivedMeshFile] = std::move(drc.bytes);
+    }
     ASSIGN_OR_RETURN(storage::DracoEncoded e, storage::encode_glb(r.mesh));
     glb = {{"bytes", e.bytes.size()}, {"position_bits", e.position_bits}, {"max_error_mm", e.max_error_mm}};
     f.results["mesh.glb"] = std::move(e.bytes);

@@ -77,13 +77,17 @@ inline constexpr const char* kRawRecordFile = "record.json";   // in DIR/raw and
 inline constexpr const char* kRawStripesFile = "stripes.bin";
 
 // Every file a scan leaves, as bytes: the results (calibration.json, points.ply,
-// points.drc, mesh.ply, mesh.glb, measurements.json, scan.json, as far as the job
-// got) and the raw record (record.json, stripes.bin). The GLB and the Draco cloud
-// are checked by decoding them again (storage/formats/draco_files.hpp).
+// points.drc, the surface, mesh.glb, measurements.json, scan.json, as far as the
+// job got) and the raw record (record.json, stripes.bin). The surface is mesh.ply,
+// or for the archive mesh.drc (Draco within 0.01 mm, a seventeenth of the size).
+// The Draco files are checked by decoding them again (storage/formats/draco_files.hpp).
+enum class SurfaceFile { kPly, kArchiveDraco };
+inline constexpr const char* kArchivedMeshFile = "mesh.drc";
+inline constexpr double kArchivedMeshErrorMm = 0.01;
 struct ScanFiles {
   std::map<std::string, std::string> results, raw;
 };
-StatusOr<ScanFiles> scan_result_files(const ScanJobResult& result);
+StatusOr<ScanFiles> scan_result_files(const ScanJobResult& result, SurfaceFile surface = SurfaceFile::kPly);
 
 // DIR/points.ply, DIR/mesh.ply (when reconstructed), DIR/measurements.json (when
 // measured; docs/measurements.md), DIR/calibration.json and DIR/scan.json (the
