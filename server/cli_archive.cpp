@@ -181,11 +181,7 @@ int run_archive(int argc, char** argv) {
   auto ends = [&](const char* suffix) {
     return out.size() >= std::strlen(suffix) && out.compare(out.size() - std::strlen(suffix), std::string::npos, suffix) == 0;
   };
-  auto surface = [&](const std::string& scan) -> StatusOr<TriangleMesh> {
-    ASSIGN_OR_RETURN(std::string path, ar.file_path(scan, 0, pipeline::kArchivedMeshFile));
-    ASSIGN_OR_RETURN(std::string bytes, read_whole_file(path));
-    return storage::decode_mesh_drc(bytes);
-  };
+  auto surface = [&](const std::string& scan) { return pipeline::archived_surface(ar, scan); };
   if (cmd == "mesh") {
     if (!need(3)) return 2;
     if (!ends(".ply") && !ends(".obj") && !ends(".stl") && !ends(".glb")) {
@@ -215,34 +211,18 @@ int run_archive(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan archive sheet: -o OUT.pdf|.csv|.json is required\n");
     return 2;
   }
-  auto r = ar.scan(args[2]);
-  if (!r.ok()) return fail(r.status());
-  auto ms = ar.measurements(r->id);
-  if (!ms.ok()) return fail(ms.status());
-  storage::MeasurementSheet sheet;
-  sheet.customer_ref = r->customer_id, sheet.scan_id = r->id, sheet.taken_at = r->started_at;
-  sheet.operator_name = r->operator_name;
-  for (const auto& m : *ms) {
-    storage::SheetEntry e;
-    e.iso_clause = m.iso_clause, e.name = m.name, e.label = m.label.empty() ? m.name : m.label, e.kind = m.kind;
-    e.value_mm = m.value_mm;
-    e.flagged = m.geometry.value("crosses_filled_hole", false);
-    e.source = m.source == "user" ? "saved by " + m.created_by : "automatic";
-    if (m.geometry.contains("path"))
-      for (const auto& p : m.geometry["path"]) e.path.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
-    e.closed = m.geometry.value("closed", false);
-    sheet.entries.push_back(std::move(e));
-  }
+  auto sheet = pipeline::archived_sheet(ar, args[2]);
+  if (!sheet.ok()) return fail(sheet.status());
   std::string bytes;
   if (ends(".csv")) {
-    bytes = storage::sheet_csv(sheet, *unit);
+    bytes = storage::sheet_csv(*sheet, *unit);
   } else if (ends(".json")) {
-    bytes = storage::sheet_json(sheet, *unit).dump(1);
+    bytes = storage::sheet_json(*sheet, *unit).dump(1);
   } else if (ends(".pdf")) {
     TriangleMesh mesh;
-    auto m = surface(r->id);
+    auto m = surface(args[2]);
     if (m.ok()) mesh = std::move(*m);
-    auto pdf = storage::sheet_pdf(sheet, mesh, *unit);
+    auto pdf = storage::sheet_pdf(*sheet, mesh, *unit);
     if (!pdf.ok()) return fail(pdf.status());
     bytes = std::move(*pdf);
   } else {
@@ -251,7 +231,7 @@ int run_archive(int argc, char** argv) {
   }
   const Status w = write_file_atomically(out, bytes);
   if (!w.ok()) return fail(w);
-  std::printf("wrote %s: %zu measurements\n", out.c_str(), sheet.entries.size());
+  std::printf("wrote %s: %zu measurements\n", out.c_str(), sheet->entries.size());
   return 0;
 }
 

@@ -11,6 +11,7 @@ int run_measure(int argc, char** argv);
 int run_sheet(int argc, char** argv);
 int run_reprocess(int argc, char** argv);
 int run_archive(int argc, char** argv);
+int run_serve(int argc, char** argv);
 }
 
 namespace {
@@ -26,6 +27,7 @@ void print_usage(FILE* out) {
       "  sheet MESH.ply -o OUT.pdf       the measurement sheet (PDF, CSV or JSON)\n"
       "  reprocess SCAN_DIR --out DIR    a scan again from its raw record\n"
       "  archive DIR list|show|verify|export|erase|reprocess|sheet ...  the scan archive\n"
+      "  serve [--port 8080] [--data DIR]  the workstation: rig, archive, API and browser UI\n"
       "\n"
       "Run 'bodyscan <command> --help' for a command's options.\n",
       out);
@@ -49,6 +51,7 @@ int main(int argc, char** argv) {
   if (cmd == "sheet") return bodyscan::cli::run_sheet(argc - 1, argv + 1);
   if (cmd == "reprocess") return bodyscan::cli::run_reprocess(argc - 1, argv + 1);
   if (cmd == "archive") return bodyscan::cli::run_archive(argc - 1, argv + 1);
+  if (cmd == "serve") return bodyscan::cli::run_serve(argc - 1, argv + 1);
   std::fprintf(stderr, "bodyscan: unknown command '%s'\n", cmd.c_str());
   print_usage(stderr);
   return 2;

@@ -40,22 +40,28 @@ void on_warning(png_structp, png_const_charp) {}
 }  // namespace
 
 Status write_png(const std::string& path, const GrayImage& image, int compression) {
+  StatusOr<std::string> bytes = encode_png(image, compression);
+  if (!bytes.ok()) return Status(bytes.status().code(), path + ": not written: " + bytes.status().message());
+  return write_file_atomically(path, *bytes);
+}
+
+StatusOr<std::string> encode_png(const GrayImage& image, int compression) {
   if (image.width <= 0 || image.height <= 0 ||
       image.pixels.size() != static_cast<size_t>(image.width) * static_cast<size_t>(image.height)) {
-    return invalid_argument(path + ": not written: the image's size does not match its pixels");
+    return invalid_argument("the image's size does not match its pixels");
   }
-  if (image.bit_depth != 8 && image.bit_depth != 16) return invalid_argument(path + ": bit depth must be 8 or 16");
+  if (image.bit_depth != 8 && image.bit_depth != 16) return invalid_argument("bit depth must be 8 or 16");
   std::string bytes, error;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, on_error, on_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_write_struct(&png, &info);
-    return internal_error(path + ": libpng could not start");
+    return internal_error("libpng could not start");
   }
   std::vector<uint8_t> row(static_cast<size_t>(image.width) * (image.bit_depth / 8));
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
-    return internal_error(path + ": PNG encoding failed: " + error);
+    return internal_error("PNG encoding failed: " + error);
   }
   png_set_write_fn(png, &bytes, append_bytes, no_flush);
   png_set_compression_level(png, compression);
@@ -76,7 +82,7 @@ Status write_png(const std::string& path, const GrayImage& image, int compressio
   }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  return write_file_atomically(path, bytes);
+  return bytes;
 }
 
 StatusOr<GrayImage> read_png(const std::string& path) {
@@ -89,7 +95,7 @@ StatusOr<GrayImage> read_png(const std::string& path) {
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_read_struct(&png, &info, nullptr);
-    return internal_error(path + ": libpng could not start");
+    return internal_error("libpng could not start");
   }
   GrayImage image;
   std::vector<uint8_t> row;

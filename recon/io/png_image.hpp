@@ -18,6 +18,8 @@ struct GrayImage {
 
 // zlib level 1-9 (speed against size); 1 suits the mostly dark frames of a scan.
 Status write_png(const std::string& path, const GrayImage& image, int compression = 1);
+// The PNG file's bytes, in memory (camera previews sent to browsers).
+StatusOr<std::string> encode_png(const GrayImage& image, int compression = 1);
 StatusOr<GrayImage> read_png(const std::string& path);
 
 }  // namespace bodyscan

@@ -2,6 +2,7 @@
 
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/measurements_json.hpp"
+#include "storage/formats/draco_files.hpp"
 
 namespace bodyscan::pipeline {
 
@@ -58,6 +59,34 @@ StatusOr<int> reprocess_archived_scan(storage::Archive& archive, const std::stri
   ASSIGN_OR_RETURN(ScanJobResult result, reprocess_scan(record, stripes, options));
   ASSIGN_OR_RETURN(storage::ScanResults results, to_results(result, options));
   return archive.add_version(scan_id, results, actor);
+}
+
+StatusOr<TriangleMesh> archived_surface(const storage::Archive& archive, const std::string& scan_id, int version) {
+  ASSIGN_OR_RETURN(std::string path, archive.file_path(scan_id, version, kArchivedMeshFile));
+  ASSIGN_OR_RETURN(std::string bytes, read_whole_file(path));
+  return storage::decode_mesh_drc(bytes);
+}
+
+StatusOr<storage::MeasurementSheet> archived_sheet(const storage::Archive& archive, const std::string& scan_id) {
+  ASSIGN_OR_RETURN(storage::ScanRecord r, archive.scan(scan_id));
+  ASSIGN_OR_RETURN(std::vector<storage::MeasurementRecord> ms, archive.measurements(r.id));
+  storage::MeasurementSheet sheet;
+  sheet.customer_ref = r.customer_id, sheet.scan_id = r.id, sheet.taken_at = r.started_at;
+  sheet.operator_name = r.operator_name;
+  for (const auto& m : ms) {
+    storage::SheetEntry e;
+    e.iso_clause = m.iso_clause, e.name = m.name, e.label = m.label.empty() ? m.name : m.label, e.kind = m.kind;
+    e.value_mm = m.value_mm;
+    e.flagged = m.geometry.value("crosses_filled_hole", false);
+    e.source = m.source == "user" ? "saved by " + m.created_by : "automatic";
+    if (m.geometry.contains("path") && m.geometry["path"].is_array())
+      for (const auto& p : m.geometry["path"])
+        if (p.is_array() && p.size() == 3 && p[0].is_number() && p[1].is_number() && p[2].is_number())
+          e.path.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+    e.closed = m.geometry.value("closed", false);
+    sheet.entries.push_back(std::move(e));
+  }
+  return sheet;
 }
 
 }  // namespace bodyscan::pipeline

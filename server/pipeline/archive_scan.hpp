@@ -9,6 +9,7 @@
 
 #include "server/pipeline/scan_job.hpp"
 #include "storage/archive/archive.hpp"
+#include "storage/formats/measurement_sheet.hpp"
 
 namespace bodyscan::pipeline {
 
@@ -22,5 +23,12 @@ Status archive_scan(storage::Archive& archive, const std::string& scan_id, const
 // results as a new version. Returns the version.
 StatusOr<int> reprocess_archived_scan(storage::Archive& archive, const std::string& scan_id,
                                       const ScanJobOptions& options, const std::string& actor);
+
+// An archived scan's surface (mesh.drc) of a version (0: the current one).
+StatusOr<TriangleMesh> archived_surface(const storage::Archive& archive, const std::string& scan_id, int version = 0);
+
+// The sheet of an archived scan: its current automatic set and the measurements
+// staff saved, each with the path to draw.
+StatusOr<storage::MeasurementSheet> archived_sheet(const storage::Archive& archive, const std::string& scan_id);
 
 }  // namespace bodyscan::pipeline

@@ -36,6 +36,8 @@ Status surface_and_measure(const ScanJobOptions& options, ScanJobResult* out) {
     if (r.ok()) {
       out->mesh = std::move(r->mesh);
       out->surface = r->stats;
+    } else if (r.status().code() == StatusCode::kCancelled) {
+      return r.status();
     } else {
       out->surface_error = r.status().message();
     }
@@ -54,18 +56,29 @@ Status surface_and_measure(const ScanJobOptions& options, ScanJobResult* out) {
 }  // namespace
 
 StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& options) {
-  ScanJobResult out;
-  auto t0 = std::chrono::steady_clock::now();
-  ASSIGN_OR_RETURN(out.calibration, calibrate_rig(rig, options.calibrate, options.progress));
-  out.calibration_seconds = seconds_since(t0);
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSIGN_OR_RETURN(RigCalibration calibration, calibrate_rig(rig, options.calibrate, options.progress));
+  const double seconds = seconds_since(t0);
+  ASSIGN_OR_RETURN(ScanJobResult out, run_scan_job(rig, std::move(calibration), options));
+  out.calibration_seconds = seconds;
+  return out;
+}
 
-  t0 = std::chrono::steady_clock::now();
+StatusOr<ScanJobResult> run_scan_job(const Rig& rig, RigCalibration calibration, const ScanJobOptions& options) {
+  ScanJobResult out;
+  out.calibration = std::move(calibration);
+  const auto t0 = std::chrono::steady_clock::now();
   ScanOptions scan_options = options.scan;
   scan_options.view.max_view_deg =
       options.max_view_deg.value_or(rig.description ? rig.description->processing.max_view_deg : 90.0);
   ScanProcessor processor(out.calibration, scan_options);
   RETURN_IF_ERROR(acquire_scan(
-      rig, [&](Shot&& s) { return processor.consume(std::move(s)); }, options.every, options.progress,
+      rig,
+      [&](Shot&& s) {
+        if (options.on_scan_shot) options.on_scan_shot(s);
+        return processor.consume(std::move(s));
+      },
+      options.every, options.progress,
       out.calibration.sweep_reversed));
   if (options.record_raw) {
     out.raw_record = calibration_record(out.calibration);

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -43,6 +44,9 @@ struct ScanJobOptions {
   bool measure = true;  // the automatic set on the surface (measure_body)
   bool record_raw = true;  // keep the raw record (scan_recording.hpp) in the result
   ProgressFn progress;  // stages: calibration..., scan, surface...
+  // Sees every scan shot before it is processed (live previews); called on the
+  // job's thread, so it must be quick.
+  std::function<void(const Shot&)> on_scan_shot;
 };
 
 struct ScanJobResult {
@@ -65,8 +69,12 @@ struct ScanJobResult {
 };
 
 // Errors when calibration or the scan fails, or the scan gives no usable cloud; a
-// failed reconstruction is reported in surface_error, the cloud kept.
+// failed reconstruction is reported in surface_error, the cloud kept. Cancelled
+// (options.progress returned false) at any stage: a kCancelled error.
 StatusOr<ScanJobResult> run_scan_job(const Rig& rig, const ScanJobOptions& options = {});
+// The same against a calibration made earlier (the workstation calibrates once and
+// scans many times).
+StatusOr<ScanJobResult> run_scan_job(const Rig& rig, RigCalibration calibration, const ScanJobOptions& options = {});
 
 // The scan again from its raw record: the cloud, surface and measurements as
 // `options` makes them now (the scan options recorded, unless overridden).

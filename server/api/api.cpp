@@ -1,0 +1,171 @@
+#include "server/api/api.hpp"
+
+#include <sodium.h>
+
+#include <fstream>
+
+#include "server/api/static_files.hpp"
+
+namespace bodyscan::server {
+
+namespace {
+
+unsigned role_bit(Role r) {
+  switch (r) {
+    case Role::kOperator: return kOperator;
+    case Role::kTailor: return kTailor;
+    case Role::kAdmin: return kAdmin;
+  }
+  return 0;
+}
+
+std::vector<std::string> split_path(const std::string& path) {
+  std::vector<std::string> out;
+  size_t start = 1;
+  while (start <= path.size()) {
+    const size_t end = std::min(path.find('/', start), path.size());
+    out.push_back(path.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+bool match(const std::vector<std::string>& pattern, const std::vector<std::string>& path,
+           std::map<std::string, std::string>* params) {
+  if (pattern.size() != path.size()) return false;
+  params->clear();
+  for (size_t i = 0; i < pattern.size(); ++i) {
+    const std::string& p = pattern[i];
+    if (p.size() > 2 && p.front() == '{' && p.back() == '}') {
+      if (path[i].empty()) return false;
+      (*params)[p.substr(1, p.size() - 2)] = path[i];
+    } else if (p != path[i]) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool constant_time_equal(const std::string& a, const std::string& b) {
+  return a.size() == b.size() && !a.empty() && sodium_memcmp(a.data(), b.data(), a.size()) == 0;
+}
+
+// A browser sends Origin on cross-site requests; when it names another host
+// than the one addressed, the request did not come from our pages.
+bool foreign_origin(const HttpRequest& r) {
+  const std::string origin = r.header("origin");
+  if (origin.empty() || origin == "null") return !origin.empty();
+  const size_t scheme = origin.find("://");
+  const std::string host = scheme == std::string::npos ? origin : origin.substr(scheme + 3);
+  const std::string forwarded = r.header("x-forwarded-host");
+  return host != r.header("host") && (forwarded.empty() || host != forwarded);
+}
+
+HttpResponse openapi(const ApiOptions& options) {
+  std::ifstream in(options.openapi_file, std::ios::binary);
+  if (!in) return error_response(404, "the API description is not installed");
+  HttpResponse r;
+  r.body.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  r.set("Content-Type", "application/json");
+  r.set("Cache-Control", "no-cache");
+  return r;
+}
+
+}  // namespace
+
+std::string session_cookie(const HttpRequest& request) {
+  const std::string cookies = request.header("cookie");
+  const std::string key = std::string(kSessionCookie) + "=";
+  size_t pos = 0;
+  while (pos < cookies.size()) {
+    while (pos < cookies.size() && (cookies[pos] == ' ' || cookies[pos] == ';')) ++pos;
+    const size_t end = std::min(cookies.find(';', pos), cookies.size());
+    if (cookies.compare(pos, key.size(), key) == 0) return cookies.substr(pos + key.size(), end - pos - key.size());
+    pos = end;
+  }
+  return {};
+}
+
+std::optional<nlohmann::json> json_body(const Call& call, HttpResponse* error) {
+  const std::string type = call.request.header("content-type");
+  if (!call.request.body.empty() && type.rfind("application/json", 0) != 0) {
+    *error = error_response(415, "send the request body as application/json");
+    return std::nullopt;
+  }
+  nlohmann::json j = call.request.body.empty() ? nlohmann::json::object()
+                                               : nlohmann::json::parse(call.request.body, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    *error = error_response(400, "the request body is not a JSON object");
+    return std::nullopt;
+  }
+  return j;
+}
+
+Api::Api(Workstation& ws, ApiOptions options) : ws_(ws), options_(std::move(options)) {
+  routes_.push_back({"GET", "/api/health", kAnyone,
+                     [](Workstation&, const Call&) {
+                       return json_response(200, {{"status", "ok"}, {"service", "bodyscan"}});
+                     }});
+  routes_.push_back({"GET", "/api/openapi.json", kAnyone,
+                     [this](Workstation&, const Call&) { return openapi(options_); }});
+  add_account_routes(&routes_, options_);
+  add_rig_routes(&routes_);
+  add_scan_routes(&routes_);
+  add_share_routes(&routes_, options_);
+}
+
+std::optional<HttpResponse> Api::refuse_events(const HttpRequest& request) {
+  const std::optional<Session> s = ws_.auth().session(session_cookie(request));
+  if (!s) return error_response(401, "log in to follow the rig's events");
+  if (foreign_origin(request)) return error_response(403, "the events are for this workstation's own pages");
+  return std::nullopt;
+}
+
+HttpResponse Api::handle(const HttpRequest& request) {
+  if (request.path.rfind("/api/", 0) != 0 && request.path != "/api") return serve_static(options_.web_root, request);
+  const std::vector<std::string> path = split_path(request.path);
+  const Route* route = nullptr;
+  std::map<std::string, std::string> params;
+  std::string allowed;
+  for (const Route& r : routes_) {
+    std::map<std::string, std::string> p;
+    if (!match(split_path(r.pattern), path, &p)) continue;
+    const bool head_of_get = request.method == "HEAD" && r.method == "GET";
+    if (r.method == request.method || head_of_get) {
+      route = &r;
+      params = std::move(p);
+      break;
+    }
+    allowed += (allowed.empty() ? "" : ", ") + r.method;
+  }
+  if (!route) {
+    if (allowed.empty()) return error_response(404, "no such endpoint: " + request.method + " " + request.path);
+    HttpResponse r = error_response(405, request.method + " is not allowed here");
+    r.set("Allow", allowed);
+    return r;
+  }
+  Call call{request, std::move(params), std::nullopt, std::nullopt};
+  const bool changes_state = request.method != "GET" && request.method != "HEAD";
+  if (route->access & kShareLink) {
+    call.share = ws_.auth().share_by_token(call.params["token"]);
+    // One answer for unknown, expired and revoked links: nothing to learn by probing.
+    if (!call.share) return error_response(404, "this link is not valid (it may have expired or been withdrawn)");
+  } else if (!(route->access & kAnyone)) {
+    call.session = ws_.auth().session(session_cookie(request));
+    if (!call.session) return error_response(401, "log in first");
+    if (!(route->access & role_bit(call.session->role)))
+      return error_response(403, std::string("a ") + to_string(call.session->role) + " may not do this");
+    if (changes_state && route->csrf) {
+      if (!constant_time_equal(request.header("x-csrf-token"), call.session->csrf_token))
+        return error_response(403, "missing or wrong X-CSRF-Token (reload the page)");
+      if (foreign_origin(request)) return error_response(403, "cross-site request refused");
+    }
+  } else if (changes_state && foreign_origin(request)) {
+    return error_response(403, "cross-site request refused");
+  }
+  HttpResponse response = route->handler(ws_, call);
+  if (request.method == "HEAD") response.body.clear();
+  return response;
+}
+
+}  // namespace bodyscan::server

@@ -1,0 +1,72 @@
+// Requests and responses as the API sees them: plain values, no Beast, so that
+// the routes compile fast and can be tested as functions (server/net converts).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "recon/core/status.hpp"
+
+namespace bodyscan::server {
+
+struct HttpRequest {
+  std::string method;  // "GET", "POST", ...
+  std::string target;  // as sent: "/api/scans?customer=c_1"
+  std::string path;    // the target's path, percent-decoded: "/api/scans"
+  std::map<std::string, std::string> query;    // decoded
+  std::map<std::string, std::string> headers;  // names in lower case
+  std::string body;
+  std::string remote_address;
+  bool secure = false;  // arrived over TLS
+
+  std::string header(const std::string& lower_name) const {
+    auto it = headers.find(lower_name);
+    return it == headers.end() ? std::string() : it->second;
+  }
+  std::string param(const std::string& name, const std::string& fallback = "") const {
+    auto it = query.find(name);
+    return it == query.end() ? fallback : it->second;
+  }
+};
+
+struct HttpResponse {
+  int status = 200;
+  std::vector<std::pair<std::string, std::string>> headers;
+  std::string body;
+  std::string file;  // when set, the body is this file's content (served from disk)
+
+  HttpResponse& set(const std::string& name, const std::string& value) {
+    for (auto& h : headers)
+      if (h.first == name) {
+        h.second = value;
+        return *this;
+      }
+    headers.emplace_back(name, value);
+    return *this;
+  }
+  std::string get(const std::string& name) const {
+    for (const auto& h : headers)
+      if (h.first == name) return h.second;
+    return {};
+  }
+};
+
+HttpResponse json_response(int status, const nlohmann::json& body);
+// {"error": {"status": 409, "code": "conflict", "message": "..."}}.
+HttpResponse error_response(int status, const std::string& message);
+// A Status's HTTP status: invalid argument 400, not found 404, failed
+// precondition 409, unavailable 503, deadline 504, I/O (a full disk ...) 507, else 500.
+int http_status(const Status& s);
+HttpResponse error_response(const Status& s);
+
+// "%41b+c" -> "Ab c" (with plus_is_space); nullopt for a malformed escape or a NUL.
+std::optional<std::string> percent_decode(std::string_view text, bool plus_is_space);
+// Splits a target into its decoded path and query; false when malformed.
+bool parse_target(const std::string& target, std::string* path, std::map<std::string, std::string>* query);
+
+}  // namespace bodyscan::server

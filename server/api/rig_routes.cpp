@@ -1,0 +1,75 @@
+// The rig: its status, calibrating it, starting a scan, following and cancelling
+// the job. One job at a time: a second gets 409 with what the rig is busy with.
+#include "server/api/api.hpp"
+
+namespace bodyscan::server {
+
+namespace {
+
+HttpResponse accepted(const JobInfo& j) {
+  HttpResponse r = json_response(202, {{"job", to_json(j)}});
+  r.set("Location", "/api/jobs/" + j.id);
+  return r;
+}
+
+}  // namespace
+
+void add_rig_routes(std::vector<Api::Route>* routes) {
+  routes->push_back({"GET", "/api/rig", kStaff,
+                     [](Workstation& ws, const Call&) { return json_response(200, ws.rig_status()); }});
+  routes->push_back({"POST", "/api/rig/calibrate", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
+                       auto j = ws.start_calibration(call.actor());
+                       if (!j.ok()) return error_response(j.status());
+                       return accepted(*j);
+                     }});
+  routes->push_back({"POST", "/api/scans", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
+                       HttpResponse error;
+                       auto body = json_body(call, &error);
+                       if (!body) return error;
+                       ScanRequest req;
+                       req.actor = call.actor();
+                       if (body->contains("every")) {
+                         if (!(*body)["every"].is_number_integer() || (*body)["every"].get<int64_t>() < 1 ||
+                             (*body)["every"].get<int64_t>() > 1000)
+                           return error_response(400, "'every' is a whole number from 1 to 1000");
+                         req.every = (*body)["every"].get<int>();
+                       }
+                       if (body->contains("customer_id") == body->contains("customer"))
+                         return error_response(400, "give either 'customer_id' or a new 'customer' {name, contact}");
+                       if (body->contains("customer_id")) {
+                         if (!(*body)["customer_id"].is_string()) return error_response(400, "'customer_id' is a string");
+                         req.customer_id = (*body)["customer_id"];
+                       }
+                       // The rig must be free before a customer record is made for the scan.
+                       if (auto running = ws.current_job())
+                         return error_response(409, std::string("the rig is busy with a ") + to_string(running->kind) +
+                                                        " (job " + running->id + ")");
+                       if (body->contains("customer")) {
+                         const nlohmann::json& c = (*body)["customer"];
+                         if (!c.is_object()) return error_response(400, "'customer' is {\"name\": ..., \"contact\": ...}");
+                         auto text = [&](const char* k) -> std::optional<std::string> {
+                           if (!c.contains(k) || c[k].is_null()) return std::nullopt;
+                           return c[k].is_string() ? std::optional<std::string>(c[k].get<std::string>()) : std::nullopt;
+                         };
+                         auto made = ws.archive().add_customer(text("name"), text("contact"), call.actor());
+                         if (!made.ok()) return error_response(made.status());
+                         req.customer_id = made->id;
+                       }
+                       auto j = ws.start_scan(req);
+                       if (!j.ok()) return error_response(j.status());
+                       return accepted(*j);
+                     }});
+  routes->push_back({"GET", "/api/jobs/{id}", kStaff, [](Workstation& ws, const Call& call) {
+                       auto j = ws.job(call.params.at("id"));
+                       if (!j) return error_response(404, "no job " + call.params.at("id"));
+                       return json_response(200, {{"job", to_json(*j)}});
+                     }});
+  routes->push_back({"POST", "/api/jobs/{id}/cancel", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
+                       const Status s = ws.cancel(call.params.at("id"), call.actor());
+                       if (!s.ok()) return error_response(s);
+                       auto j = ws.job(call.params.at("id"));
+                       return json_response(202, {{"job", j ? to_json(*j) : nlohmann::json()}});
+                     }});
+}
+
+}  // namespace bodyscan::server

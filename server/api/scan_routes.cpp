@@ -1,0 +1,288 @@
+// Customers and their scans: search, details, the served files (GLB, Draco cloud)
+// with ETags, the measurements (automatic and saved), evaluating a measurement the
+// browser draws, measurement sheets, deleting and reprocessing.
+#include <cmath>
+
+#include "server/api/api.hpp"
+#include "server/pipeline/archive_scan.hpp"
+#include "server/pipeline/evaluate_measurement.hpp"
+#include "storage/formats/measurement_sheet.hpp"
+
+namespace bodyscan::server {
+
+nlohmann::json customer_json(const storage::Customer& c) {
+  return {{"id", c.id}, {"name", c.name ? nlohmann::json(*c.name) : nlohmann::json()},
+          {"contact", c.contact ? nlohmann::json(*c.contact) : nlohmann::json()}, {"created_at", c.created_at}};
+}
+
+nlohmann::json scan_json(const storage::ScanRecord& r) {
+  nlohmann::json versions = nlohmann::json::array();
+  for (const storage::ScanVersion& v : r.versions) {
+    nlohmann::json files = nlohmann::json::array();
+    for (const storage::ArchivedFile& f : v.files) files.push_back({{"name", f.name}, {"bytes", f.bytes}});
+    versions.push_back({{"version", v.version},
+                        {"created_at", v.created_at},
+                        {"algorithms", v.algorithms},
+                        {"note", v.note},
+                        {"files", files}});
+  }
+  return {{"id", r.id},
+          {"customer_id", r.customer_id},
+          {"operator", r.operator_name},
+          {"calibration_id", r.calibration_id},
+          {"status", storage::to_string(r.status)},
+          {"status_reason", r.status_reason},
+          {"started_at", r.started_at},
+          {"finished_at", r.finished_at},
+          {"current_version", r.current_version},
+          {"versions", versions}};
+}
+
+nlohmann::json measurement_json(const storage::MeasurementRecord& m) {
+  return {{"id", m.id},       {"version", m.version},       {"source", m.source},
+          {"name", m.name},   {"label", m.label},           {"kind", m.kind},
+          {"iso_clause", m.iso_clause}, {"value_mm", m.value_mm}, {"geometry", m.geometry},
+          {"created_by", m.created_by}, {"created_at", m.created_at}};
+}
+
+// A scan's result file, served from the archive. The current version revalidates
+// (a reprocess changes it); a named version never changes.
+HttpResponse scan_file(Workstation& ws, const std::string& scan_id, const std::string& name,
+                       const std::string& version_text, const std::string& if_none_match) {
+  int version = 0;
+  if (!version_text.empty()) {
+    char* end = nullptr;
+    const long v = std::strtol(version_text.c_str(), &end, 10);
+    if (*end != '\0' || v < 1 || v > 1000000) return error_response(400, "'version' is a version number (1, 2, ...)");
+    version = static_cast<int>(v);
+  }
+  auto r = ws.archive().scan(scan_id);
+  if (!r.ok()) return error_response(r.status());
+  const int wanted = version == 0 ? r->current_version : version;
+  auto path = ws.archive().file_path(scan_id, wanted, name);
+  if (!path.ok()) return error_response(path.status());
+  std::string etag;
+  for (const storage::ScanVersion& v : r->versions)
+    if (v.version == wanted)
+      for (const storage::ArchivedFile& f : v.files)
+        if (f.name == name) etag = "\"" + f.blake2b.substr(0, 32) + "\"";
+  HttpResponse out;
+  out.set("Content-Type", name.size() > 4 && name.substr(name.size() - 4) == ".glb" ? "model/gltf-binary"
+                                                                                     : "application/octet-stream");
+  out.set("ETag", etag);
+  out.set("Cache-Control", version ? "private, max-age=31536000, immutable" : "private, no-cache");
+  if (!etag.empty() && if_none_match == etag) {
+    out.status = 304;
+    return out;
+  }
+  out.file = *path;
+  return out;
+}
+
+namespace {
+
+HttpResponse no_content() {
+  HttpResponse r;
+  r.status = 204;
+  return r;
+}
+
+HttpResponse sheet(Workstation& ws, const Call& call, const std::string& format) {
+  auto unit = storage::parse_length_unit(call.request.param("unit", "mm"));
+  if (!unit.ok()) return error_response(400, unit.status().message());
+  const std::string& id = call.params.at("id");
+  auto s = pipeline::archived_sheet(ws.archive(), id);
+  if (!s.ok()) return error_response(s.status());
+  HttpResponse out;
+  if (format == "csv") {
+    out.body = storage::sheet_csv(*s, *unit);
+    out.set("Content-Type", "text/csv; charset=utf-8");
+  } else if (format == "json") {
+    out.body = storage::sheet_json(*s, *unit).dump(1);
+    out.set("Content-Type", "application/json");
+  } else {
+    auto mesh = ws.surface(id);
+    const TriangleMesh empty;
+    auto pdf = storage::sheet_pdf(*s, mesh.ok() ? **mesh : empty, *unit);
+    if (!pdf.ok()) return error_response(pdf.status());
+    out.body = std::move(*pdf);
+    out.set("Content-Type", "application/pdf");
+  }
+  out.set("Content-Disposition", "attachment; filename=\"" + id + "-measurements." + format + "\"");
+  out.set("Cache-Control", "no-store");
+  ws.archive().log(call.actor(), "export sheet", "scan", id, format);
+  return out;
+}
+
+}  // namespace
+
+void add_scan_routes(std::vector<Api::Route>* routes) {
+  routes->push_back({"GET", "/api/customers", kStaff, [](Workstation& ws, const Call& call) {
+                       auto list = ws.archive().customers(call.request.param("q"));
+                       if (!list.ok()) return error_response(list.status());
+                       nlohmann::json out = nlohmann::json::array();
+                       for (const auto& c : *list) out.push_back(customer_json(c));
+                       return json_response(200, {{"customers", out}});
+                     }});
+  routes->push_back({"POST", "/api/customers", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
+                       HttpResponse error;
+                       auto body = json_body(call, &error);
+                       if (!body) return error;
+                       auto text = [&](const char* k) -> std::optional<std::string> {
+                         return body->contains(k) && (*body)[k].is_string()
+                                    ? std::optional<std::string>((*body)[k].get<std::string>())
+                                    : std::nullopt;
+                       };
+                       auto c = ws.archive().add_customer(text("name"), text("contact"), call.actor());
+                       if (!c.ok()) return error_response(c.status());
+                       return json_response(201, customer_json(*c));
+                     }});
+  routes->push_back({"GET", "/api/customers/{id}", kStaff, [](Workstation& ws, const Call& call) {
+                       auto c = ws.archive().customer(call.params.at("id"));
+                       if (!c.ok()) return error_response(c.status());
+                       storage::ScanQuery q;
+                       q.customer_id = c->id;
+                       auto scans = ws.archive().scans(q);
+                       if (!scans.ok()) return error_response(scans.status());
+                       nlohmann::json out = customer_json(*c);
+                       out["scans"] = nlohmann::json::array();
+                       for (const auto& s : *scans) out["scans"].push_back(scan_json(s));
+                       return json_response(200, out);
+                     }});
+  routes->push_back({"DELETE", "/api/customers/{id}", kAdmin, [](Workstation& ws, const Call& call) {
+                       const std::string& id = call.params.at("id");
+                       storage::ScanQuery q;
+                       q.customer_id = id;
+                       q.limit = 1000000;
+                       auto scans = ws.archive().scans(q);
+                       if (!scans.ok()) return error_response(scans.status());
+                       // The links go first: a link must never outlive what it shows.
+                       for (const auto& s : *scans) {
+                         const Status st = ws.auth().delete_shares_of_scan(s.id);
+                         if (!st.ok()) return error_response(st);
+                       }
+                       const Status st = ws.archive().delete_customer(id, call.actor());
+                       if (!st.ok()) return error_response(st);
+                       return no_content();
+                     }});
+  routes->push_back({"GET", "/api/scans", kStaff, [](Workstation& ws, const Call& call) {
+                       storage::ScanQuery q;
+                       q.customer_id = call.request.param("customer");
+                       q.text = call.request.param("q");
+                       q.from = call.request.param("from");
+                       q.to = call.request.param("to");
+                       const std::string limit = call.request.param("limit", "100");
+                       char* end = nullptr;
+                       const long n = std::strtol(limit.c_str(), &end, 10);
+                       if (*end != '\0' || n < 1 || n > 1000) return error_response(400, "'limit' is 1 to 1000");
+                       q.limit = static_cast<int>(n);
+                       auto list = ws.archive().scans(q);
+                       if (!list.ok()) return error_response(list.status());
+                       nlohmann::json out = nlohmann::json::array();
+                       for (const auto& s : *list) out.push_back(scan_json(s));
+                       return json_response(200, {{"scans", out}});
+                     }});
+  routes->push_back({"GET", "/api/scans/{id}", kStaff, [](Workstation& ws, const Call& call) {
+                       auto r = ws.archive().scan(call.params.at("id"));
+                       if (!r.ok()) return error_response(r.status());
+                       return json_response(200, scan_json(*r));
+                     }});
+  routes->push_back({"DELETE", "/api/scans/{id}", kAdmin, [](Workstation& ws, const Call& call) {
+                       const std::string& id = call.params.at("id");
+                       if (auto j = ws.current_job(); j && j->scan_id == id)
+                         return error_response(409, "scan " + id + " is being processed; cancel the job first");
+                       auto r = ws.archive().scan(id);
+                       if (!r.ok()) return error_response(r.status());
+                       Status st = ws.auth().delete_shares_of_scan(id);
+                       if (st.ok()) st = ws.archive().delete_scan(id, call.actor());
+                       if (!st.ok()) return error_response(st);
+                       return no_content();
+                     }});
+  routes->push_back({"POST", "/api/scans/{id}/reprocess", kAdmin, [](Workstation& ws, const Call& call) {
+                       auto j = ws.start_reprocess(call.params.at("id"), call.actor());
+                       if (!j.ok()) return error_response(j.status());
+                       HttpResponse r = json_response(202, {{"job", to_json(*j)}});
+                       r.set("Location", "/api/jobs/" + j->id);
+                       return r;
+                     }});
+  for (const char* name : {"mesh.glb", "points.drc"}) {
+    routes->push_back({"GET", std::string("/api/scans/{id}/") + name, kStaff, [name](Workstation& ws, const Call& call) {
+                         return scan_file(ws, call.params.at("id"), name, call.request.param("version"),
+                                          call.request.header("if-none-match"));
+                       }});
+  }
+  routes->push_back({"GET", "/api/scans/{id}/measurements", kStaff, [](Workstation& ws, const Call& call) {
+                       const std::string& id = call.params.at("id");
+                       auto r = ws.archive().scan(id);
+                       if (!r.ok()) return error_response(r.status());
+                       auto ms = ws.archive().measurements(id);
+                       if (!ms.ok()) return error_response(ms.status());
+                       nlohmann::json out = nlohmann::json::array();
+                       for (const auto& m : *ms) out.push_back(measurement_json(m));
+                       return json_response(200,
+                                            {{"scan_id", id}, {"version", r->current_version}, {"measurements", out}});
+                     }});
+  routes->push_back({"POST", "/api/scans/{id}/measure", kStaff, [](Workstation& ws, const Call& call) {
+                       HttpResponse error;
+                       auto body = json_body(call, &error);
+                       if (!body) return error;
+                       auto mesh = ws.surface(call.params.at("id"));
+                       if (!mesh.ok()) return error_response(mesh.status());
+                       auto m = pipeline::evaluate_measurement(**mesh, *body);
+                       if (!m.ok()) return error_response(m.status());
+                       return json_response(200, *m);
+                     }});
+  routes->push_back({"POST", "/api/scans/{id}/measurements", kTailor | kAdmin, [](Workstation& ws, const Call& call) {
+                       HttpResponse error;
+                       auto body = json_body(call, &error);
+                       if (!body) return error;
+                       const std::string& id = call.params.at("id");
+                       const std::string name = body->value("name", "");
+                       if (name.empty() || name.size() > 100)
+                         return error_response(400, "give the measurement a 'name' (up to 100 characters)");
+                       if (!(*body)["request"].is_object())
+                         return error_response(400, "'request' is the measurement to take (as for /measure)");
+                       auto r = ws.archive().scan(id);
+                       if (!r.ok()) return error_response(r.status());
+                       auto mesh = ws.surface(id);
+                       if (!mesh.ok()) return error_response(mesh.status());
+                       // Evaluated here, on the archived surface: what is saved is what the server measured.
+                       auto m = pipeline::evaluate_measurement(**mesh, (*body)["request"]);
+                       if (!m.ok()) return error_response(m.status());
+                       storage::MeasurementRecord rec;
+                       rec.scan_id = id;
+                       rec.version = r->current_version;
+                       rec.source = "user";
+                       rec.name = name;
+                       rec.label = body->value("label", name);
+                       rec.kind = (*m)["kind"];
+                       rec.value_mm = (*m)["value_mm"];
+                       rec.geometry = *m;
+                       rec.geometry["request"] = (*body)["request"];
+                       rec.created_by = call.actor();
+                       auto saved = ws.archive().save_measurement(rec, call.actor());
+                       if (!saved.ok()) return error_response(saved.status());
+                       auto all = ws.archive().measurements(id);
+                       if (all.ok())
+                         for (const auto& x : *all)
+                           if (x.id == *saved) return json_response(201, measurement_json(x));
+                       rec.id = *saved;
+                       return json_response(201, measurement_json(rec));
+                     }});
+  routes->push_back({"DELETE", "/api/scans/{id}/measurements/{mid}", kTailor | kAdmin,
+                     [](Workstation& ws, const Call& call) {
+                       const std::string& mid = call.params.at("mid");
+                       char* end = nullptr;
+                       const long long n = std::strtoll(mid.c_str(), &end, 10);
+                       if (*end != '\0' || n < 1) return error_response(404, "no measurement " + mid);
+                       const Status st = ws.archive().delete_measurement(call.params.at("id"), n, call.actor());
+                       if (!st.ok()) return error_response(st);
+                       return no_content();
+                     }});
+  for (const char* format : {"csv", "json", "pdf"}) {
+    routes->push_back({"GET", std::string("/api/scans/{id}/sheet.") + format, kStaff,
+                       [format](Workstation& ws, const Call& call) { return sheet(ws, call, format); }});
+  }
+}
+
+}  // namespace bodyscan::server

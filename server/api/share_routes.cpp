@@ -1,0 +1,109 @@
+// Customer share links: staff make one per scan (read-only, expiring, revocable,
+// with the measurements they choose); the customer's phone reaches that scan's
+// model and those measurements through the token alone, and nothing else.
+#include "server/api/api.hpp"
+
+namespace bodyscan::server {
+
+nlohmann::json measurement_json(const storage::MeasurementRecord& m);
+HttpResponse scan_file(Workstation& ws, const std::string& scan_id, const std::string& name,
+                       const std::string& version_text, const std::string& if_none_match);
+
+namespace {
+
+constexpr int64_t kDay = 24 * 3600;
+
+nlohmann::json share_json(const ShareLink& s) {
+  return {{"id", s.id},
+          {"scan_id", s.scan_id},
+          {"measurements", s.measurements},
+          {"created_by", s.created_by},
+          {"created_at", s.created_at},
+          {"expires_at", s.expires_at},
+          {"revoked", s.revoked}};
+}
+
+std::string link_base(const ApiOptions& o, const HttpRequest& r) {
+  if (!o.public_url.empty()) return o.public_url;
+  return std::string(r.secure || o.secure_cookies ? "https://" : "http://") + r.header("host");
+}
+
+}  // namespace
+
+void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options) {
+  routes->push_back({"POST", "/api/scans/{id}/shares", kStaff, [options](Workstation& ws, const Call& call) {
+                       HttpResponse error;
+                       auto body = json_body(call, &error);
+                       if (!body) return error;
+                       const std::string& id = call.params.at("id");
+                       auto r = ws.archive().scan(id);
+                       if (!r.ok()) return error_response(r.status());
+                       if (r->current_version == 0) return error_response(409, "scan " + id + " has no results to share");
+                       const nlohmann::json days = body->value("days", nlohmann::json(30));
+                       if (!days.is_number() || !(days.get<double>() > 0) || days.get<double>() > 365)
+                         return error_response(400, "'days' is how long the link works: more than 0, at most 365");
+                       std::vector<std::string> names;
+                       if (body->contains("measurements")) {
+                         const nlohmann::json& m = (*body)["measurements"];
+                         if (!m.is_array()) return error_response(400, "'measurements' is a list of names");
+                         for (const auto& n : m) {
+                           if (!n.is_string()) return error_response(400, "'measurements' is a list of names");
+                           names.push_back(n);
+                         }
+                       }
+                       auto made = ws.auth().create_share(id, names, static_cast<int64_t>(days.get<double>() * kDay),
+                                                          call.actor());
+                       if (!made.ok()) return error_response(made.status());
+                       ws.archive().log(call.actor(), "share scan", "scan", id, made->link.id);
+                       nlohmann::json out = share_json(made->link);
+                       out["token"] = made->token;
+                       out["url"] = link_base(options, call.request) + "/s/" + made->token;
+                       return json_response(201, out);
+                     }});
+  routes->push_back({"GET", "/api/scans/{id}/shares", kStaff, [](Workstation& ws, const Call& call) {
+                       auto list = ws.auth().shares(call.params.at("id"));
+                       if (!list.ok()) return error_response(list.status());
+                       nlohmann::json out = nlohmann::json::array();
+                       for (const auto& s : *list) out.push_back(share_json(s));
+                       return json_response(200, {{"shares", out}});
+                     }});
+  routes->push_back({"DELETE", "/api/shares/{id}", kStaff, [](Workstation& ws, const Call& call) {
+                       const Status st = ws.auth().revoke_share(call.params.at("id"));
+                       if (!st.ok()) return error_response(st);
+                       ws.archive().log(call.actor(), "withdraw share", "share", call.params.at("id"), "");
+                       HttpResponse out;
+                       out.status = 204;
+                       return out;
+                     }});
+  // The customer's side: the token is the only key, and it opens one scan.
+  routes->push_back({"GET", "/api/share/{token}", kShareLink, [](Workstation& ws, const Call& call) {
+                       const ShareLink& link = *call.share;
+                       auto r = ws.archive().scan(link.scan_id);
+                       if (!r.ok()) return error_response(404, "this link is not valid");
+                       auto ms = ws.archive().measurements(link.scan_id);
+                       if (!ms.ok()) return error_response(ms.status());
+                       nlohmann::json shown = nlohmann::json::array();
+                       for (const auto& m : *ms)
+                         if (std::find(link.measurements.begin(), link.measurements.end(), m.name) !=
+                             link.measurements.end()) {
+                           nlohmann::json j = measurement_json(m);
+                           j.erase("created_by");  // staff names stay in the shop
+                           j.erase("id");
+                           shown.push_back(j);
+                         }
+                       HttpResponse out = json_response(200, {{"taken_at", r->started_at},
+                                                              {"expires_at", link.expires_at},
+                                                              {"measurements", shown},
+                                                              {"mesh", "/api/share/" + call.params.at("token") + "/mesh.glb"}});
+                       out.set("Referrer-Policy", "no-referrer");
+                       return out;
+                     }});
+  routes->push_back({"GET", "/api/share/{token}/mesh.glb", kShareLink, [](Workstation& ws, const Call& call) {
+                       HttpResponse out = scan_file(ws, call.share->scan_id, "mesh.glb", "",
+                                                    call.request.header("if-none-match"));
+                       out.set("Referrer-Policy", "no-referrer");
+                       return out;
+                     }});
+}
+
+}  // namespace bodyscan::server

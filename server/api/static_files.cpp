@@ -1,0 +1,108 @@
+#include "server/api/static_files.hpp"
+
+#include <filesystem>
+#include <map>
+#include <system_error>
+
+namespace bodyscan::server {
+
+namespace fs = std::filesystem;
+
+std::string mime_type(const std::string& name) {
+  static const std::map<std::string, std::string> kTypes = {
+      {".html", "text/html; charset=utf-8"},
+      {".js", "text/javascript; charset=utf-8"},
+      {".mjs", "text/javascript; charset=utf-8"},
+      {".css", "text/css; charset=utf-8"},
+      {".json", "application/json"},
+      {".map", "application/json"},
+      {".wasm", "application/wasm"},
+      {".glb", "model/gltf-binary"},
+      {".gltf", "model/gltf+json"},
+      {".drc", "application/octet-stream"},  // Draco has no registered type
+      {".png", "image/png"},
+      {".jpg", "image/jpeg"},
+      {".svg", "image/svg+xml"},
+      {".ico", "image/x-icon"},
+      {".woff2", "font/woff2"},
+      {".txt", "text/plain; charset=utf-8"},
+      {".pdf", "application/pdf"},
+      {".csv", "text/csv; charset=utf-8"},
+      {".webmanifest", "application/manifest+json"},
+  };
+  const size_t dot = name.rfind('.');
+  if (dot == std::string::npos) return "application/octet-stream";
+  std::string ext = name.substr(dot);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  auto it = kTypes.find(ext);
+  return it == kTypes.end() ? "application/octet-stream" : it->second;
+}
+
+namespace {
+
+bool safe_segments(const std::string& path) {
+  if (path.empty() || path[0] != '/') return false;
+  size_t start = 1;
+  while (start <= path.size()) {
+    const size_t end = std::min(path.find('/', start), path.size());
+    const std::string seg = path.substr(start, end - start);
+    if (seg.empty() && end != path.size()) return false;  // "//"
+    if (seg == "." || seg == ".." || (!seg.empty() && seg[0] == '.')) return false;
+    for (char c : seg)
+      if (c == '\\' || c == '\0' || static_cast<unsigned char>(c) < 0x20) return false;
+    start = end + 1;
+  }
+  return true;
+}
+
+// `p` lies under `root` (both canonical).
+bool under(const fs::path& root, const fs::path& p) {
+  auto r = root.begin(), q = p.begin();
+  for (; r != root.end(); ++r, ++q)
+    if (q == p.end() || *r != *q) return false;
+  return true;
+}
+
+}  // namespace
+
+HttpResponse serve_static(const std::string& web_root, const HttpRequest& request) {
+  if (request.method != "GET" && request.method != "HEAD") {
+    HttpResponse r = error_response(405, "only GET and HEAD reach static files");
+    r.set("Allow", "GET, HEAD");
+    return r;
+  }
+  if (!safe_segments(request.path)) return error_response(400, "bad path");
+  std::error_code ec;
+  const fs::path root = fs::canonical(web_root, ec);
+  if (ec) return error_response(404, "the web UI is not installed (" + web_root + ")");
+  std::string rel = request.path.substr(1);
+  if (rel.empty() || rel.back() == '/') rel += "index.html";
+  fs::path file = root / rel;
+  if (!fs::is_regular_file(file, ec)) {
+    // The UI's own routes (no extension) are pages of the single-page app.
+    const std::string last = rel.substr(rel.rfind('/') == std::string::npos ? 0 : rel.rfind('/') + 1);
+    if (last.find('.') != std::string::npos) return error_response(404, "no such file: " + request.path);
+    file = root / "index.html";
+  }
+  const fs::path real = fs::canonical(file, ec);
+  if (ec || !under(root, real) || !fs::is_regular_file(real, ec)) return error_response(404, "no such file: " + request.path);
+  const auto size = fs::file_size(real, ec);
+  const auto mtime = fs::last_write_time(real, ec).time_since_epoch().count();
+  char etag[64];
+  std::snprintf(etag, sizeof etag, "\"%llx-%llx\"", static_cast<unsigned long long>(size),
+                static_cast<unsigned long long>(mtime));
+  HttpResponse r;
+  r.set("Content-Type", mime_type(real.filename().string()));
+  r.set("ETag", etag);
+  r.set("X-Content-Type-Options", "nosniff");
+  if (rel.rfind("assets/", 0) == 0) r.set("Cache-Control", "public, max-age=31536000, immutable");
+  else r.set("Cache-Control", "no-cache");
+  if (request.header("if-none-match") == etag) {
+    r.status = 304;
+    return r;
+  }
+  r.file = real.string();
+  return r;
+}
+
+}  // namespace bodyscan::server

@@ -1,0 +1,758 @@
+#include "server/auth/auth_store.hpp"
+
+#include <fcntl.h>
+#include <sodium.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <ctime>
+#include <deque>
+#include <mutex>
+#include <unordered_map>
+
+#include "storage/archive/sqlite.hpp"
+
+namespace bodyscan::server {
+
+using storage::Database;
+using storage::Statement;
+using storage::Transaction;
+
+const char* to_string(Role r) {
+  switch (r) {
+    case Role::kOperator:
+      return "operator";
+    case Role::kTailor:
+      return "tailor";
+    case Role::kAdmin:
+      return "admin";
+  }
+  return "?";
+}
+
+std::optional<Role> role_from_string(std::string_view s) {
+  if (s == "operator") return Role::kOperator;
+  if (s == "tailor") return Role::kTailor;
+  if (s == "admin") return Role::kAdmin;
+  return std::nullopt;
+}
+
+namespace {
+
+constexpr int kSchemaVersion = 1;
+constexpr size_t kSessionTokenBytes = 32;
+constexpr size_t kShareTokenBytes = 16;
+// Writing last_used on every request would mean an fsync per request
+// (synchronous=FULL); a minute's slack in the idle limit costs nothing.
+constexpr int64_t kTouchEvery = 60;
+// The limiter forgets keys whose failures have aged out only when it holds
+// this many, so guessing across many usernames or addresses cannot grow it
+// without bound, yet a quiet workstation never sweeps.
+constexpr size_t kLimiterSweepAbove = 4096;
+constexpr size_t kMaxRemoteKey = 128;
+constexpr size_t kMaxScanId = 200;
+constexpr size_t kMaxMeasurementName = 200;
+constexpr size_t kMaxMeasurements = 1000;
+
+int64_t system_now() {
+  return std::chrono::duration_cast<std::chrono::seconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string iso_utc(int64_t unix_s) {
+  const std::time_t t = static_cast<std::time_t>(unix_s);
+  std::tm utc{};
+  gmtime_r(&t, &utc);
+  char b[40];
+  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return b;
+}
+
+std::string random_hex(size_t bytes) {
+  std::vector<unsigned char> b(bytes);
+  randombytes_buf(b.data(), b.size());
+  std::string hex(bytes * 2 + 1, '\0');
+  sodium_bin2hex(hex.data(), hex.size(), b.data(), b.size());
+  hex.pop_back();
+  return hex;
+}
+
+constexpr int kBase64Url = sodium_base64_VARIANT_URLSAFE_NO_PADDING;
+
+size_t base64url_chars(size_t bytes) { return sodium_base64_ENCODED_LEN(bytes, kBase64Url) - 1; }
+
+std::string random_token(size_t bytes) {
+  std::vector<unsigned char> b(bytes);
+  randombytes_buf(b.data(), b.size());
+  std::string out(base64url_chars(bytes) + 1, '\0');
+  sodium_bin2base64(out.data(), out.size(), b.data(), b.size(), kBase64Url);
+  sodium_memzero(b.data(), b.size());
+  out.pop_back();
+  return out;
+}
+
+// Cheap to check before touching the database: anything else was never issued.
+bool well_formed_token(const std::string& token, size_t bytes) {
+  if (token.size() != base64url_chars(bytes)) return false;
+  return std::all_of(token.begin(), token.end(), [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' ||
+           c == '_';
+  });
+}
+
+// What the database keeps instead of a token. The tokens carry 128 or 256
+// random bits, so a fast unsalted hash is enough: there is nothing to guess.
+std::string token_hash(const std::string& token) {
+  unsigned char h[32];
+  crypto_generichash(h, sizeof h, reinterpret_cast<const unsigned char*>(token.data()),
+                     token.size(), nullptr, 0);
+  char hex[65];
+  sodium_bin2hex(hex, sizeof hex, h, sizeof h);
+  return hex;
+}
+
+// The row was found by an index lookup on the hash, which leaks at most how
+// much of a hash of a random secret matched; comparing again in constant time
+// keeps the final decision free of early exits all the same.
+bool same_hash(const std::string& a, const std::string& b) {
+  return a.size() == b.size() && sodium_memcmp(a.data(), b.data(), a.size()) == 0;
+}
+
+bool valid_username(const std::string& u) {
+  if (u.empty() || u.size() > AuthStore::kMaxUsername) return false;
+  return std::all_of(u.begin(), u.end(), [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' ||
+           c == '_' || c == '-';
+  });
+}
+
+Status check_username(const std::string& u) {
+  if (!valid_username(u))
+    return invalid_argument(
+        "username must be 1-64 characters of letters, digits, '.', '_' and '-'");
+  return Status::Ok();
+}
+
+// Characters, not bytes, so a passphrase in any script gets the same minimum.
+size_t utf8_chars(const std::string& s) {
+  return static_cast<size_t>(std::count_if(
+      s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+
+Status check_password(const std::string& p) {
+  if (p.size() > AuthStore::kMaxPasswordBytes)
+    return invalid_argument("password is longer than 1024 bytes");
+  if (utf8_chars(p) < AuthStore::kMinPasswordChars)
+    return invalid_argument("password must be at least 10 characters");
+  return Status::Ok();
+}
+
+// Measurement names end up on a customer's page: no control characters, no
+// byte sequences a browser or the JSON encoder would have to guess at.
+bool printable_utf8(const std::string& s) {
+  size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      if (c < 0x20 || c == 0x7f) return false;
+      ++i;
+      continue;
+    }
+    const size_t n = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 ? 2 : 0;
+    if (n == 0 || c > 0xF4 || i + n > s.size()) return false;
+    uint32_t cp = c & (0xFF >> (n + 1));
+    for (size_t k = 1; k < n; ++k) {
+      const auto cc = static_cast<unsigned char>(s[i + k]);
+      if ((cc & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (cc & 0x3F);
+    }
+    const uint32_t min = n == 2 ? 0x80 : n == 3 ? 0x800 : 0x10000;
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF) || (cp >= 0x80 && cp < 0xA0))
+      return false;
+    i += n;
+  }
+  return true;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
+// Remembers recent login failures per key. A failure is recorded before the
+// password is checked and forgiven on success, so parallel guesses cannot all
+// slip past the check before any of them is counted.
+class Limiter {
+ public:
+  Limiter(int max_failures, int64_t window_s) : max_(max_failures), window_(window_s) {}
+
+  // 0 having reserved a failure under both keys, else seconds to wait.
+  int reserve(const std::string& user_key, const std::string& addr_key, int64_t now) {
+    std::lock_guard lock(mu_);
+    if (max_ <= 0) return 0;
+    if (failures_.size() > kLimiterSweepAbove) sweep(now);
+    auto& user = failures_[user_key];
+    auto& addr = failures_[addr_key];
+    int64_t wait = 0;
+    for (auto* d : {&user, &addr}) {
+      expire(*d, now);
+      if (static_cast<int>(d->size()) >= max_) wait = std::max(wait, d->front() + window_ - now);
+    }
+    // Clamped: a clock stepped backwards must not lock anyone out for longer.
+    if (wait > 0 || static_cast<int>(user.size()) >= max_ || static_cast<int>(addr.size()) >= max_)
+      return static_cast<int>(std::clamp<int64_t>(wait, 1, window_));
+    user.push_back(now);
+    addr.push_back(now);
+    return 0;
+  }
+
+  // The reserved failure was no failure: the username starts afresh, the
+  // address keeps the failures it made before.
+  void forgive(const std::string& user_key, const std::string& addr_key, int64_t reserved_at) {
+    std::lock_guard lock(mu_);
+    failures_.erase(user_key);
+    auto it = failures_.find(addr_key);
+    if (it == failures_.end()) return;
+    auto& d = it->second;
+    auto pos = std::find(d.rbegin(), d.rend(), reserved_at);
+    if (pos != d.rend()) d.erase(std::next(pos).base());
+    if (d.empty()) failures_.erase(it);
+  }
+
+  // Not the user's fault (the store failed): the attempt does not count.
+  void release(const std::string& user_key, const std::string& addr_key, int64_t reserved_at) {
+    std::lock_guard lock(mu_);
+    for (const std::string* k : {&user_key, &addr_key}) {
+      auto it = failures_.find(*k);
+      if (it == failures_.end()) continue;
+      auto pos = std::find(it->second.rbegin(), it->second.rend(), reserved_at);
+      if (pos != it->second.rend()) it->second.erase(std::next(pos).base());
+      if (it->second.empty()) failures_.erase(it);
+    }
+  }
+
+ private:
+  void expire(std::deque<int64_t>& d, int64_t now) const {
+    while (!d.empty() && d.front() <= now - window_) d.pop_front();
+  }
+  void sweep(int64_t now) {
+    for (auto it = failures_.begin(); it != failures_.end();) {
+      expire(it->second, now);
+      it = it->second.empty() ? failures_.erase(it) : std::next(it);
+    }
+  }
+
+  const int max_;
+  const int64_t window_;
+  std::mutex mu_;
+  std::unordered_map<std::string, std::deque<int64_t>> failures_;
+};
+
+}  // namespace
+
+struct AuthStore::Impl {
+  mutable Database db;  // const queries prepare statements too
+  mutable std::mutex mu;
+  AuthOptions options;
+  std::string dummy_hash;  // what unknown users are verified against
+  Limiter limiter;
+
+  Impl(Database d, AuthOptions o)
+      : db(std::move(d)),
+        options(std::move(o)),
+        limiter(options.max_failures, options.failure_window_s) {}
+
+  int64_t now() const { return options.now ? options.now() : system_now(); }
+
+  Status schema() {
+    RETURN_IF_ERROR(
+        db.exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON; PRAGMA "
+                "secure_delete=ON;"
+                "PRAGMA busy_timeout=5000;"));
+    RETURN_IF_ERROR(db.exec(R"sql(
+      CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);
+      CREATE TABLE IF NOT EXISTS accounts(
+        username TEXT PRIMARY KEY COLLATE NOCASE,
+        password_hash TEXT NOT NULL,
+        role TEXT NOT NULL CHECK (role IN ('operator', 'tailor', 'admin')),
+        created_at TEXT NOT NULL);
+      CREATE TABLE IF NOT EXISTS sessions(
+        token_hash TEXT PRIMARY KEY,
+        username TEXT NOT NULL COLLATE NOCASE REFERENCES accounts(username) ON DELETE CASCADE,
+        csrf_token TEXT NOT NULL,
+        created_at INTEGER NOT NULL,
+        last_used INTEGER NOT NULL,
+        expires_at INTEGER NOT NULL);
+      CREATE INDEX IF NOT EXISTS sessions_by_user ON sessions(username);
+      CREATE TABLE IF NOT EXISTS shares(
+        id TEXT PRIMARY KEY,
+        token_hash TEXT NOT NULL UNIQUE,
+        scan_id TEXT NOT NULL,
+        measurements TEXT NOT NULL,
+        created_by TEXT NOT NULL,
+        created_at TEXT NOT NULL,
+        created_at_s INTEGER NOT NULL,
+        expires_at INTEGER NOT NULL,
+        revoked INTEGER NOT NULL DEFAULT 0);
+      CREATE INDEX IF NOT EXISTS shares_by_scan ON shares(scan_id);
+    )sql"));
+    ASSIGN_OR_RETURN(
+        Statement ins,
+        db.prepare("INSERT OR IGNORE INTO meta(key, value) VALUES ('schema_version', ?)"));
+    RETURN_IF_ERROR(ins.bind(1, std::to_string(kSchemaVersion)).run());
+    ASSIGN_OR_RETURN(Statement st,
+                     db.prepare("SELECT value FROM meta WHERE key = 'schema_version'"));
+    ASSIGN_OR_RETURN(bool row, st.step());
+    if (!row || std::atoi(st.text(0).c_str()) > kSchemaVersion)
+      return failed_precondition("accounts database: made by a newer bodyscan; update this one");
+    return Status::Ok();
+  }
+
+  unsigned long long opslimit() const {
+    return options.opslimit ? options.opslimit : crypto_pwhash_OPSLIMIT_INTERACTIVE;
+  }
+  size_t memlimit() const {
+    return static_cast<size_t>(options.memlimit ? options.memlimit
+                                                : crypto_pwhash_MEMLIMIT_INTERACTIVE);
+  }
+
+  StatusOr<std::string> hash_password(const std::string& password) const {
+    char out[crypto_pwhash_STRBYTES];
+    if (crypto_pwhash_str_alg(out, password.data(), password.size(), opslimit(), memlimit(),
+                              crypto_pwhash_ALG_ARGON2ID13) != 0)
+      return unavailable("accounts: not enough memory to hash the password");
+    return std::string(out);
+  }
+
+  // mu held.
+  struct Stored {
+    std::string username, hash;
+    Role role;
+  };
+  StatusOr<std::optional<Stored>> find_account(const std::string& username) const {
+    ASSIGN_OR_RETURN(
+        Statement st,
+        db.prepare("SELECT username, password_hash, role FROM accounts WHERE username = ?"));
+    st.bind(1, username);
+    ASSIGN_OR_RETURN(bool row, st.step());
+    if (!row) return std::optional<Stored>();
+    const auto role = role_from_string(st.text(2));
+    if (!role) return internal_error("accounts: account '" + st.text(0) + "' has an unknown role");
+    return std::optional<Stored>(Stored{st.text(0), st.text(1), *role});
+  }
+
+  StatusOr<int64_t> admin_count() const {
+    ASSIGN_OR_RETURN(Statement st,
+                     db.prepare("SELECT COUNT(*) FROM accounts WHERE role = 'admin'"));
+    ASSIGN_OR_RETURN(bool row, st.step());
+    return row ? st.integer(0) : int64_t{0};
+  }
+
+  Status delete_sessions_of(const std::string& username) {
+    ASSIGN_OR_RETURN(Statement st, db.prepare("DELETE FROM sessions WHERE username = ?"));
+    return st.bind(1, username).run();
+  }
+
+  // A session for `stored`, provided its password is still the one just
+  // verified: a password change while the hash ran must not be outlived.
+  StatusOr<std::optional<LoginResult>> create_session(const Stored& stored, int64_t now) {
+    ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(db));
+    ASSIGN_OR_RETURN(auto current, find_account(stored.username));
+    if (!current || !same_hash(current->hash, stored.hash)) return std::optional<LoginResult>();
+    ASSIGN_OR_RETURN(Statement purge,
+                     db.prepare("DELETE FROM sessions WHERE expires_at <= ? OR last_used <= ?"));
+    RETURN_IF_ERROR(purge.bind(1, now).bind(2, now - options.session_idle_s).run());
+    LoginResult r;
+    r.outcome = LoginResult::kOk;
+    r.token = random_token(kSessionTokenBytes);
+    r.session.username = current->username;
+    r.session.role = current->role;
+    r.session.csrf_token = random_token(kSessionTokenBytes);
+    const int64_t expires = now + options.session_lifetime_s;
+    r.session.expires_at = std::min(expires, now + options.session_idle_s);
+    ASSIGN_OR_RETURN(
+        Statement ins,
+        db.prepare("INSERT INTO sessions(token_hash, username, csrf_token, created_at, "
+                   "last_used, expires_at) VALUES (?, ?, ?, ?, ?, ?)"));
+    ins.bind(1, token_hash(r.token)).bind(2, current->username).bind(3, r.session.csrf_token);
+    RETURN_IF_ERROR(ins.bind(4, now).bind(5, now).bind(6, expires).run());
+    RETURN_IF_ERROR(tx.commit());
+    return std::optional<LoginResult>(std::move(r));
+  }
+
+  StatusOr<std::optional<Session>> find_session(const std::string& hash, int64_t now) {
+    ASSIGN_OR_RETURN(Statement st,
+                     db.prepare("SELECT s.token_hash, s.csrf_token, s.last_used, s.expires_at, "
+                                "a.username, a.role FROM sessions s JOIN accounts a "
+                                "ON a.username = s.username WHERE s.token_hash = ?"));
+    st.bind(1, hash);
+    ASSIGN_OR_RETURN(bool row, st.step());
+    if (!row || !same_hash(st.text(0), hash)) return std::optional<Session>();
+    const int64_t last_used = st.integer(2), expires = st.integer(3);
+    const auto role = role_from_string(st.text(5));
+    if (!role || now >= expires || now >= last_used + options.session_idle_s) {
+      ASSIGN_OR_RETURN(Statement del, db.prepare("DELETE FROM sessions WHERE token_hash = ?"));
+      RETURN_IF_ERROR(del.bind(1, hash).run());
+      return std::optional<Session>();
+    }
+    Session s;
+    s.username = st.text(4);
+    s.role = *role;
+    s.csrf_token = st.text(1);
+    int64_t used = last_used;
+    if (now - last_used >= kTouchEvery) {
+      ASSIGN_OR_RETURN(Statement touch,
+                       db.prepare("UPDATE sessions SET last_used = ? WHERE token_hash = ?"));
+      // The session is valid either way; a failed refresh only shortens it.
+      if (touch.bind(1, now).bind(2, hash).run().ok()) used = now;
+    }
+    s.expires_at = std::min(expires, used + options.session_idle_s);
+    return std::optional<Session>(std::move(s));
+  }
+
+  static StatusOr<ShareLink> read_share(const Statement& st) {
+    // Columns: id, scan_id, measurements, created_by, created_at, expires_at, revoked.
+    ShareLink l;
+    l.id = st.text(0), l.scan_id = st.text(1), l.created_by = st.text(3), l.created_at = st.text(4);
+    l.expires_at = st.integer(5);
+    l.revoked = st.integer(6) != 0;
+    const auto j = nlohmann::json::parse(st.text(2), nullptr, /*allow_exceptions=*/false);
+    if (!j.is_array())
+      return internal_error("accounts: share " + l.id + " has damaged measurements");
+    for (const auto& m : j) {
+      if (!m.is_string())
+        return internal_error("accounts: share " + l.id + " has damaged measurements");
+      l.measurements.push_back(m.get<std::string>());
+    }
+    return l;
+  }
+};
+
+AuthStore::AuthStore(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+AuthStore::~AuthStore() = default;
+
+StatusOr<std::unique_ptr<AuthStore>> AuthStore::open(const std::string& db_path,
+                                                     AuthOptions options) {
+  if (sodium_init() < 0) return internal_error("accounts: libsodium failed to start");
+  if (options.session_lifetime_s <= 0 || options.session_idle_s <= 0 ||
+      options.failure_window_s <= 0)
+    return invalid_argument("accounts: session lifetimes and the failure window must be positive");
+  // Password hashes are nobody else's business: create the file (and so, as
+  // SQLite copies its mode, the WAL beside it) readable by its owner only.
+  if (!db_path.empty() && db_path != ":memory:") {
+    const int fd = ::open(db_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+    if (fd < 0) return io_error("accounts: cannot open " + db_path + ": " + std::strerror(errno));
+    ::close(fd);
+  }
+  ASSIGN_OR_RETURN(Database db, Database::open(db_path));
+  auto impl = std::make_unique<Impl>(std::move(db), std::move(options));
+  RETURN_IF_ERROR(impl->schema().with_context(db_path));
+  ASSIGN_OR_RETURN(impl->dummy_hash, impl->hash_password(random_hex(32)));
+  return std::unique_ptr<AuthStore>(new AuthStore(std::move(impl)));
+}
+
+// --- accounts ------------------------------------------------------------------
+
+StatusOr<Account> AuthStore::add_account(const std::string& username, const std::string& password,
+                                         Role role) {
+  RETURN_IF_ERROR(check_username(username));
+  RETURN_IF_ERROR(check_password(password));
+  {
+    std::lock_guard lock(impl_->mu);
+    ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
+    if (existing)
+      return failed_precondition("an account named '" + existing->username + "' already exists");
+  }
+  ASSIGN_OR_RETURN(std::string hash, impl_->hash_password(password));
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+  // Again: another thread may have added the name while the hash ran.
+  ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
+  if (existing)
+    return failed_precondition("an account named '" + existing->username + "' already exists");
+  Account a{username, role, iso_utc(impl_->now())};
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare(
+          "INSERT INTO accounts(username, password_hash, role, created_at) VALUES (?, ?, ?, ?)"));
+  RETURN_IF_ERROR(
+      st.bind(1, a.username).bind(2, hash).bind(3, to_string(role)).bind(4, a.created_at).run());
+  RETURN_IF_ERROR(tx.commit());
+  return a;
+}
+
+Status AuthStore::set_password(const std::string& username, const std::string& password) {
+  RETURN_IF_ERROR(check_password(password));
+  {
+    std::lock_guard lock(impl_->mu);
+    ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
+    if (!existing) return not_found("no account named '" + username + "'");
+  }
+  ASSIGN_OR_RETURN(std::string hash, impl_->hash_password(password));
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("UPDATE accounts SET password_hash = ? WHERE username = ?"));
+  RETURN_IF_ERROR(st.bind(1, hash).bind(2, username).run());
+  if (sqlite3_changes(impl_->db.handle()) == 0)
+    return not_found("no account named '" + username + "'");
+  RETURN_IF_ERROR(impl_->delete_sessions_of(username));
+  return tx.commit();
+}
+
+Status AuthStore::set_role(const std::string& username, Role role) {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+  ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
+  if (!existing) return not_found("no account named '" + username + "'");
+  if (existing->role == role) return Status::Ok();
+  if (existing->role == Role::kAdmin) {
+    ASSIGN_OR_RETURN(int64_t admins, impl_->admin_count());
+    if (admins <= 1)
+      return failed_precondition("'" + existing->username +
+                                 "' is the last admin; make another admin first");
+  }
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("UPDATE accounts SET role = ? WHERE username = ?"));
+  RETURN_IF_ERROR(st.bind(1, to_string(role)).bind(2, username).run());
+  return tx.commit();
+}
+
+Status AuthStore::delete_account(const std::string& username) {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+  ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
+  if (!existing) return not_found("no account named '" + username + "'");
+  if (existing->role == Role::kAdmin) {
+    ASSIGN_OR_RETURN(int64_t admins, impl_->admin_count());
+    if (admins <= 1)
+      return failed_precondition("'" + existing->username +
+                                 "' is the last admin; make another admin first");
+  }
+  // Sessions go with it (ON DELETE CASCADE); said explicitly so it does not
+  // hang on a pragma.
+  RETURN_IF_ERROR(impl_->delete_sessions_of(username));
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("DELETE FROM accounts WHERE username = ?"));
+  RETURN_IF_ERROR(st.bind(1, username).run());
+  return tx.commit();
+}
+
+StatusOr<Account> AuthStore::account(const std::string& username) const {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare("SELECT username, role, created_at FROM accounts WHERE username = ?"));
+  st.bind(1, username);
+  ASSIGN_OR_RETURN(bool row, st.step());
+  if (!row) return not_found("no account named '" + username + "'");
+  const auto role = role_from_string(st.text(1));
+  if (!role) return internal_error("accounts: account '" + st.text(0) + "' has an unknown role");
+  return Account{st.text(0), *role, st.text(2)};
+}
+
+StatusOr<std::vector<Account>> AuthStore::accounts() const {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare("SELECT username, role, created_at FROM accounts ORDER BY username"));
+  std::vector<Account> out;
+  for (;;) {
+    ASSIGN_OR_RETURN(bool row, st.step());
+    if (!row) break;
+    const auto role = role_from_string(st.text(1));
+    if (!role) return internal_error("accounts: account '" + st.text(0) + "' has an unknown role");
+    out.push_back({st.text(0), *role, st.text(2)});
+  }
+  return out;
+}
+
+bool AuthStore::has_admin() const {
+  std::lock_guard lock(impl_->mu);
+  const auto n = impl_->admin_count();
+  return n.ok() && *n > 0;
+}
+
+// --- sessions ------------------------------------------------------------------
+
+LoginResult AuthStore::login(const std::string& username, const std::string& password,
+                             const std::string& remote_address) {
+  LoginResult r;
+  const int64_t now = impl_->now();
+  // Bounded keys: an absurd username or address is still one key, not a megabyte.
+  const std::string user_key = "u:" + lower(username.substr(0, kMaxUsername + 1));
+  const std::string addr_key = "a:" + remote_address.substr(0, kMaxRemoteKey);
+  if (const int wait = impl_->limiter.reserve(user_key, addr_key, now)) {
+    r.outcome = LoginResult::kRateLimited;
+    r.retry_after_s = wait;
+    return r;
+  }
+  auto fail = [&](Status s) {
+    impl_->limiter.release(user_key, addr_key, now);
+    r.outcome = LoginResult::kError;
+    r.error = std::move(s);
+    return r;
+  };
+
+  std::optional<Impl::Stored> stored;
+  if (valid_username(username)) {
+    std::lock_guard lock(impl_->mu);
+    auto found = impl_->find_account(username);
+    if (!found.ok()) return fail(found.status());
+    stored = std::move(*found);
+  }
+  // No password that long was ever accepted, and refusing early bounds the
+  // work an anonymous request can cause.
+  if (password.size() > kMaxPasswordBytes) return r;
+  const std::string& hash = stored ? stored->hash : impl_->dummy_hash;
+  const bool match = crypto_pwhash_str_verify(hash.c_str(), password.data(), password.size()) == 0;
+  if (!match || !stored) return r;
+
+  std::optional<LoginResult> ok;
+  {
+    std::lock_guard lock(impl_->mu);
+    auto created = impl_->create_session(*stored, now);
+    if (!created.ok()) return fail(created.status());
+    ok = std::move(*created);
+  }
+  if (!ok) return r;  // the password changed (or the account went) while verifying
+  impl_->limiter.forgive(user_key, addr_key, now);
+
+  // Accounts made under weaker settings get the current cost now that the
+  // password is at hand; failing to is no reason to refuse the login.
+  if (crypto_pwhash_str_needs_rehash(stored->hash.c_str(), impl_->opslimit(), impl_->memlimit()) !=
+      0) {
+    if (auto rehashed = impl_->hash_password(password); rehashed.ok()) {
+      std::lock_guard lock(impl_->mu);
+      auto st = impl_->db.prepare(
+          "UPDATE accounts SET password_hash = ? WHERE username = ? AND password_hash = ?");
+      if (st.ok())
+        (void)st->bind(1, *rehashed).bind(2, stored->username).bind(3, stored->hash).run();
+    }
+  }
+  return std::move(*ok);
+}
+
+std::optional<Session> AuthStore::session(const std::string& token) {
+  if (!well_formed_token(token, kSessionTokenBytes)) return std::nullopt;
+  const std::string hash = token_hash(token);
+  const int64_t now = impl_->now();
+  std::lock_guard lock(impl_->mu);
+  auto s = impl_->find_session(hash, now);
+  // A store that cannot answer lets no one in.
+  if (!s.ok()) return std::nullopt;
+  return std::move(*s);
+}
+
+void AuthStore::logout(const std::string& token) {
+  if (!well_formed_token(token, kSessionTokenBytes)) return;
+  const std::string hash = token_hash(token);
+  std::lock_guard lock(impl_->mu);
+  auto st = impl_->db.prepare("DELETE FROM sessions WHERE token_hash = ?");
+  if (st.ok()) (void)st->bind(1, hash).run();
+}
+
+Status AuthStore::end_sessions(const std::string& username) {
+  std::lock_guard lock(impl_->mu);
+  return impl_->delete_sessions_of(username);
+}
+
+// --- share links ---------------------------------------------------------------
+
+StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id,
+                                           const std::vector<std::string>& measurements,
+                                           int64_t valid_for_s, const std::string& created_by) {
+  if (scan_id.empty() || scan_id.size() > kMaxScanId) return invalid_argument("share: bad scan id");
+  if (valid_for_s <= 0 || valid_for_s > kMaxShareValidity)
+    return invalid_argument("share: validity must be more than 0 seconds and at most 365 days");
+  if (measurements.size() > kMaxMeasurements)
+    return invalid_argument("share: too many measurements");
+  nlohmann::json names = nlohmann::json::array();
+  for (const auto& m : measurements) {
+    if (m.empty() || m.size() > kMaxMeasurementName || !printable_utf8(m))
+      return invalid_argument("share: measurement names must be 1-200 bytes of printable UTF-8");
+    names.push_back(m);
+  }
+  const std::string names_json = names.dump();  // cannot throw: the names are valid UTF-8
+
+  const int64_t now = impl_->now();
+  NewShare out;
+  out.token = random_token(kShareTokenBytes);
+  ShareLink& l = out.link;
+  l.id = "sh_" + random_hex(8);
+  l.scan_id = scan_id;
+  l.measurements = measurements;
+  l.created_by = created_by;
+  l.created_at = iso_utc(now);
+  l.expires_at = now + valid_for_s;
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare("INSERT INTO shares(id, token_hash, scan_id, measurements, created_by, "
+                        "created_at, created_at_s, expires_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?)"));
+  st.bind(1, l.id)
+      .bind(2, token_hash(out.token))
+      .bind(3, l.scan_id)
+      .bind(4, names_json)
+      .bind(5, l.created_by);
+  RETURN_IF_ERROR(st.bind(6, l.created_at).bind(7, now).bind(8, l.expires_at).run());
+  return out;
+}
+
+std::optional<ShareLink> AuthStore::share_by_token(const std::string& token) {
+  if (!well_formed_token(token, kShareTokenBytes)) return std::nullopt;
+  const std::string hash = token_hash(token);
+  const int64_t now = impl_->now();
+  std::lock_guard lock(impl_->mu);
+  auto st = impl_->db.prepare(
+      "SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked, token_hash "
+      "FROM shares WHERE token_hash = ?");
+  if (!st.ok()) return std::nullopt;
+  st->bind(1, hash);
+  const auto row = st->step();
+  if (!row.ok() || !*row || !same_hash(st->text(7), hash)) return std::nullopt;
+  auto link = Impl::read_share(*st);
+  if (!link.ok() || link->revoked || now >= link->expires_at) return std::nullopt;
+  return std::move(*link);
+}
+
+StatusOr<std::vector<ShareLink>> AuthStore::shares(const std::string& scan_id) const {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare(
+          "SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked "
+          "FROM shares WHERE scan_id = ? ORDER BY created_at_s, rowid"));
+  st.bind(1, scan_id);
+  std::vector<ShareLink> out;
+  for (;;) {
+    ASSIGN_OR_RETURN(bool row, st.step());
+    if (!row) break;
+    ASSIGN_OR_RETURN(ShareLink l, Impl::read_share(st));
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+Status AuthStore::revoke_share(const std::string& share_id) {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("UPDATE shares SET revoked = 1 WHERE id = ?"));
+  RETURN_IF_ERROR(st.bind(1, share_id).run());
+  if (sqlite3_changes(impl_->db.handle()) == 0)
+    return not_found("no share link '" + share_id + "'");
+  return Status::Ok();
+}
+
+Status AuthStore::delete_shares_of_scan(const std::string& scan_id) {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("DELETE FROM shares WHERE scan_id = ?"));
+  return st.bind(1, scan_id).run();
+}
+
+}  // namespace bodyscan::server

@@ -1,0 +1,439 @@
+// After Beast's advanced server examples: one class per role in a connection's
+// life (listener, HTTP session, WebSocket session), each async step a named
+// do_x/on_x pair, one fail() that ignores normal shutdown, a queue in front of
+// every WebSocket write.
+#include "server/net/http_server.hpp"
+
+#include <boost/asio/dispatch.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/ssl.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/asio/thread_pool.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/ssl.hpp>
+#include <boost/beast/websocket.hpp>
+#include <boost/version.hpp>
+
+#include <algorithm>
+#include <deque>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <vector>
+
+static_assert(BOOST_VERSION >= 108100, "Beast's message_generator needs Boost 1.81 (libboost1.81-dev)");
+
+namespace bodyscan::server {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace ssl = asio::ssl;
+using tcp = asio::ip::tcp;
+
+namespace {
+
+// Normal ends of a connection are not worth a line in the log.
+void fail(beast::error_code ec, const char* what) {
+  if (ec == asio::error::operation_aborted || ec == websocket::error::closed || ec == asio::error::eof ||
+      ec == beast::error::timeout || ec == asio::ssl::error::stream_truncated || ec == http::error::end_of_stream ||
+      ec == asio::error::connection_reset || ec == asio::error::broken_pipe)
+    return;
+  std::fprintf(stderr, "bodyscan serve: %s: %s\n", what, ec.message().c_str());
+}
+
+}  // namespace
+
+class EventSessionBase {
+ public:
+  virtual ~EventSessionBase() = default;
+  virtual void close() = 0;
+};
+
+// What every session shares: the API, the pool, the limits, the live WebSockets.
+struct Shared {
+  Api& api;
+  Workstation& ws;
+  NetOptions options;
+  asio::thread_pool workers;
+  std::mutex mutex;
+  std::set<std::weak_ptr<EventSessionBase>, std::owner_less<std::weak_ptr<EventSessionBase>>> event_sessions;
+  bool stopping = false;
+
+  Shared(Api& a, Workstation& w, const NetOptions& o) : api(a), ws(w), options(o), workers(std::max(1, o.workers)) {}
+};
+
+namespace {
+
+HttpRequest to_request(const http::request<http::string_body>& req, const std::string& remote, bool secure,
+                       bool* ok) {
+  HttpRequest r;
+  r.method = std::string(req.method_string());
+  r.target = std::string(req.target());
+  for (const auto& f : req) {
+    std::string name(f.name_string());
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+    r.headers[name] = std::string(f.value());
+  }
+  r.body = req.body();
+  r.remote_address = remote;
+  r.secure = secure;
+  *ok = parse_target(r.target, &r.path, &r.query);
+  return r;
+}
+
+template <class Body>
+void apply(const HttpResponse& r, unsigned version, bool keep_alive, http::response<Body>* res) {
+  res->version(version);
+  res->result(static_cast<unsigned>(r.status));
+  res->set(http::field::server, "bodyscan");
+  res->set("X-Content-Type-Options", "nosniff");
+  res->set("Referrer-Policy", "same-origin");
+  res->set("X-Frame-Options", "DENY");
+  for (const auto& [k, v] : r.headers) res->set(k, v);
+  res->keep_alive(keep_alive);
+}
+
+http::message_generator make_message(HttpResponse r, unsigned version, bool keep_alive, bool head) {
+  if (!r.file.empty()) {
+    beast::error_code ec;
+    http::file_body::value_type body;
+    body.open(r.file.c_str(), beast::file_mode::scan, ec);
+    if (ec) {
+      r = error_response(500, "could not read " + r.file + ": " + ec.message());
+    } else if (head) {
+      http::response<http::empty_body> res;
+      apply(r, version, keep_alive, &res);
+      res.content_length(body.size());
+      return res;
+    } else {
+      http::response<http::file_body> res{std::piecewise_construct, std::make_tuple(std::move(body))};
+      apply(r, version, keep_alive, &res);
+      res.prepare_payload();
+      return res;
+    }
+  }
+  http::response<http::string_body> res;
+  apply(r, version, keep_alive, &res);
+  const size_t size = r.body.size();
+  if (!head) res.body() = std::move(r.body);
+  res.prepare_payload();
+  if (head) res.content_length(size);
+  return res;
+}
+
+bool is_preview(const std::string& event) { return event.find("\"type\":\"preview\"") != std::string::npos; }
+
+}  // namespace
+
+template <class Stream>
+class EventSession : public EventSessionBase, public std::enable_shared_from_this<EventSession<Stream>> {
+ public:
+  EventSession(Stream&& stream, Shared& shared) : ws_(std::move(stream)), shared_(shared) {}
+  ~EventSession() override {
+    if (sink_) shared_.ws.unsubscribe(sink_);
+  }
+
+  void run(http::request<http::string_body> req, std::string hello) {
+    hello_ = std::move(hello);
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.set_option(websocket::stream_base::decorator(
+        [](websocket::response_type& res) { res.set(http::field::server, "bodyscan"); }));
+    ws_.read_message_max(4096);  // clients only ever send small control messages
+    ws_.async_accept(req, beast::bind_front_handler(&EventSession::on_accept, this->shared_from_this()));
+  }
+
+  // From any thread: queue an event for this client.
+  void send(std::shared_ptr<const std::string> event) {
+    asio::post(ws_.get_executor(), [self = this->shared_from_this(), event]() { self->on_send(event); });
+  }
+
+  void close() override {
+    asio::post(ws_.get_executor(), [self = this->shared_from_this()]() {
+      if (self->closed_) return;
+      self->closed_ = true;
+      self->ws_.async_close(websocket::close_code::going_away, [self](beast::error_code) {});
+    });
+  }
+
+ private:
+  void on_accept(beast::error_code ec) {
+    if (ec) return fail(ec, "websocket accept");
+    {
+      std::lock_guard lock(shared_.mutex);
+      if (shared_.stopping) return;
+      shared_.event_sessions.insert(this->shared_from_this());
+    }
+    std::weak_ptr<EventSession> weak = this->shared_from_this();
+    sink_ = shared_.ws.subscribe([weak](std::shared_ptr<const std::string> event) {
+      if (auto self = weak.lock()) self->send(std::move(event));
+    });
+    on_send(std::make_shared<const std::string>(std::move(hello_)));
+    do_read();
+  }
+
+  void do_read() {
+    ws_.async_read(buffer_, beast::bind_front_handler(&EventSession::on_read, this->shared_from_this()));
+  }
+  void on_read(beast::error_code ec, size_t) {
+    if (ec) {
+      closed_ = true;
+      return fail(ec, "websocket read");
+    }
+    buffer_.consume(buffer_.size());  // nothing clients say changes anything
+    do_read();
+  }
+
+  void on_send(std::shared_ptr<const std::string> event) {
+    if (closed_) return;
+    if (queue_.size() >= shared_.options.ws_queue_limit) {
+      // Too far behind to catch up: drop the client, not the server's pace.
+      closed_ = true;
+      beast::get_lowest_layer(ws_).cancel();
+      return;
+    }
+    if (queue_.size() >= shared_.options.ws_preview_limit && is_preview(*event)) return;
+    queue_.push_back(std::move(event));
+    if (queue_.size() > 1) return;  // a write is under way
+    do_write();
+  }
+  void do_write() {
+    ws_.text(true);
+    ws_.async_write(asio::buffer(*queue_.front()),
+                    beast::bind_front_handler(&EventSession::on_write, this->shared_from_this()));
+  }
+  void on_write(beast::error_code ec, size_t) {
+    if (ec) {
+      closed_ = true;
+      return fail(ec, "websocket write");
+    }
+    queue_.pop_front();
+    if (!queue_.empty() && !closed_) do_write();
+  }
+
+  websocket::stream<Stream> ws_;
+  Shared& shared_;
+  beast::flat_buffer buffer_;
+  std::deque<std::shared_ptr<const std::string>> queue_;
+  std::string hello_;
+  int sink_ = 0;
+  bool closed_ = false;
+};
+
+template <class Stream>
+class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
+  static constexpr bool kTls = !std::is_same_v<Stream, beast::tcp_stream>;
+
+ public:
+  template <class... Args>
+  HttpSession(Shared& shared, std::string remote, Args&&... args)
+      : stream_(std::forward<Args>(args)...), shared_(shared), remote_(std::move(remote)) {}
+
+  void run() { asio::dispatch(stream_.get_executor(), beast::bind_front_handler(&HttpSession::on_run, this->shared_from_this())); }
+
+ private:
+  beast::tcp_stream& tcp() { return beast::get_lowest_layer(stream_); }
+
+  void on_run() {
+    if constexpr (kTls) {
+      tcp().expires_after(shared_.options.timeout);
+      stream_.async_handshake(ssl::stream_base::server,
+                              beast::bind_front_handler(&HttpSession::on_handshake, this->shared_from_this()));
+    } else {
+      do_read();
+    }
+  }
+  void on_handshake(beast::error_code ec) {
+    if (ec) return fail(ec, "tls handshake");
+    do_read();
+  }
+
+  void do_read() {
+    parser_.emplace();
+    parser_->header_limit(static_cast<std::uint32_t>(shared_.options.header_limit));
+    parser_->body_limit(shared_.options.body_limit);
+    tcp().expires_after(shared_.options.timeout);
+    http::async_read(stream_, buffer_, *parser_, beast::bind_front_handler(&HttpSession::on_read, this->shared_from_this()));
+  }
+
+  void on_read(beast::error_code ec, size_t) {
+    if (ec == http::error::end_of_stream) return do_close();
+    if (ec == http::error::body_limit) return reply_and_close(413, "the request body is too large");
+    if (ec == http::error::header_limit) return reply_and_close(431, "the request headers are too large");
+    if (ec == http::error::bad_method || ec == http::error::bad_target || ec == http::error::bad_version ||
+        ec == http::error::bad_field || ec == http::error::bad_value || ec == http::error::bad_chunk ||
+        ec == http::error::bad_content_length || ec == http::error::bad_line_ending ||
+        ec == http::error::bad_obs_fold || ec == http::error::bad_transfer_encoding)
+      return reply_and_close(400, "malformed request: " + ec.message());
+    if (ec) return fail(ec, "read");
+    http::request<http::string_body> req = parser_->release();
+    bool ok = false;
+    HttpRequest request = to_request(req, remote_, kTls, &ok);
+    if (!ok) return reply_and_close(400, "malformed request target");
+    if (websocket::is_upgrade(req)) {
+      if (request.path != "/api/events") return reply_and_close(404, "WebSockets live at /api/events");
+      // The session check reads the accounts database: on the pool, like all work.
+      asio::post(shared_.workers, [self = this->shared_from_this(), req = std::move(req), request]() mutable {
+        std::optional<HttpResponse> refused = self->shared_.api.refuse_events(request);
+        std::string hello;
+        if (!refused) hello = nlohmann::json{{"type", "hello"}, {"rig", self->shared_.ws.rig_status()}}.dump();
+        asio::post(self->stream_.get_executor(), [self, req = std::move(req), refused = std::move(refused),
+                                                  hello = std::move(hello)]() mutable {
+          if (refused) return self->send(make_message(std::move(*refused), req.version(), false, false), false);
+          self->tcp().expires_never();
+          auto session = std::make_shared<EventSession<Stream>>(std::move(self->stream_), self->shared_);
+          session->run(std::move(req), std::move(hello));
+        });
+      });
+      return;
+    }
+    const unsigned version = req.version();
+    const bool keep_alive = req.keep_alive();
+    const bool head = req.method() == http::verb::head;
+    // The work happens off the network thread; the answer comes back to this
+    // session's strand.
+    asio::post(shared_.workers, [self = this->shared_from_this(), request = std::move(request), version, keep_alive, head]() {
+      HttpResponse response;
+      try {
+        response = self->shared_.api.handle(request);
+      } catch (const std::exception& e) {
+        response = error_response(500, std::string("internal error: ") + e.what());
+      }
+      asio::post(self->stream_.get_executor(), [self, response = std::move(response), version, keep_alive, head]() mutable {
+        self->send(make_message(std::move(response), version, keep_alive, head), keep_alive);
+      });
+    });
+  }
+
+  void reply_and_close(int status, const std::string& message) {
+    send(make_message(error_response(status, message), 11, false, false), false);
+  }
+
+  void send(http::message_generator msg, bool keep_alive) {
+    tcp().expires_after(shared_.options.timeout);
+    beast::async_write(stream_, std::move(msg),
+                       beast::bind_front_handler(&HttpSession::on_write, this->shared_from_this(), keep_alive));
+  }
+
+  void on_write(bool keep_alive, beast::error_code ec, size_t) {
+    // A client that goes away mid-download ends here, its file closed with it.
+    if (ec) return fail(ec, "write");
+    if (!keep_alive) return do_close();
+    do_read();
+  }
+
+  void do_close() {
+    if constexpr (kTls) {
+      tcp().expires_after(std::chrono::seconds(5));
+      stream_.async_shutdown([self = this->shared_from_this()](beast::error_code) {});
+    } else {
+      beast::error_code ec;
+      stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+    }
+  }
+
+  Stream stream_;
+  Shared& shared_;
+  std::string remote_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+};
+
+struct HttpServer::Impl {
+  asio::io_context ioc;
+  std::optional<ssl::context> tls;
+  tcp::acceptor acceptor{ioc};
+  std::unique_ptr<Shared> shared;
+  std::vector<std::thread> threads;
+  uint16_t port = 0;
+  bool stopped = false;
+
+  void do_accept() {
+    acceptor.async_accept(asio::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
+      if (ec) {
+        if (ec != asio::error::operation_aborted) fail(ec, "accept");
+        if (!acceptor.is_open()) return;
+      } else {
+        beast::error_code e2;
+        const auto ep = socket.remote_endpoint(e2);
+        std::string remote = e2 ? "?" : ep.address().to_string();
+        if (tls)
+          std::make_shared<HttpSession<beast::ssl_stream<beast::tcp_stream>>>(*shared, std::move(remote),
+                                                                               std::move(socket), *tls)
+              ->run();
+        else
+          std::make_shared<HttpSession<beast::tcp_stream>>(*shared, std::move(remote), std::move(socket))->run();
+      }
+      do_accept();
+    });
+  }
+};
+
+HttpServer::HttpServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+HttpServer::~HttpServer() { stop(); }
+
+StatusOr<std::unique_ptr<HttpServer>> HttpServer::start(Api& api, Workstation& ws, const NetOptions& options) {
+  auto impl = std::make_unique<Impl>();
+  if (options.tls_cert.empty() != options.tls_key.empty())
+    return invalid_argument("TLS needs both a certificate and its key");
+  if (!options.tls_cert.empty()) {
+    impl->tls.emplace(ssl::context::tls_server);
+    beast::error_code ec;
+    impl->tls->set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 | ssl::context::no_sslv3 |
+                               ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1 | ssl::context::single_dh_use,
+                           ec);
+    impl->tls->use_certificate_chain_file(options.tls_cert, ec);
+    if (ec) return invalid_argument(options.tls_cert + ": not a usable PEM certificate: " + ec.message());
+    impl->tls->use_private_key_file(options.tls_key, ssl::context::pem, ec);
+    if (ec) return invalid_argument(options.tls_key + ": not a usable PEM key for the certificate: " + ec.message());
+  }
+  beast::error_code ec;
+  const auto address = asio::ip::make_address(options.address, ec);
+  if (ec) return invalid_argument("'" + options.address + "' is not an IP address");
+  const tcp::endpoint endpoint(address, options.port);
+  impl->acceptor.open(endpoint.protocol(), ec);
+  if (!ec) impl->acceptor.set_option(asio::socket_base::reuse_address(true), ec);
+  if (!ec) impl->acceptor.bind(endpoint, ec);
+  if (!ec) impl->acceptor.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec)
+    return unavailable("cannot listen on " + options.address + ":" + std::to_string(options.port) + ": " + ec.message());
+  impl->port = impl->acceptor.local_endpoint().port();
+  impl->shared = std::make_unique<Shared>(api, ws, options);
+  impl->do_accept();
+  for (int i = 0; i < std::max(1, options.io_threads); ++i) impl->threads.emplace_back([io = &impl->ioc]() { io->run(); });
+  return std::unique_ptr<HttpServer>(new HttpServer(std::move(impl)));
+}
+
+uint16_t HttpServer::port() const { return impl_->port; }
+bool HttpServer::tls() const { return impl_->tls.has_value(); }
+
+void HttpServer::stop() {
+  Impl& s = *impl_;
+  if (s.stopped) return;
+  s.stopped = true;
+  asio::post(s.ioc, [&s]() {
+    beast::error_code ec;
+    s.acceptor.close(ec);
+  });
+  std::vector<std::shared_ptr<EventSessionBase>> live;
+  {
+    std::lock_guard lock(s.shared->mutex);
+    s.shared->stopping = true;
+    for (const auto& w : s.shared->event_sessions)
+      if (auto p = w.lock()) live.push_back(p);
+    s.shared->event_sessions.clear();
+  }
+  for (auto& p : live) p->close();
+  live.clear();
+  s.shared->workers.join();  // the requests being worked on finish
+  // Give the last answers and close frames a moment to leave, then stop.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  s.ioc.stop();
+  for (std::thread& t : s.threads) t.join();
+  s.threads.clear();
+}
+
+}  // namespace bodyscan::server

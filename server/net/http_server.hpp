@@ -1,0 +1,51 @@
+// The network side of `bodyscan serve` (Boost.Beast): HTTP/1.1 and the WebSocket
+// at /api/events, plain or TLS. Network threads only read, write and route; every
+// request's work runs on a worker pool and its answer is posted back. Each
+// WebSocket session has its own write queue, bounded: a slow client loses camera
+// previews first and is dropped if it falls further behind, never slowing others.
+//
+// Only this module's .cpp includes Beast (the heavy headers stay in one place).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "recon/core/status.hpp"
+#include "server/api/api.hpp"
+#include "server/workstation/workstation.hpp"
+
+namespace bodyscan::server {
+
+struct NetOptions {
+  std::string address = "0.0.0.0";
+  uint16_t port = 8080;        // 0: any free port (tests)
+  int io_threads = 1;          // network threads
+  int workers = 3;             // threads running requests' work
+  std::string tls_cert, tls_key;  // PEM files; both or neither
+  size_t header_limit = 8 * 1024;
+  size_t body_limit = 1 << 20;  // request bodies are JSON; nothing uploads meshes
+  std::chrono::seconds timeout{30};  // to read a request, or write a response, or a TLS handshake
+  size_t ws_queue_limit = 256;       // queued events before a WebSocket client is dropped
+  size_t ws_preview_limit = 8;       // queued events past which camera previews are skipped
+};
+
+class HttpServer {
+ public:
+  // Binds and starts serving on its own threads.
+  static StatusOr<std::unique_ptr<HttpServer>> start(Api& api, Workstation& ws, const NetOptions& options);
+  ~HttpServer();  // stop()
+  uint16_t port() const;
+  bool tls() const;
+  // Stops accepting, closes the WebSocket sessions, finishes the requests being
+  // worked on, joins the threads. Idempotent.
+  void stop();
+
+ private:
+  struct Impl;
+  explicit HttpServer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace bodyscan::server

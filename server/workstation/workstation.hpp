@@ -1,0 +1,112 @@
+// The workstation: the rig, its calibration, the archive and the staff accounts,
+// and the one job the rig runs at a time (calibrate, scan, reprocess), with the
+// events browsers follow. The HTTP layer (server/api) calls it; it knows nothing
+// of HTTP.
+//
+// Threads: a job runs on a thread of its own, never on the network threads;
+// everything here may be called from any thread. Events are delivered to the
+// subscribers on the job's thread (or the caller's), so a subscriber must only
+// queue them (server/net does, per WebSocket session).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "hw/sim/sim_rig.hpp"
+#include "recon/core/status.hpp"
+#include "recon/geometry/triangle_mesh.hpp"
+#include "server/auth/auth_store.hpp"
+#include "storage/archive/archive.hpp"
+
+namespace bodyscan::server {
+
+struct WorkstationOptions {
+  std::string data_dir = "bodyscan-data";  // archive.db, scans/, accounts.db, workstation/
+  std::string rig = "sim";                 // sim | thesis | square | a rig description file
+  std::string body;                        // the simulated subject (PLY, mm); "" the description's
+  AuthOptions auth;
+  int default_every = 1;                   // scan every Nth laser step unless a request says
+  // Live camera previews during a scan: at most one per camera this often, this wide.
+  double preview_interval_s = 1.0;
+  int preview_width = 160;
+};
+
+enum class JobKind { kCalibrate, kScan, kReprocess };
+enum class JobState { kRunning, kComplete, kFailed, kCancelled };
+const char* to_string(JobKind k);
+const char* to_string(JobState s);
+
+struct JobInfo {
+  std::string id;  // "j_" + 16 hex digits
+  JobKind kind = JobKind::kScan;
+  JobState state = JobState::kRunning;
+  std::string stage;       // e.g. "calibration: lens", "scan", "surface: field"
+  double fraction = 0;     // of the stage
+  int64_t frames = 0;      // camera frames processed so far (scans)
+  std::string scan_id, customer_id, actor;
+  std::string error;       // why it failed or was cancelled
+  std::string started_at, finished_at;  // ISO 8601 UTC
+  int version = 0;         // a reprocess's new version
+};
+nlohmann::json to_json(const JobInfo& job);
+
+struct ScanRequest {
+  std::string customer_id;  // an existing customer
+  int every = 0;            // 0: the workstation's default
+  std::string actor;
+};
+
+class Workstation {
+ public:
+  // Opens the archive and accounts in options.data_dir (created), the rig, and
+  // the last calibration kept there.
+  static StatusOr<std::unique_ptr<Workstation>> open(const WorkstationOptions& options);
+  ~Workstation();  // shutdown("the workstation stopped")
+
+  storage::Archive& archive();
+  AuthStore& auth();
+  const WorkstationOptions& options() const;
+  // The simulated rig (fault injection in tests); null for a real rig.
+  hw::sim::SimulatedRig* simulated_rig();
+
+  // Cameras, lasers, the calibration (age, residuals), the job running.
+  nlohmann::json rig_status() const;
+
+  // A job, started when the rig is free; failed_precondition ("the rig is busy
+  // with ...") when another runs. The scan is in the archive, as running, before
+  // this returns (so a crash leaves a scan marked failed, never a silent gap).
+  StatusOr<JobInfo> start_calibration(const std::string& actor);
+  StatusOr<JobInfo> start_scan(const ScanRequest& request);
+  StatusOr<JobInfo> start_reprocess(const std::string& scan_id, const std::string& actor);
+  // Asks the job to stop (it stops at the next frame or stage, lasers off).
+  Status cancel(const std::string& job_id, const std::string& actor);
+  std::optional<JobInfo> job(const std::string& id) const;  // the current or the last job
+  std::optional<JobInfo> current_job() const;               // running
+  // Waits until no job runs (tests, shutdown); false on timeout.
+  bool wait_idle(double timeout_s) const;
+
+  // Events as JSON text (docs/api.md): {"type": "job" | "preview" | "rig" | "scan_finished", ...}.
+  using EventSink = std::function<void(std::shared_ptr<const std::string>)>;
+  int subscribe(EventSink sink);
+  void unsubscribe(int id);
+
+  // A scan's surface (version 0: the current one), decoded once and kept for the
+  // next measurement (a few recent scans).
+  StatusOr<std::shared_ptr<const TriangleMesh>> surface(const std::string& scan_id, int version = 0);
+
+  // Cancels the job (marking it and its scan with `reason`), waits for it, turns
+  // every laser off. Idempotent.
+  void shutdown(const std::string& reason);
+
+ private:
+  struct Impl;
+  explicit Workstation(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace bodyscan::server
