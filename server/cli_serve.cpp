@@ -63,7 +63,6 @@ int run_serve(int argc, char** argv) {
   server::NetOptions no;
   server::ApiOptions ao;
   ao.web_root = BODYSCAN_WEB_ROOT;
-  ao.openapi_file = BODYSCAN_OPENAPI_FILE;
   std::string admin = "admin";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];

@@ -2,8 +2,6 @@
 
 #include <sodium.h>
 
-#include <fstream>
-
 #include "server/api/static_files.hpp"
 
 namespace bodyscan::server {
@@ -61,16 +59,6 @@ bool foreign_origin(const HttpRequest& r) {
   return host != r.header("host") && (forwarded.empty() || host != forwarded);
 }
 
-HttpResponse openapi(const ApiOptions& options) {
-  std::ifstream in(options.openapi_file, std::ios::binary);
-  if (!in) return error_response(404, "the API description is not installed");
-  HttpResponse r;
-  r.body.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  r.set("Content-Type", "application/json");
-  r.set("Cache-Control", "no-cache");
-  return r;
-}
-
 }  // namespace
 
 std::string session_cookie(const HttpRequest& request) {
@@ -106,8 +94,20 @@ Api::Api(Workstation& ws, ApiOptions options) : ws_(ws), options_(std::move(opti
                      [](Workstation&, const Call&) {
                        return json_response(200, {{"status", "ok"}, {"service", "bodyscan"}});
                      }});
-  routes_.push_back({"GET", "/api/openapi.json", kAnyone,
-                     [this](Workstation&, const Call&) { return openapi(options_); }});
+  routes_.push_back({"GET", "/api/openapi.json", kAnyone, [](Workstation&, const Call&) {
+                       HttpResponse r;
+                       r.body = openapi_document();
+                       r.set("Content-Type", "application/json");
+                       r.set("Cache-Control", "no-cache");
+                       return r;
+                     }});
+  // The events are a WebSocket (server/net upgrades it before routing); a plain
+  // GET is told so.
+  routes_.push_back({"GET", "/api/events", kStaff, [](Workstation&, const Call&) {
+                       HttpResponse r = error_response(426, "connect to /api/events with a WebSocket");
+                       r.set("Upgrade", "websocket");
+                       return r;
+                     }});
   add_account_routes(&routes_, options_);
   add_rig_routes(&routes_);
   add_scan_routes(&routes_);

@@ -40,7 +40,6 @@ struct Call {
 
 struct ApiOptions {
   std::string web_root;       // the UI's static files
-  std::string openapi_file;   // served at /api/openapi.json
   bool secure_cookies = false;  // Secure on the session cookie (TLS here or at a proxy)
   std::string public_url;     // share links' base, e.g. "https://scanner.shop.example"; "" from Host
 };
@@ -70,6 +69,9 @@ class Api {
   ApiOptions options_;
   std::vector<Route> routes_;
 };
+
+// server/api/openapi.json, compiled in.
+const char* openapi_document();
 
 // The route groups (one file each).
 void add_account_routes(std::vector<Api::Route>* routes, const ApiOptions& options);

@@ -22,7 +22,10 @@ const char* reason_code(int status) {
     case 409: return "conflict";
     case 413: return "payload_too_large";
     case 415: return "unsupported_media_type";
+    case 422: return "unprocessable";
+    case 426: return "upgrade_required";
     case 429: return "too_many_requests";
+    case 431: return "headers_too_large";
     case 503: return "unavailable";
     case 504: return "timeout";
     case 507: return "insufficient_storage";

@@ -79,6 +79,26 @@ HttpResponse scan_file(Workstation& ws, const std::string& scan_id, const std::s
   return out;
 }
 
+// A cached JSON body: 304 on a matching ETag, gzip when the client takes it.
+HttpResponse cached_json(const Workstation::CachedText& text, const HttpRequest& request) {
+  HttpResponse out;
+  out.set("Content-Type", "application/json");
+  out.set("Cache-Control", "private, no-cache");
+  out.set("ETag", text.etag);
+  out.set("Vary", "Accept-Encoding");
+  if (request.header("if-none-match") == text.etag) {
+    out.status = 304;
+    return out;
+  }
+  if (!text.gzip.empty() && request.header("accept-encoding").find("gzip") != std::string::npos) {
+    out.body = text.gzip;
+    out.set("Content-Encoding", "gzip");
+  } else {
+    out.body = text.body;
+  }
+  return out;
+}
+
 namespace {
 
 HttpResponse no_content() {
@@ -213,14 +233,16 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
   }
   routes->push_back({"GET", "/api/scans/{id}/measurements", kStaff, [](Workstation& ws, const Call& call) {
                        const std::string& id = call.params.at("id");
-                       auto r = ws.archive().scan(id);
-                       if (!r.ok()) return error_response(r.status());
-                       auto ms = ws.archive().measurements(id);
-                       if (!ms.ok()) return error_response(ms.status());
-                       nlohmann::json out = nlohmann::json::array();
-                       for (const auto& m : *ms) out.push_back(measurement_json(m));
-                       return json_response(200,
-                                            {{"scan_id", id}, {"version", r->current_version}, {"measurements", out}});
+                       auto text = ws.cached_text("measurements/" + id, [&]() -> StatusOr<std::string> {
+                         ASSIGN_OR_RETURN(storage::ScanRecord r, ws.archive().scan(id));
+                         ASSIGN_OR_RETURN(std::vector<storage::MeasurementRecord> ms, ws.archive().measurements(id));
+                         nlohmann::json out = nlohmann::json::array();
+                         for (const auto& m : ms) out.push_back(measurement_json(m));
+                         return nlohmann::json{{"scan_id", id}, {"version", r.current_version}, {"measurements", out}}
+                             .dump();
+                       });
+                       if (!text.ok()) return error_response(text.status());
+                       return cached_json(**text, call.request);
                      }});
   routes->push_back({"POST", "/api/scans/{id}/measure", kStaff, [](Workstation& ws, const Call& call) {
                        HttpResponse error;

@@ -1,6 +1,9 @@
 // Customer share links: staff make one per scan (read-only, expiring, revocable,
 // with the measurements they choose); the customer's phone reaches that scan's
 // model and those measurements through the token alone, and nothing else.
+#include <algorithm>
+#include <cmath>
+
 #include "server/api/api.hpp"
 
 namespace bodyscan::server {
@@ -51,8 +54,8 @@ void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options
                            names.push_back(n);
                          }
                        }
-                       auto made = ws.auth().create_share(id, names, static_cast<int64_t>(days.get<double>() * kDay),
-                                                          call.actor());
+                       const int64_t seconds = std::max<int64_t>(1, std::llround(days.get<double>() * kDay));
+                       auto made = ws.auth().create_share(id, names, seconds, call.actor());
                        if (!made.ok()) return error_response(made.status());
                        ws.archive().log(call.actor(), "share scan", "scan", id, made->link.id);
                        nlohmann::json out = share_json(made->link);

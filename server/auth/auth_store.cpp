@@ -191,7 +191,8 @@ std::string lower(std::string s) {
 // slip past the check before any of them is counted.
 class Limiter {
  public:
-  Limiter(int max_failures, int64_t window_s) : max_(max_failures), window_(window_s) {}
+  Limiter(int max_failures, int max_address_failures, int64_t window_s)
+      : max_(max_failures), max_addr_(max_address_failures), window_(window_s) {}
 
   // 0 having reserved a failure under both keys, else seconds to wait.
   int reserve(const std::string& user_key, const std::string& addr_key, int64_t now) {
@@ -201,12 +202,12 @@ class Limiter {
     auto& user = failures_[user_key];
     auto& addr = failures_[addr_key];
     int64_t wait = 0;
-    for (auto* d : {&user, &addr}) {
+    for (auto [d, max] : {std::pair{&user, max_}, std::pair{&addr, max_addr_}}) {
       expire(*d, now);
-      if (static_cast<int>(d->size()) >= max_) wait = std::max(wait, d->front() + window_ - now);
+      if (static_cast<int>(d->size()) >= max) wait = std::max(wait, d->front() + window_ - now);
     }
     // Clamped: a clock stepped backwards must not lock anyone out for longer.
-    if (wait > 0 || static_cast<int>(user.size()) >= max_ || static_cast<int>(addr.size()) >= max_)
+    if (wait > 0 || static_cast<int>(user.size()) >= max_ || static_cast<int>(addr.size()) >= max_addr_)
       return static_cast<int>(std::clamp<int64_t>(wait, 1, window_));
     user.push_back(now);
     addr.push_back(now);
@@ -249,7 +250,7 @@ class Limiter {
     }
   }
 
-  const int max_;
+  const int max_, max_addr_;
   const int64_t window_;
   std::mutex mu_;
   std::unordered_map<std::string, std::deque<int64_t>> failures_;
@@ -267,7 +268,9 @@ struct AuthStore::Impl {
   Impl(Database d, AuthOptions o)
       : db(std::move(d)),
         options(std::move(o)),
-        limiter(options.max_failures, options.failure_window_s) {}
+        limiter(options.max_failures,
+                options.max_address_failures > 0 ? options.max_address_failures : options.max_failures,
+                options.failure_window_s) {}
 
   int64_t now() const { return options.now ? options.now() : system_now(); }
 

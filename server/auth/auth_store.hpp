@@ -76,6 +76,10 @@ struct AuthOptions {
   // Login failures per key (the username, and the remote address separately)
   // within failure_window_s before refusing. <= 0 turns the limit off.
   int max_failures = 5;
+  // From one address: higher, since a shop's tablets may all reach the server
+  // through one proxy or NAT address; guessing at one account stays at
+  // max_failures. <= 0: the same as max_failures.
+  int max_address_failures = 20;
   int64_t failure_window_s = 300;
   std::function<int64_t()> now;  // unix seconds; default: the system clock
 };
@@ -99,10 +103,11 @@ class AuthStore {
   // is failed_precondition; an unknown one not_found.
   StatusOr<Account> add_account(const std::string& username, const std::string& password,
                                 Role role);
-  Status set_password(const std::string& username,
-                      const std::string& password);         // ends that user's sessions
-  Status set_role(const std::string& username, Role role);  // refuses to demote the last admin
-  Status delete_account(const std::string& username);  // refuses the last admin; ends its sessions
+  // set_password ends that user's sessions. set_role refuses to demote the last
+  // admin; delete_account refuses to delete it, and ends the account's sessions.
+  Status set_password(const std::string& username, const std::string& password);
+  Status set_role(const std::string& username, Role role);
+  Status delete_account(const std::string& username);
   StatusOr<Account> account(const std::string& username) const;
   StatusOr<std::vector<Account>> accounts() const;  // by username
   bool has_admin() const;

@@ -17,6 +17,7 @@
 #include <boost/version.hpp>
 
 #include <algorithm>
+#include <array>
 #include <deque>
 #include <mutex>
 #include <set>
@@ -308,8 +309,20 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     });
   }
 
+  // For a request refused before it was read whole: answer, stop sending, and
+  // read on (discarding, briefly, boundedly) so that the client - still sending
+  // its oversized body - gets to read the answer rather than a reset.
   void reply_and_close(int status, const std::string& message) {
+    lingering_ = true;
     send(make_message(error_response(status, message), 11, false, false), false);
+  }
+
+  void do_drain() {
+    tcp().expires_after(std::chrono::seconds(2));
+    stream_.async_read_some(asio::buffer(drain_), [self = this->shared_from_this()](beast::error_code ec, size_t n) {
+      self->drained_ += n;
+      if (!ec && self->drained_ < (8u << 20)) self->do_drain();
+    });
   }
 
   void send(http::message_generator msg, bool keep_alive) {
@@ -326,6 +339,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   }
 
   void do_close() {
+    if (lingering_) {
+      beast::error_code ec;
+      tcp().socket().shutdown(tcp::socket::shutdown_send, ec);
+      return do_drain();
+    }
     if constexpr (kTls) {
       tcp().expires_after(std::chrono::seconds(5));
       stream_.async_shutdown([self = this->shared_from_this()](beast::error_code) {});
@@ -340,6 +358,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   std::string remote_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
+  bool lingering_ = false;
+  std::array<char, 16384> drain_;
+  size_t drained_ = 0;
 };
 
 struct HttpServer::Impl {

@@ -1,8 +1,18 @@
 #include "server/pipeline/measurements_json.hpp"
 
+#include <cmath>
+
 namespace bodyscan::pipeline {
 
-nlohmann::json point_json(const Eigen::Vector3d& p) { return nlohmann::json::array({p.x(), p.y(), p.z()}); }
+namespace {
+// Positions to the micrometre: far below what a scan resolves, and a third of the
+// text of full double precision (the served measurements are mostly polylines).
+double to_um(double mm) { return std::round(mm * 1000.0) / 1000.0; }
+}  // namespace
+
+nlohmann::json point_json(const Eigen::Vector3d& p) {
+  return nlohmann::json::array({to_um(p.x()), to_um(p.y()), to_um(p.z())});
+}
 
 nlohmann::json polyline_json(const std::vector<Eigen::Vector3d>& points) {
   nlohmann::json a = nlohmann::json::array();
@@ -11,7 +21,8 @@ nlohmann::json polyline_json(const std::vector<Eigen::Vector3d>& points) {
 }
 
 nlohmann::json plane_json(const Plane& plane) {
-  return {{"point", point_json(plane.point)}, {"normal", point_json(plane.normal)}};
+  return {{"point", point_json(plane.point)},
+          {"normal", nlohmann::json::array({plane.normal.x(), plane.normal.y(), plane.normal.z()})}};
 }
 
 nlohmann::json measurements_document(const std::string& file, const std::string& kind) {

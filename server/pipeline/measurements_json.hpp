@@ -16,6 +16,7 @@ inline constexpr const char* kMeasurementsSchema = "bodyscan.measurements/1";
 inline constexpr const char* kGirthAlgorithm = "girth/convex-hull-1";
 inline constexpr const char* kSurfaceAlgorithm = "surface/geodesic-funnel-1";
 
+// Positions (mm) rounded to the micrometre.
 nlohmann::json point_json(const Eigen::Vector3d& p);
 nlohmann::json polyline_json(const std::vector<Eigen::Vector3d>& points);
 nlohmann::json plane_json(const Plane& plane);

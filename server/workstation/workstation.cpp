@@ -12,6 +12,8 @@
 #include <mutex>
 #include <thread>
 
+#include <zlib.h>
+
 #include "hw/rig_description.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/png_image.hpp"
@@ -102,6 +104,20 @@ StatusOr<std::string> preview_png(const hw::Frame& f, int width) {
   return encode_png(img, 6);
 }
 
+std::string gzip(const std::string& in) {
+  z_stream z{};
+  if (deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) return {};
+  std::string out(deflateBound(&z, in.size()) + 32, '\0');
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
+  z.avail_in = static_cast<uInt>(in.size());
+  z.next_out = reinterpret_cast<Bytef*>(out.data());
+  z.avail_out = static_cast<uInt>(out.size());
+  const int rc = deflate(&z, Z_FINISH);
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  return rc == Z_STREAM_END ? out : std::string();
+}
+
 constexpr const char* kCalibrationFile = "calibration-record.json";  // in DATA/workstation/
 
 }  // namespace
@@ -129,6 +145,10 @@ struct Workstation::Impl {
   std::map<int, EventSink> sinks;
   int next_sink = 1;
   std::string last_camera_error;
+
+  std::mutex text_mutex;
+  std::map<std::string, std::pair<uint64_t, std::shared_ptr<const CachedText>>> texts;  // key -> (revision, text)
+  static constexpr size_t kTextCacheSize = 32;
 
   std::mutex cache_mutex;
   std::list<std::pair<std::string, std::shared_ptr<const TriangleMesh>>> cache;  // most recent first
@@ -554,6 +574,30 @@ StatusOr<std::shared_ptr<const TriangleMesh>> Workstation::surface(const std::st
   s.cache.emplace_front(key, shared);
   if (s.cache.size() > Impl::kCacheSize) s.cache.pop_back();
   return shared;
+}
+
+StatusOr<std::shared_ptr<const Workstation::CachedText>> Workstation::cached_text(
+    const std::string& key, const std::function<StatusOr<std::string>()>& make) {
+  Impl& s = *impl_;
+  const uint64_t revision = s.archive->revision();
+  {
+    std::lock_guard lock(s.text_mutex);
+    auto it = s.texts.find(key);
+    if (it != s.texts.end() && it->second.first == revision) return it->second.second;
+  }
+  ASSIGN_OR_RETURN(std::string body, make());
+  auto text = std::make_shared<CachedText>();
+  unsigned char h[16];
+  crypto_generichash(h, sizeof h, reinterpret_cast<const unsigned char*>(body.data()), body.size(), nullptr, 0);
+  char hex[33];
+  sodium_bin2hex(hex, sizeof hex, h, sizeof h);
+  text->etag = std::string("\"") + hex + "\"";
+  text->gzip = gzip(body);
+  text->body = std::move(body);
+  std::lock_guard lock(s.text_mutex);
+  if (s.texts.size() >= Impl::kTextCacheSize) s.texts.clear();  // rarely reached: a shop looks at a few scans
+  s.texts[key] = {revision, text};
+  return std::shared_ptr<const CachedText>(text);
 }
 
 void Workstation::shutdown(const std::string& reason) {

@@ -99,6 +99,15 @@ class Workstation {
   // next measurement (a few recent scans).
   StatusOr<std::shared_ptr<const TriangleMesh>> surface(const std::string& scan_id, int version = 0);
 
+  // A response body derived from the archive (a scan's measurements ...), made
+  // once per change of the archive (Archive::revision) and kept with its gzip
+  // form and an ETag, so that fifty tablets asking for it cost one parse.
+  struct CachedText {
+    std::string body, gzip, etag;  // etag quoted, as sent
+  };
+  StatusOr<std::shared_ptr<const CachedText>> cached_text(const std::string& key,
+                                                          const std::function<StatusOr<std::string>()>& make);
+
   // Cancels the job (marking it and its scan with `reason`), waits for it, turns
   // every laser off. Idempotent.
   void shutdown(const std::string& reason);

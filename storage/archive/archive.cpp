@@ -2,6 +2,8 @@
 
 #include <fcntl.h>
 #include <sodium.h>
+
+#include <atomic>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -120,6 +122,7 @@ struct Archive::Impl {
   int lock_fd = -1;
   mutable Database db;  // const queries prepare statements too
   mutable std::mutex mu;
+  std::atomic<uint64_t> revision{0};  // bumped by every change to scans or measurements
   RecoveryReport recovery;
 
   explicit Impl(Database d) : db(std::move(d)) {}
@@ -474,6 +477,7 @@ StatusOr<std::vector<Customer>> Archive::customers(const std::string& text) cons
 }
 
 Status Archive::delete_customer(const std::string& id, const std::string& actor) {
+  impl_->revision.fetch_add(1);
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(std::vector<std::string> scan_ids, impl_->ids("SELECT id FROM scans WHERE customer_id = ?", id));
   {
@@ -533,6 +537,7 @@ StatusOr<nlohmann::json> Archive::calibration(const std::string& id) const {
 
 StatusOr<std::string> Archive::begin_scan(const std::string& customer_id, const std::string& operator_name,
                                           const nlohmann::json& rig, const std::string& calibration_id) {
+  impl_->revision.fetch_add(1);
   std::lock_guard lock(impl_->mu);
   const std::string id = new_id('s');
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
@@ -556,6 +561,7 @@ StatusOr<std::string> Archive::begin_scan(const std::string& customer_id, const 
 }
 
 Status Archive::put_raw(const std::string& scan_id, const std::string& name, std::string_view bytes) {
+  impl_->revision.fetch_add(1);
   {
     std::lock_guard lock(impl_->mu);
     ASSIGN_OR_RETURN(ScanRecord r, impl_->record(scan_id));
@@ -570,6 +576,7 @@ Status Archive::put_raw(const std::string& scan_id, const std::string& name, std
 }
 
 Status Archive::set_scan_calibration(const std::string& scan_id, const std::string& calibration_id) {
+  impl_->revision.fetch_add(1);
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(ScanRecord r, impl_->record(scan_id));
   if (r.status != ScanStatus::kRunning) return failed_precondition("archive: scan '" + scan_id + "' is not running");
@@ -580,6 +587,7 @@ Status Archive::set_scan_calibration(const std::string& scan_id, const std::stri
 }
 
 Status Archive::complete_scan(const std::string& scan_id, const ScanResults& results) {
+  impl_->revision.fetch_add(1);
   {
     std::lock_guard lock(impl_->mu);
     ASSIGN_OR_RETURN(ScanRecord r, impl_->record(scan_id));
@@ -609,6 +617,7 @@ Status Archive::complete_scan(const std::string& scan_id, const ScanResults& res
 }
 
 Status Archive::end_scan(const std::string& scan_id, ScanStatus status, const std::string& reason) {
+  impl_->revision.fetch_add(1);
   if (status != ScanStatus::kFailed && status != ScanStatus::kCancelled)
     return invalid_argument("archive: a scan ends failed or cancelled here; complete_scan completes it");
   std::lock_guard lock(impl_->mu);
@@ -629,6 +638,7 @@ Status Archive::end_scan(const std::string& scan_id, ScanStatus status, const st
 }
 
 StatusOr<int> Archive::add_version(const std::string& scan_id, const ScanResults& results, const std::string& actor) {
+  impl_->revision.fetch_add(1);
   int version = 0;
   {
     std::lock_guard lock(impl_->mu);
@@ -669,6 +679,7 @@ StatusOr<int> Archive::add_version(const std::string& scan_id, const ScanResults
 }
 
 Status Archive::delete_scan(const std::string& id, const std::string& actor) {
+  impl_->revision.fetch_add(1);
   std::lock_guard lock(impl_->mu);
   {
     ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
@@ -730,7 +741,12 @@ StatusOr<std::string> Archive::file_path(const std::string& scan_id, int version
 
 // --- measurements ------------------------------------------------------------
 
+uint64_t Archive::revision() const { return impl_->revision.load(); }
+
 StatusOr<std::vector<MeasurementRecord>> Archive::measurements(const std::string& scan_id, int version) const {
+  std::vector<MeasurementRecord> out;
+  std::vector<std::string> geometry;  // parsed after the lock is let go: it is most of the work
+  {
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(ScanRecord r, impl_->record(scan_id));
   const int v = version == 0 ? r.current_version : version;
@@ -739,7 +755,6 @@ StatusOr<std::vector<MeasurementRecord>> Archive::measurements(const std::string
                                      "created_by, created_at FROM measurements WHERE scan_id = ? AND "
                                      "(version = ? OR source = 'user') ORDER BY source, id"));
   st.bind(1, scan_id).bind(2, v);
-  std::vector<MeasurementRecord> out;
   for (;;) {
     ASSIGN_OR_RETURN(bool row, st.step());
     if (!row) break;
@@ -747,14 +762,17 @@ StatusOr<std::vector<MeasurementRecord>> Archive::measurements(const std::string
     m.id = st.integer(0), m.scan_id = st.text(1), m.version = static_cast<int>(st.integer(2));
     m.source = st.text(3), m.name = st.text(4), m.label = st.text(5), m.kind = st.text(6), m.iso_clause = st.text(7);
     m.value_mm = st.real(8);
-    m.geometry = nlohmann::json::parse(st.text(9), nullptr, false);
+    geometry.push_back(st.text(9));
     m.created_by = st.text(10), m.created_at = st.text(11);
     out.push_back(std::move(m));
   }
+  }
+  for (size_t i = 0; i < out.size(); ++i) out[i].geometry = nlohmann::json::parse(geometry[i], nullptr, false);
   return out;
 }
 
 StatusOr<int64_t> Archive::save_measurement(const MeasurementRecord& in, const std::string& actor) {
+  impl_->revision.fetch_add(1);
   if (in.name.empty()) return invalid_argument("archive: a saved measurement needs a name");
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(ScanRecord r, impl_->record(in.scan_id));
@@ -770,6 +788,7 @@ StatusOr<int64_t> Archive::save_measurement(const MeasurementRecord& in, const s
 }
 
 Status Archive::delete_measurement(const std::string& scan_id, int64_t id, const std::string& actor) {
+  impl_->revision.fetch_add(1);
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
   ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("DELETE FROM measurements WHERE id = ? AND scan_id = ? AND source = 'user'"));

@@ -158,6 +158,10 @@ class Archive {
   StatusOr<int64_t> save_measurement(const MeasurementRecord& m, const std::string& actor);
   Status delete_measurement(const std::string& scan_id, int64_t id, const std::string& actor);
 
+  // Changes whenever a scan, its versions or measurements change (through this
+  // object): what is derived from them can be cached against it.
+  uint64_t revision() const;
+
   StatusOr<std::vector<AuditEntry>> audit(const std::string& target_id = "", int limit = 1000) const;
   Status log(const std::string& actor, const std::string& action, const std::string& target_kind,
              const std::string& target_id, const std::string& detail);

@@ -1,0 +1,249 @@
+// Who reaches what: the OpenAPI file against the routes the server has, every
+// endpoint against every kind of caller, CSRF, login limits, share-link scope.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <thread>
+
+#include "tests/server/server_fixture.hpp"
+
+namespace bodyscan::testing {
+namespace {
+
+using server::Api;
+
+std::set<std::string> access_names(unsigned a) {
+  std::set<std::string> out;
+  if (a & server::kAnyone) out.insert("anyone");
+  if (a & server::kShareLink) out.insert("share");
+  if (a & server::kOperator) out.insert("operator");
+  if (a & server::kTailor) out.insert("tailor");
+  if (a & server::kAdmin) out.insert("admin");
+  return out;
+}
+
+class ApiAccess : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { server_ = new ServerUnderTest(); }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+  static ServerUnderTest* server_;
+};
+ServerUnderTest* ApiAccess::server_ = nullptr;
+
+// The served description is the file in the repository, and it lists exactly the
+// routes the server has, each with the callers it admits.
+TEST_F(ApiAccess, OpenApiDescribesEveryRouteAndWhoMayCallIt) {
+  const HttpReply r = http(server_->port, "GET", "/api/openapi.json");
+  ASSERT_EQ(r.status, 200);
+  const nlohmann::json doc = parse(r);
+  ASSERT_FALSE(doc.is_discarded());
+  EXPECT_EQ(doc["openapi"].get<std::string>().substr(0, 2), "3.");
+  std::set<std::string> documented, routed;
+  for (const auto& [path, ops] : doc["paths"].items())
+    for (const auto& [method, op] : ops.items()) {
+      std::string m = method;
+      for (char& c : m) c = static_cast<char>(std::toupper(c));
+      documented.insert(m + " " + path);
+      ASSERT_TRUE(op.contains("x-bodyscan-access")) << m << " " << path;
+      ASSERT_TRUE(op.contains("responses")) << m << " " << path;
+      std::set<std::string> says(op["x-bodyscan-access"].begin(), op["x-bodyscan-access"].end());
+      for (const Api::Route& route : server_->api->routes())
+        if (route.method == m && route.pattern == path) {
+          EXPECT_EQ(says, access_names(route.access)) << m << " " << path;
+          const bool staff_only = !(route.access & (server::kAnyone | server::kShareLink));
+          if (staff_only) {
+            EXPECT_TRUE(op["responses"].contains("401")) << m << " " << path;
+            EXPECT_TRUE(op["responses"].contains("403")) << m << " " << path;
+          }
+        }
+    }
+  for (const Api::Route& route : server_->api->routes()) routed.insert(route.method + " " + route.pattern);
+  EXPECT_EQ(documented, routed);
+  // Every $ref resolves.
+  std::function<void(const nlohmann::json&)> walk = [&](const nlohmann::json& j) {
+    if (j.is_object()) {
+      if (j.contains("$ref")) {
+        const std::string ref = j["$ref"];
+        ASSERT_EQ(ref.rfind("#/", 0), 0u) << ref;
+        EXPECT_FALSE(doc.contains(nlohmann::json::json_pointer(ref.substr(1))) == false) << ref;
+      }
+      for (const auto& [k, v] : j.items()) walk(v);
+    } else if (j.is_array()) {
+      for (const auto& v : j) walk(v);
+    }
+  };
+  walk(doc);
+}
+
+// Every endpoint x {anonymous, customer with a link, operator, tailor, admin}.
+// Allowed callers get past authentication and authorisation (whatever the
+// request then gives); the others get 401 (no session) or 403 (role), and a
+// customer's link opens its own scan's two endpoints and nothing else.
+TEST_F(ApiAccess, AccessMatrixOverEveryEndpoint) {
+  ServerUnderTest& s = *server_;
+  Client admin = s.as("admin");
+  ASSERT_FALSE(admin.cookie.empty());
+  const HttpReply made = admin.post("/api/scans/" + s.scan_id + "/shares", R"({"days": 1, "measurements": ["waist_girth"]})");
+  ASSERT_EQ(made.status, 201) << made.body;
+  const std::string token = parse(made)["token"];
+
+  auto concrete = [&](const Api::Route& r) {
+    std::string p = r.pattern;
+    auto put = [&](const std::string& key, const std::string& value) {
+      const size_t at = p.find(key);
+      if (at != std::string::npos) p.replace(at, key.size(), value);
+    };
+    const bool destructive = r.method == "DELETE";
+    if (p.rfind("/api/customers/", 0) == 0) put("{id}", destructive ? "c_0000000000000000" : s.customer_id);
+    if (p.rfind("/api/scans/", 0) == 0) put("{id}", destructive && p == "/api/scans/{id}" ? "s_none" : s.scan_id);
+    put("{id}", "x_none");  // jobs, shares
+    put("{mid}", "999999");
+    put("{username}", "nobody");
+    put("{token}", token);
+    return p;
+  };
+  auto body_for = [&](const Api::Route& r) -> std::string {
+    if (r.pattern == "/api/login") return R"({"username": "op", "password": "correct horse battery"})";
+    if (r.pattern == "/api/scans" && r.method == "POST") return R"({"customer_id": "c_0000000000000000"})";
+    if (r.pattern == "/api/scans/{id}/measure")
+      return R"({"kind": "distance", "from": [0, 0, 0], "to": [0, 100, 0]})";
+    if (r.method == "POST" || r.method == "PUT") return "{}";
+    return "";
+  };
+
+  struct Caller {
+    std::string name;
+    std::string user;  // "" anonymous / customer
+    unsigned bit;
+  };
+  const std::vector<Caller> callers = {{"anonymous", "", 0},
+                                       {"customer", "", server::kShareLink},
+                                       {"operator", "op", server::kOperator},
+                                       {"tailor", "tailor", server::kTailor},
+                                       {"admin", "admin", server::kAdmin}};
+  int checked = 0;
+  for (const Api::Route& r : s.api->routes()) {
+    for (const Caller& c : callers) {
+      Client client;
+      client.port = s.port;
+      if (!c.user.empty()) {
+        client = s.as(c.user);  // fresh: /api/logout must not end the next case's session
+        ASSERT_FALSE(client.cookie.empty()) << c.user;
+      } else if (c.name == "customer") {
+        client.cookie = std::string(server::kSessionCookie) + "=" + token;  // the link's token is no session
+      }
+      const std::string target = concrete(r);
+      const HttpReply got = client.request(r.method, target, body_for(r));
+      ASSERT_NE(got.status, 0) << r.method << " " << target;
+      const bool allowed = (r.access & (server::kAnyone | server::kShareLink)) || (r.access & c.bit);
+      SCOPED_TRACE(r.method + " " + target + " as " + c.name + ": " + std::to_string(got.status) + " " + got.body);
+      if (allowed) {
+        EXPECT_NE(got.status, 401);
+        EXPECT_NE(got.status, 403);
+        EXPECT_LT(got.status, 500);
+      } else if (c.user.empty()) {
+        EXPECT_EQ(got.status, 401);
+      } else {
+        EXPECT_EQ(got.status, 403);
+      }
+      if (r.pattern == "/api/rig/calibrate" && got.status == 202) {
+        // Allowed and started: stop it again, lasers off, before the next case.
+        const std::string job = parse(got)["job"]["id"];
+        EXPECT_EQ(client.post("/api/jobs/" + job + "/cancel").status, 202);
+        ASSERT_TRUE(s.ws->wait_idle(60));
+      }
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, static_cast<int>(s.api->routes().size() * callers.size()));
+
+  // The link is scoped: its own scan only, read-only, and a wrong or withdrawn
+  // token gives the same 404 as one that never existed.
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + token).status, 200);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + token + "/mesh.glb").status, 200);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/AAAAAAAAAAAAAAAAAAAAAA").status, 404);
+  EXPECT_EQ(http(s.port, "GET", "/api/scans/" + s.scan_id + "/mesh.glb?token=" + token).status, 401);
+  EXPECT_EQ(http(s.port, "POST", "/api/share/" + token).status, 405);
+}
+
+TEST_F(ApiAccess, LoginSetsAStrictHttpOnlyCookieAndLogoutEndsIt) {
+  const int port = server_->port;
+  HttpReply r = http(port, "POST", "/api/login", {{"Content-Type", "application/json"}},
+                     R"({"username": "tailor", "password": "correct horse battery"})");
+  ASSERT_EQ(r.status, 200) << r.body;
+  const std::string cookie = r.header("set-cookie");
+  EXPECT_NE(cookie.find("HttpOnly"), std::string::npos) << cookie;
+  EXPECT_NE(cookie.find("SameSite=Strict"), std::string::npos) << cookie;
+  EXPECT_EQ(cookie.find("Secure"), std::string::npos) << "plain HTTP: no Secure flag, " << cookie;
+  EXPECT_EQ(parse(r)["role"], "tailor");
+  Client c = login(port, "tailor", kPassword);
+  EXPECT_EQ(c.get("/api/session").status, 200);
+  EXPECT_EQ(parse(c.get("/api/session"))["csrf_token"], c.csrf);
+  EXPECT_EQ(c.post("/api/logout").status, 204);
+  EXPECT_EQ(c.get("/api/session").status, 401);
+  EXPECT_EQ(http(port, "POST", "/api/login", {{"Content-Type", "application/json"}},
+                 R"({"username": "tailor", "password": "wrong password!"})")
+                .status,
+            401);
+  EXPECT_EQ(http(port, "POST", "/api/login", {{"Content-Type", "application/json"}}, R"({"username": 3})").status, 400);
+  EXPECT_EQ(http(port, "POST", "/api/login", {{"Content-Type", "text/plain"}}, "username=a").status, 415);
+}
+
+TEST_F(ApiAccess, StateChangingRequestsNeedTheCsrfTokenAndOurOrigin) {
+  Client op = server_->as("op");
+  Client no_token = op;
+  no_token.csrf.clear();
+  EXPECT_EQ(no_token.post("/api/customers", R"({"name": "X"})").status, 403);
+  Client wrong = op;
+  wrong.csrf = "A" + op.csrf.substr(1);
+  EXPECT_EQ(wrong.post("/api/customers", R"({"name": "X"})").status, 403);
+  EXPECT_EQ(op.request("POST", "/api/customers", R"({"name": "X"})", {{"Origin", "https://evil.example"}}).status, 403);
+  EXPECT_EQ(op.request("POST", "/api/customers", R"({"name": "X"})",
+                       {{"Origin", "http://127.0.0.1:" + std::to_string(server_->port)}})
+                .status,
+            201);
+  EXPECT_EQ(op.post("/api/customers", R"({"name": "Y"})").status, 201);
+  // Reading needs no token.
+  EXPECT_EQ(no_token.get("/api/customers").status, 200);
+}
+
+TEST_F(ApiAccess, RepeatedFailedLoginsAreRefusedForAWhile) {
+  const int port = server_->port;
+  auto attempt = [&](const std::string& password) {
+    return http(port, "POST", "/api/login", {{"Content-Type", "application/json"}},
+                R"({"username": "admin", "password": ")" + password + R"("})");
+  };
+  int refused = 0;
+  HttpReply last;
+  for (int i = 0; i < 8; ++i) {
+    last = attempt("guess number " + std::to_string(i));
+    if (last.status == 429) ++refused;
+  }
+  EXPECT_GE(refused, 3);
+  EXPECT_EQ(last.status, 429);
+  EXPECT_GT(std::atoi(last.header("retry-after").c_str()), 0);
+  // Even the right password waits out the window.
+  EXPECT_EQ(attempt(kPassword).status, 429);
+}
+
+TEST_F(ApiAccess, EventsNeedAStaffSession) {
+  HttpReply refusal;
+  EXPECT_EQ(EventStream::open(server_->port, "", &refusal), nullptr);
+  EXPECT_EQ(refusal.status, 401);
+  Client t = server_->as("tailor");
+  auto events = EventStream::open(server_->port, t.cookie);
+  ASSERT_NE(events, nullptr);
+  auto hello = events->next(std::chrono::seconds(10));
+  ASSERT_TRUE(hello);
+  const nlohmann::json j = nlohmann::json::parse(*hello);
+  EXPECT_EQ(j["type"], "hello");
+  EXPECT_EQ(j["rig"]["cameras"].size(), 3u);
+  EXPECT_EQ(Client{server_->port}.get("/api/events").status, 401);
+  EXPECT_EQ(t.get("/api/events").status, 426);
+}
+
+}  // namespace
+}  // namespace bodyscan::testing

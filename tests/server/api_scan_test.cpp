@@ -1,0 +1,339 @@
+// The rig through the API: a whole simulated scan followed over the WebSocket,
+// one job at a time, cancelling, a camera that stops mid-scan, and what staff do
+// with a finished scan (measure, save, sheets, cached downloads).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <thread>
+
+#include "recon/measure/girth.hpp"
+#include "storage/formats/draco_files.hpp"
+#include "tests/server/server_fixture.hpp"
+
+namespace bodyscan::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+nlohmann::json wait_job(const Client& c, const std::string& id, double timeout_s = 300) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  nlohmann::json j;
+  while (std::chrono::steady_clock::now() < until) {
+    j = parse(c.get("/api/jobs/" + id))["job"];
+    if (j["state"] != "running") return j;
+    std::this_thread::sleep_for(200ms);
+  }
+  return j;
+}
+
+// An operator scans a new customer on the simulated rig (every 12th laser step),
+// following it over the WebSocket: progress by stage, frame counts, camera
+// previews (real PNGs), the end. A second scan meanwhile gets 409; a client that
+// never reads its events does not hold anything up. The result is the demo
+// body: its served model's bounds and a girth agree with the true mesh.
+TEST(ApiScan, SimulatedScanThroughTheApiWithLiveEvents) {
+  ServerUnderTest s(12);
+  Client op = s.as("op");
+  auto events = EventStream::open(s.port, op.cookie);
+  ASSERT_NE(events, nullptr);
+  auto stalled = Connection::open(s.port);  // a WebSocket client that never reads
+  ASSERT_NE(stalled, nullptr);
+  ASSERT_TRUE(stalled->send_all("GET /api/events HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                                "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\nCookie: " +
+                                op.cookie + "\r\n\r\n"));
+
+  const HttpReply started = op.post("/api/scans", R"({"customer": {"name": "Walk-in"}})");
+  ASSERT_EQ(started.status, 202) << started.body;
+  const nlohmann::json job = parse(started)["job"];
+  const std::string job_id = job["id"], scan_id = job["scan_id"];
+  EXPECT_EQ(started.header("location"), "/api/jobs/" + job_id);
+  // The archive has it as running before the rig moves.
+  EXPECT_EQ(parse(op.get("/api/scans/" + scan_id))["status"], "running");
+  const HttpReply second = op.post("/api/scans", R"({"customer": {"name": "Next"}})");
+  EXPECT_EQ(second.status, 409);
+  EXPECT_NE(second.body.find("busy"), std::string::npos) << second.body;
+  EXPECT_EQ(op.post("/api/rig/calibrate").status, 409);
+
+  std::set<std::string> stages;
+  int previews = 0, progress = 0;
+  int64_t frames = 0;
+  nlohmann::json finished;
+  const auto until = std::chrono::steady_clock::now() + 300s;
+  while (finished.is_null() && std::chrono::steady_clock::now() < until) {
+    auto m = events->next(30s);
+    ASSERT_TRUE(m) << "the event stream went quiet";
+    const nlohmann::json e = nlohmann::json::parse(*m);
+    if (e["type"] == "job") {
+      ++progress;
+      stages.insert(e["job"]["stage"].get<std::string>());
+      frames = std::max(frames, e["job"]["frames"].get<int64_t>());
+    } else if (e["type"] == "preview") {
+      ++previews;
+      const std::string b64 = e["png_base64"];
+      std::vector<unsigned char> bin(b64.size());
+      size_t len = 0;
+      ASSERT_EQ(sodium_base642bin(bin.data(), bin.size(), b64.data(), b64.size(), nullptr, &len, nullptr,
+                                  sodium_base64_VARIANT_ORIGINAL),
+                0);
+      ASSERT_GT(len, 8u);
+      EXPECT_EQ(std::string(reinterpret_cast<char*>(bin.data()) + 1, 3), "PNG");
+    } else if (e["type"] == "scan_finished") {
+      finished = e["job"];
+    }
+  }
+  ASSERT_FALSE(finished.is_null());
+  EXPECT_EQ(finished["state"], "complete") << finished.dump();
+  EXPECT_TRUE(stages.count("scan")) << "stages seen: " << nlohmann::json(stages).dump();
+  EXPECT_TRUE(std::any_of(stages.begin(), stages.end(), [](const std::string& x) { return x.rfind("calibration", 0) == 0; }))
+      << "a fresh rig calibrates before its first scan";
+  EXPECT_GT(progress, 20);
+  EXPECT_GT(previews, 3);
+  EXPECT_GT(frames, 100);
+
+  const nlohmann::json scan = parse(op.get("/api/scans/" + scan_id));
+  EXPECT_EQ(scan["status"], "complete");
+  EXPECT_EQ(scan["current_version"], 1);
+  EXPECT_FALSE(scan["calibration_id"].get<std::string>().empty());
+  const nlohmann::json rig = parse(op.get("/api/rig"));
+  EXPECT_FALSE(rig["busy"].get<bool>());
+  ASSERT_TRUE(rig["calibration"].is_object());
+  for (const auto& l : rig["lasers"]) EXPECT_EQ(l["on"], false) << "a laser left on after the scan";
+
+  // The served model is the demo body as the simulated rig stands it (centred,
+  // on the floor): its crown within 15 mm of the true mesh's (the model is in
+  // metres on the wire, mm once decoded).
+  const HttpReply glb = op.get("/api/scans/" + scan_id + "/mesh.glb");
+  ASSERT_EQ(glb.status, 200);
+  EXPECT_EQ(glb.header("content-type"), "model/gltf-binary");
+  auto decoded = storage::decode_glb(glb.body);
+  ASSERT_TRUE(decoded.ok()) << decoded.status().message();
+  TriangleMesh truth_mesh = s.body;
+  {
+    Vec3d centre = Vec3d::Zero();
+    double min_y = 1e9;
+    for (const Vec3f& v : truth_mesh.vertices) centre += v.cast<double>(), min_y = std::min(min_y, double(v.y()));
+    centre /= double(truth_mesh.vertices.size());
+    const double floor_y = -0.5 * s.ws->simulated_rig()->description().frame.tube;
+    const Vec3f shift(float(-centre.x()), float(floor_y - min_y), float(-centre.z()));
+    for (Vec3f& v : truth_mesh.vertices) v += shift;
+  }
+  Vec3f lo = Vec3f::Constant(1e9f), hi = Vec3f::Constant(-1e9f), tlo = lo, thi = hi;
+  for (const Vec3f& v : decoded->vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  for (const Vec3f& v : truth_mesh.vertices) tlo = tlo.cwiseMin(v), thi = thi.cwiseMax(v);
+  EXPECT_NEAR(hi.y(), thi.y(), 15) << "the crown";
+  EXPECT_NEAR(hi.x() - lo.x(), thi.x() - tlo.x(), 30) << "the width (arms)";
+  // The waist girth evaluated by the server on the scan against the true body,
+  // within the ISO 20685-1 allowance for large girths (9 mm).
+  const double waist_y = tlo.y() + 0.6 * (thi.y() - tlo.y());
+  const std::string plane = "{\"kind\": \"girth\", \"plane\": {\"point\": [0, " + std::to_string(waist_y) +
+                            ", 0], \"normal\": [0, 1, 0]}}";
+  const HttpReply girth = op.post("/api/scans/" + scan_id + "/measure", plane);
+  ASSERT_EQ(girth.status, 200) << girth.body;
+  auto truth = mesh_girth(truth_mesh, Plane{Eigen::Vector3d(0, waist_y, 0), Eigen::Vector3d::UnitY()}, std::nullopt);
+  ASSERT_TRUE(truth.ok());
+  EXPECT_NEAR(parse(girth)["value_mm"].get<double>(), truth->value_mm, 9.0);
+}
+
+// Cancelling stops the scan at the next frame: the job and the archived scan say
+// who cancelled it, every laser is off, and the rig takes the next job.
+TEST(ApiScan, CancelStopsTheScanAndTurnsTheLasersOff) {
+  ServerUnderTest s(4);
+  Client op = s.as("op");
+  const HttpReply started = op.post("/api/scans", "{\"customer_id\": \"" + s.customer_id + "\"}");
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::string job = parse(started)["job"]["id"], scan_id = parse(started)["job"]["scan_id"];
+  // Into the scan proper (lasers sweeping) before cancelling.
+  const auto until = std::chrono::steady_clock::now() + 240s;
+  for (;;) {
+    const nlohmann::json j = parse(op.get("/api/jobs/" + job))["job"];
+    if (j["stage"] == "scan" && j["frames"].get<int64_t>() > 20) break;
+    ASSERT_EQ(j["state"], "running") << j.dump();
+    ASSERT_LT(std::chrono::steady_clock::now(), until);
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_EQ(Client{s.port}.post("/api/jobs/" + job + "/cancel").status, 401);
+  EXPECT_EQ(s.as("tailor").post("/api/jobs/" + job + "/cancel").status, 403);
+  EXPECT_EQ(op.post("/api/jobs/" + job + "/cancel").status, 202);
+  const nlohmann::json j = wait_job(op, job, 30);
+  EXPECT_EQ(j["state"], "cancelled");
+  EXPECT_EQ(j["error"], "cancelled by op");
+  const nlohmann::json scan = parse(op.get("/api/scans/" + scan_id));
+  EXPECT_EQ(scan["status"], "cancelled");
+  EXPECT_EQ(scan["status_reason"], "cancelled by op");
+  for (int i = 0; i < s.ws->simulated_rig()->controller().num_lasers(); ++i)
+    EXPECT_FALSE(s.ws->simulated_rig()->controller().laser_on(i)) << "laser " << i;
+  EXPECT_EQ(op.post("/api/jobs/" + job + "/cancel").status, 409);
+  EXPECT_EQ(op.post("/api/jobs/j_unknown/cancel").status, 404);
+}
+
+// A camera that stops answering mid-scan: the job fails naming it, the scan is
+// marked failed with the reason, nothing else in the archive changes, the lasers
+// are off and the rig status shows the device error.
+TEST(ApiScan, ACameraThatStopsMidScanFailsTheJobClearly) {
+  ServerUnderTest s(12);
+  Client op = s.as("op");
+  const size_t scans_before = parse(op.get("/api/scans"))["scans"].size();
+  // Calibrated first, so that the camera fails in the scan proper, 30 frames in.
+  const HttpReply cal = op.post("/api/rig/calibrate");
+  ASSERT_EQ(cal.status, 202) << cal.body;
+  EXPECT_EQ(wait_job(op, parse(cal)["job"]["id"])["state"], "complete");
+  s.ws->simulated_rig()->fail_camera_after(1, 30, StatusCode::kUnavailable);
+  const HttpReply started = op.post("/api/scans", "{\"customer_id\": \"" + s.customer_id + "\"}");
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::string job = parse(started)["job"]["id"], scan_id = parse(started)["job"]["scan_id"];
+  const nlohmann::json j = wait_job(op, job);
+  EXPECT_EQ(j["state"], "failed") << j.dump();
+  const std::string error = j.value("error", "");
+  EXPECT_NE(error.find("front-right"), std::string::npos) << error;
+  const nlohmann::json scan = parse(op.get("/api/scans/" + scan_id));
+  EXPECT_EQ(scan["status"], "failed");
+  EXPECT_EQ(scan["status_reason"], error);
+  EXPECT_EQ(parse(op.get("/api/scans"))["scans"].size(), scans_before + 1);
+  EXPECT_EQ(parse(op.get("/api/scans/" + s.scan_id))["status"], "complete") << "the earlier scan is untouched";
+  const nlohmann::json rig = parse(op.get("/api/rig"));
+  for (const auto& l : rig["lasers"]) EXPECT_EQ(l["on"], false);
+  EXPECT_NE(rig.value("last_device_error", "").find("front-right"), std::string::npos) << rig.dump();
+}
+
+// A tailor's work on a finished scan: the automatic set, a girth drawn as a line
+// on screen (evaluated by the server around the loop under the line), saved and
+// deleted, the sheets, and downloads that revalidate by ETag.
+TEST(ApiScan, TailorMeasuresSavesAndExports) {
+  ServerUnderTest s;
+  Client t = s.as("tailor");
+  const std::string base = "/api/scans/" + s.scan_id;
+  const nlohmann::json auto_set = parse(t.get(base + "/measurements"));
+  ASSERT_GT(auto_set["measurements"].size(), 20u);
+  double waist_y = 0, waist_mm = 0;
+  for (const auto& m : auto_set["measurements"])
+    if (m["name"] == "waist_girth") {
+      waist_mm = m["value_mm"];
+      waist_y = m["geometry"]["plane"]["point"][1];
+    }
+  ASSERT_GT(waist_mm, 0);
+  // A horizontal line across the front of the waist, seen from the front: the
+  // plane holds the line and the view direction; the loop is the torso's.
+  const std::string line = "{\"kind\": \"girth\", \"line\": {\"from\": [-250, " + std::to_string(waist_y) +
+                           ", 300], \"to\": [250, " + std::to_string(waist_y) + ", 300]}, \"view\": [0, 0, -1]}";
+  const HttpReply g = t.post(base + "/measure", line);
+  ASSERT_EQ(g.status, 200) << g.body;
+  EXPECT_NEAR(parse(g)["value_mm"].get<double>(), waist_mm, 3.0) << "the same cut as the automatic waist";
+  EXPECT_TRUE(parse(g)["closed"].get<bool>());
+  const HttpReply saved = t.post(base + "/measurements", "{\"name\": \"waist at the line\", \"request\": " + line + "}");
+  ASSERT_EQ(saved.status, 201) << saved.body;
+  const int64_t id = parse(saved)["id"];
+  EXPECT_EQ(parse(saved)["source"], "user");
+  EXPECT_EQ(parse(saved)["created_by"], "tailor");
+  const HttpReply csv = t.get(base + "/sheet.csv?unit=cm");
+  ASSERT_EQ(csv.status, 200);
+  EXPECT_NE(csv.header("content-type").find("text/csv"), std::string::npos);
+  EXPECT_NE(csv.header("content-disposition").find("attachment"), std::string::npos);
+  EXPECT_NE(csv.body.find("waist at the line"), std::string::npos);
+  EXPECT_NE(csv.body.find("saved by tailor"), std::string::npos);
+  const HttpReply json = t.get(base + "/sheet.json?unit=in");
+  ASSERT_EQ(json.status, 200);
+  EXPECT_EQ(parse(json)["unit"], "in");
+  const HttpReply pdf = t.get(base + "/sheet.pdf");
+  ASSERT_EQ(pdf.status, 200);
+  EXPECT_EQ(pdf.body.substr(0, 5), "%PDF-");
+  EXPECT_EQ(t.get(base + "/sheet.csv?unit=furlong").status, 400);
+  // Other kinds: point to point, over the skin, along the tape.
+  EXPECT_NEAR(parse(t.post(base + "/measure", R"({"kind": "distance", "from": [0, 0, 0], "to": [30, 40, 0]})"))["value_mm"]
+                  .get<double>(),
+              50.0, 1e-9);
+  EXPECT_EQ(t.post(base + "/measure", R"({"kind": "girth"})").status, 400);
+  EXPECT_EQ(t.post(base + "/measure", R"({"kind": "girth", "plane": {"point": [0, 1, 0], "normal": [0, 0, 0]}})").status,
+            400);
+  EXPECT_EQ(t.post(base + "/measure", R"({"kind": "spiral"})").status, 400);
+  EXPECT_EQ(t.post(base + "/measure", R"({"kind": "distance", "from": [0, 0], "to": [1, 1, 1]})").status, 400);
+  EXPECT_EQ(t.post("/api/scans/s_none/measure", R"({"kind": "girth", "plane": {"point": [0, 1, 0], "normal": [0, 1, 0]}})")
+                .status,
+            404);
+  // The automatic set cannot be deleted; the saved one can.
+  EXPECT_EQ(t.del(base + "/measurements/" + std::to_string(auto_set["measurements"][0]["id"].get<int64_t>())).status, 404);
+  EXPECT_EQ(t.del(base + "/measurements/" + std::to_string(id)).status, 204);
+  EXPECT_EQ(t.get(base + "/sheet.csv").body.find("waist at the line"), std::string::npos);
+  // Downloads: the ETag is the file's checksum; a match is 304 with no body.
+  const HttpReply glb = t.get(base + "/mesh.glb");
+  ASSERT_EQ(glb.status, 200);
+  const std::string etag = glb.header("etag");
+  ASSERT_FALSE(etag.empty());
+  EXPECT_EQ(glb.header("cache-control"), "private, no-cache");
+  const HttpReply again = t.get(base + "/mesh.glb", {{"If-None-Match", etag}});
+  EXPECT_EQ(again.status, 304);
+  EXPECT_TRUE(again.body.empty());
+  const HttpReply v1 = t.get(base + "/mesh.glb?version=1");
+  EXPECT_EQ(v1.status, 200);
+  EXPECT_NE(v1.header("cache-control").find("immutable"), std::string::npos);
+  EXPECT_EQ(t.get(base + "/mesh.glb?version=7").status, 404);
+  EXPECT_EQ(t.get(base + "/mesh.glb?version=x").status, 400);
+  const HttpReply drc = t.get(base + "/points.drc");
+  EXPECT_EQ(drc.status, 200);
+  EXPECT_EQ(drc.header("content-type"), "application/octet-stream");
+  EXPECT_EQ(drc.body.substr(0, 5), "DRACO");
+  const HttpReply head = t.request("HEAD", base + "/mesh.glb", "");
+  EXPECT_EQ(head.status, 200);
+  EXPECT_EQ(head.header("content-length"), std::to_string(glb.body.size()));
+}
+
+// Share links: what the customer sees is what staff chose; withdrawing or
+// expiry closes the link; deleting the scan takes its links with it.
+TEST(ApiScan, ShareLinksShowOnlyWhatWasSharedUntilWithdrawnOrExpired) {
+  ServerUnderTest s;
+  Client op = s.as("op");
+  const std::string base = "/api/scans/" + s.scan_id;
+  const HttpReply made = op.post(base + "/shares", R"({"days": 30, "measurements": ["waist_girth", "hip_girth"]})");
+  ASSERT_EQ(made.status, 201) << made.body;
+  const nlohmann::json link = parse(made);
+  const std::string token = link["token"];
+  EXPECT_EQ(token.size(), 22u) << "128 bits, base64url";
+  EXPECT_EQ(link["url"], "http://127.0.0.1:" + std::to_string(s.port) + "/s/" + token);
+  const nlohmann::json seen = parse(http(s.port, "GET", "/api/share/" + token));
+  ASSERT_EQ(seen["measurements"].size(), 2u) << seen.dump();
+  for (const auto& m : seen["measurements"]) {
+    EXPECT_TRUE(m["name"] == "waist_girth" || m["name"] == "hip_girth");
+    EXPECT_FALSE(m.contains("created_by"));
+  }
+  EXPECT_FALSE(seen.contains("customer_id"));
+  EXPECT_EQ(seen.dump().find("Demo Customer"), std::string::npos);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + token + "/mesh.glb").body.substr(0, 4), "glTF");
+  // The list never shows tokens again.
+  const nlohmann::json list = parse(op.get(base + "/shares"));
+  ASSERT_EQ(list["shares"].size(), 1u);
+  EXPECT_FALSE(list["shares"][0].contains("token"));
+  EXPECT_EQ(op.del("/api/shares/" + link["id"].get<std::string>()).status, 204);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + token).status, 404);
+  // Expiry: a link for a second.
+  const HttpReply brief = op.post(base + "/shares", R"({"days": 0.00001})");
+  ASSERT_EQ(brief.status, 201);
+  const std::string brief_token = parse(brief)["token"];
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + brief_token).status, 200);
+  std::this_thread::sleep_for(2100ms);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + brief_token).status, 404);
+  EXPECT_EQ(op.post(base + "/shares", R"({"days": 400})").status, 400);
+  EXPECT_EQ(op.post(base + "/shares", R"({"measurements": "waist"})").status, 400);
+  // Deleting the scan (admin) withdraws its links.
+  const std::string kept = parse(op.post(base + "/shares", "{}"))["token"];
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + kept).status, 200);
+  Client admin = s.as("admin");
+  EXPECT_EQ(admin.del(base).status, 204);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + kept).status, 404);
+  EXPECT_EQ(admin.get(base).status, 404);
+}
+
+// Erasing a customer through the API: their scans, files and links go.
+TEST(ApiScan, AdminErasesACustomer) {
+  ServerUnderTest s;
+  Client admin = s.as("admin");
+  const std::string token = parse(admin.post("/api/scans/" + s.scan_id + "/shares", "{}"))["token"];
+  EXPECT_EQ(s.as("tailor").del("/api/customers/" + s.customer_id).status, 403);
+  EXPECT_EQ(admin.del("/api/customers/" + s.customer_id).status, 204);
+  EXPECT_EQ(admin.get("/api/customers/" + s.customer_id).status, 404);
+  EXPECT_EQ(admin.get("/api/scans/" + s.scan_id).status, 404);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + token).status, 404);
+  EXPECT_EQ(admin.del("/api/customers/" + s.customer_id).status, 404);
+}
+
+}  // namespace
+}  // namespace bodyscan::testing
