@@ -1,14 +1,13 @@
 #!/usr/bin/env bash
 # The workstation server under HTTP load: wrk against a scan's measurements (JSON)
 # and its mesh (GLB), first with the rig idle, then while a long scan runs.
-#   [BODYSCAN_BIN=PATH] [DURATION=15] [THREADS=2] [CONNECTIONS=50] [FIRST_EVERY=12] bench/server_load.sh
+#   [BODYSCAN_BIN=PATH] [DURATION=15] [THREADS=2] [CONNECTIONS=50] [FIRST_EVERY=6] bench/server_load.sh
 # Builds nothing. Starts its own server on a free port with a throw-away archive and
-# an empty web root, makes one scan (every=12, ~35 s with calibration on 2 cores)
-# to have a mesh and measurements, measures, then starts a scan with every=1
+# an empty web root, makes one scan (every=6, ~45 s with calibration on 2 cores:
+# the sparsest that closes the surface and gives the automatic measurements) to
+# have a mesh and measurements, measures, then starts a scan with every=1
 # (~2-3 min) and measures again while it runs, cancels it and stops the server.
-# On the default body every=12 is too sparse for the automatic measurements (no
-# neck found), so the JSON is an empty list (70 bytes; the report says so);
-# FIRST_EVERY=4 (~100 s) gives the 31 measurements (~790 KB of JSON).
+# (every=12 leaves the surface in pieces and the measurements list empty.)
 # Prints a markdown table. Needs curl, wrk (Debian package wrk) and python3.
 # KEEP_LOGS=1 keeps the temp dir (server log, wrk outputs) and says where.
 set -euo pipefail
@@ -111,9 +110,9 @@ start_scan() {  # EVERY; sets job_id and scan_id
 
 # --- the scan to read --------------------------------------------------------------
 t0=$SECONDS
-start_scan "${FIRST_EVERY:-12}"
+start_scan "${FIRST_EVERY:-6}"
 job="$job_id"
-log "scan $scan_id (job $job, every=${FIRST_EVERY:-12}) started; waiting for it"
+log "scan $scan_id (job $job, every=${FIRST_EVERY:-6}) started; waiting for it"
 while :; do
   line="$(job_line "$job")"
   case "${line%% *}" in
@@ -271,7 +270,7 @@ machine: $(nproc) CPUs, ${cpu:-unknown CPU}; load average at the end $(cut -d' '
 server: $bin ($build_type) serve --every 12 (default --workers), archive in a temp dir
 command: wrk -t$threads -c$connections -d${duration}s --latency -H "Cookie: bodyscan_session=..." URL
 responses: GET /api/scans/ID/measurements $json_bytes bytes ($json_type, $n_measurements measurements), $json_alone ms alone; GET /api/scans/ID/mesh.glb $glb_bytes bytes ($glb_type), $glb_alone ms alone (median of 5 single requests, idle)
-scan read: every=${FIRST_EVERY:-12}, version note: $scan_note
+scan read: every=${FIRST_EVERY:-6}, version note: $scan_note
 
 | case | requests/s | p50 ms | p99 ms | transfer MB/s | errors (non-2xx or socket) |
 |---|---:|---:|---:|---:|---|

@@ -18,11 +18,13 @@ packages=(
   libcairo2-dev fonts-dejavu-core  # measurement sheets as PDF (storage/formats)
   libsqlite3-dev       # the scan archive's index (storage/archive)
   libsodium-dev        # checksums of archived files; password hashing (server)
+  libboost1.81-dev     # Beast HTTP + WebSocket (server); 1.74 lacks message_generator
+  libssl-dev openssl   # TLS for `bodyscan serve`; the tests make a certificate with openssl
   libgtest-dev libgmock-dev libbenchmark-dev
   poppler-utils        # pdftotext: the tests read the PDF sheets back
 )
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(python3-open3d python3-numpy time)
+  packages+=(python3-open3d python3-numpy time wrk curl)
 fi
 
 missing=()

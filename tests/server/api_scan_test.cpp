@@ -27,13 +27,14 @@ nlohmann::json wait_job(const Client& c, const std::string& id, double timeout_s
   return j;
 }
 
-// An operator scans a new customer on the simulated rig (every 12th laser step),
+// An operator scans a new customer on the simulated rig (every 6th laser step: the
+// sparsest that still closes the body's surface; every 12th leaves it in pieces),
 // following it over the WebSocket: progress by stage, frame counts, camera
 // previews (real PNGs), the end. A second scan meanwhile gets 409; a client that
 // never reads its events does not hold anything up. The result is the demo
 // body: its served model's bounds and a girth agree with the true mesh.
 TEST(ApiScan, SimulatedScanThroughTheApiWithLiveEvents) {
-  ServerUnderTest s(12);
+  ServerUnderTest s(6);
   Client op = s.as("op");
   auto events = EventStream::open(s.port, op.cookie);
   ASSERT_NE(events, nullptr);
