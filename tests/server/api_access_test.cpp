@@ -247,3 +247,44 @@ TEST_F(ApiAccess, EventsNeedAStaffSession) {
 
 }  // namespace
 }  // namespace bodyscan::testing
+
+namespace bodyscan::testing {
+namespace {
+
+// An admin manages the staff: add, change role and password (which ends the
+// account's sessions), delete; never the last admin.
+TEST(ApiAccounts, AdminManagesStaffAccounts) {
+  ServerUnderTest s;
+  Client admin = s.as("admin");
+  const HttpReply made = admin.post("/api/accounts", R"({"username": "fitter", "password": "measure twice cut once", "role": "tailor"})");
+  ASSERT_EQ(made.status, 201) << made.body;
+  EXPECT_EQ(parse(made)["role"], "tailor");
+  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "fitter", "password": "measure twice cut once", "role": "tailor"})").status, 409);
+  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "x y", "password": "measure twice cut once", "role": "tailor"})").status, 400);
+  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "shorty", "password": "short", "role": "tailor"})").status, 400);
+  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "boss", "password": "measure twice cut once", "role": "king"})").status, 400);
+  const nlohmann::json list = parse(admin.get("/api/accounts"));
+  EXPECT_EQ(list["accounts"].size(), 4u);
+  Client fitter = login(s.port, "fitter", "measure twice cut once");
+  ASSERT_FALSE(fitter.cookie.empty());
+  EXPECT_EQ(fitter.post("/api/rig/calibrate").status, 403);
+  ASSERT_EQ(admin.put("/api/accounts/fitter", R"({"role": "operator"})").status, 200);
+  EXPECT_EQ(parse(fitter.get("/api/session"))["role"], "operator") << "a role change applies to live sessions";
+  ASSERT_EQ(admin.put("/api/accounts/fitter", R"({"password": "a brand new password"})").status, 200);
+  EXPECT_EQ(fitter.get("/api/session").status, 401) << "a new password ends the account's sessions";
+  EXPECT_FALSE(login(s.port, "fitter", "a brand new password").cookie.empty());
+  EXPECT_EQ(admin.put("/api/accounts/nobody", R"({"role": "operator"})").status, 404);
+  EXPECT_EQ(admin.put("/api/accounts/admin", R"({"role": "tailor"})").status, 409) << "the last admin";
+  EXPECT_EQ(admin.del("/api/accounts/admin").status, 409) << "the last admin";
+  EXPECT_EQ(admin.del("/api/accounts/fitter").status, 204);
+  EXPECT_TRUE(login(s.port, "fitter", "a brand new password").cookie.empty());
+  EXPECT_EQ(admin.del("/api/accounts/fitter").status, 404);
+  // Every change is in the audit log, by whom.
+  auto audit = s.ws->archive().audit("fitter");
+  ASSERT_TRUE(audit.ok());
+  EXPECT_GE(audit->size(), 3u);
+  for (const auto& e : *audit) EXPECT_TRUE(e.actor == "admin" || e.actor == "fitter") << e.actor;
+}
+
+}  // namespace
+}  // namespace bodyscan::testing
