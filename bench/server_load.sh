@@ -57,7 +57,7 @@ jget() { python3 -c 'import json,sys; j=json.load(sys.stdin); print(eval(sys.arg
 
 # --- the server -------------------------------------------------------------------
 mkdir -p "$tmp/data" "$tmp/web"
-BODYSCAN_ADMIN_PASSWORD="$password" "$bin" serve --data "$tmp/data" --port 0 --web "$tmp/web" --every 12 \
+BODYSCAN_ADMIN_PASSWORD="$password" "$bin" serve --data "$tmp/data" --port 0 --web "$tmp/web" \
   >"$tmp/server.log" 2>&1 &
 server_pid=$!
 port=""
@@ -152,10 +152,12 @@ glb_alone="$(alone_ms "$glb_url")"
 # --- the load ------------------------------------------------------------------------
 rows=()
 notes=()
-run_wrk() {  # NAME URL
+run_wrk() {  # NAME URL [HEADER]
   local out="$tmp/wrk-${#rows[@]}.txt"
+  local extra=()
+  if [[ -n "${3:-}" ]]; then extra=(-H "$3"); fi
   log "wrk: $1 (${duration}s)"
-  wrk -t"$threads" -c"$connections" -d"${duration}s" --latency -H "$cookie" "$2" >"$out" 2>&1 ||
+  wrk -t"$threads" -c"$connections" -d"${duration}s" --latency -H "$cookie" "${extra[@]}" "$2" >"$out" 2>&1 ||
     { cat "$out" >&2; log "wrk failed"; exit 1; }
   if [[ "${VERBOSE:-0}" == 1 ]]; then cat "$out" >&2; fi
   rows+=("$(python3 "$tmp/parse_wrk.py" "$1" "$out")")
@@ -209,6 +211,7 @@ print(f"| {name} | {rps:.0f} | {p50:.1f} | {p99:.1f} | {xfer:.1f} | {errors} of 
 EOF
 
 run_wrk "measurements JSON, idle" "$json_url"
+run_wrk "measurements JSON gzip (as browsers ask), idle" "$json_url" "Accept-Encoding: gzip"
 run_wrk "mesh.glb, idle" "$glb_url"
 
 t0=$SECONDS
@@ -221,10 +224,10 @@ busy_check="a second POST /api/scans while it runs: HTTP $(status)"
 [[ "$(status)" == 409 ]] || busy_check+=" (expected 409): $out"
 notes+=("- $busy_check")
 log "$busy_check"
-during() {  # NAME URL
+during() {  # NAME URL [HEADER]
   local before after
   before="$(job_line "$long_job")"
-  run_wrk "$1" "$2"
+  run_wrk "$1" "$2" "${3:-}"
   after="$(job_line "$long_job")"
   local verdict="running throughout"
   [[ "${before%% *}" == running && "${after%% *}" == running ]] || verdict="NOT running throughout"
@@ -232,6 +235,7 @@ during() {  # NAME URL
   log "$1: scan $verdict (before: $before; after: $after)"
 }
 during "measurements JSON, during a scan" "$json_url"
+during "measurements JSON gzip, during a scan" "$json_url" "Accept-Encoding: gzip"
 during "mesh.glb, during a scan" "$glb_url"
 
 final="$(job_line "$long_job")"
@@ -267,7 +271,7 @@ cat <<EOF
 ## Workstation server under load
 
 machine: $(nproc) CPUs, ${cpu:-unknown CPU}; load average at the end $(cut -d' ' -f1-3 /proc/loadavg)
-server: $bin ($build_type) serve --every 12 (default --workers), archive in a temp dir
+server: $bin ($build_type) serve (default --workers), archive in a temp dir
 command: wrk -t$threads -c$connections -d${duration}s --latency -H "Cookie: bodyscan_session=..." URL
 responses: GET /api/scans/ID/measurements $json_bytes bytes ($json_type, $n_measurements measurements), $json_alone ms alone; GET /api/scans/ID/mesh.glb $glb_bytes bytes ($glb_type), $glb_alone ms alone (median of 5 single requests, idle)
 scan read: every=${FIRST_EVERY:-6}, version note: $scan_note

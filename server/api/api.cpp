@@ -163,9 +163,7 @@ HttpResponse Api::handle(const HttpRequest& request) {
   } else if (changes_state && foreign_origin(request)) {
     return error_response(403, "cross-site request refused");
   }
-  HttpResponse response = route->handler(ws_, call);
-  if (request.method == "HEAD") response.body.clear();
-  return response;
+  return route->handler(ws_, call);
 }
 
 }  // namespace bodyscan::server

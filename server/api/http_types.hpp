@@ -37,8 +37,7 @@ struct HttpRequest {
 struct HttpResponse {
   int status = 200;
   std::vector<std::pair<std::string, std::string>> headers;
-  std::string body;
-  std::string file;  // when set, the body is this file's content (served from disk)
+  std::string body;  // kept for HEAD too: the network layer sends only its length
 
   HttpResponse& set(const std::string& name, const std::string& value) {
     for (auto& h : headers)

@@ -1,5 +1,7 @@
 #include "server/api/static_files.hpp"
 
+#include "recon/io/atomic_file.hpp"
+
 #include <filesystem>
 #include <map>
 #include <system_error>
@@ -101,7 +103,10 @@ HttpResponse serve_static(const std::string& web_root, const HttpRequest& reques
     r.status = 304;
     return r;
   }
-  r.file = real.string();
+  // Read on the worker pool (see scan_file); the UI's files are at most a few MB.
+  auto bytes = read_whole_file(real.string());
+  if (!bytes.ok()) return error_response(bytes.status());
+  r.body = std::move(*bytes);
   return r;
 }
 

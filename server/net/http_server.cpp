@@ -99,24 +99,6 @@ void apply(const HttpResponse& r, unsigned version, bool keep_alive, http::respo
 }
 
 http::message_generator make_message(HttpResponse r, unsigned version, bool keep_alive, bool head) {
-  if (!r.file.empty()) {
-    beast::error_code ec;
-    http::file_body::value_type body;
-    body.open(r.file.c_str(), beast::file_mode::scan, ec);
-    if (ec) {
-      r = error_response(500, "could not read " + r.file + ": " + ec.message());
-    } else if (head) {
-      http::response<http::empty_body> res;
-      apply(r, version, keep_alive, &res);
-      res.content_length(body.size());
-      return res;
-    } else {
-      http::response<http::file_body> res{std::piecewise_construct, std::make_tuple(std::move(body))};
-      apply(r, version, keep_alive, &res);
-      res.prepare_payload();
-      return res;
-    }
-  }
   http::response<http::string_body> res;
   apply(r, version, keep_alive, &res);
   const size_t size = r.body.size();
@@ -332,7 +314,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   }
 
   void on_write(bool keep_alive, beast::error_code ec, size_t) {
-    // A client that goes away mid-download ends here, its file closed with it.
+    // A client that goes away mid-download ends here; nothing else is held for it.
     if (ec) return fail(ec, "write");
     if (!keep_alive) return do_close();
     do_read();
@@ -379,6 +361,9 @@ struct HttpServer::Impl {
         if (!acceptor.is_open()) return;
       } else {
         beast::error_code e2;
+        // Responses go out in several writes (headers, file chunks): without
+        // this, Nagle holds the last one for the client's delayed ACK (40 ms).
+        socket.set_option(tcp::no_delay(true), e2);
         const auto ep = socket.remote_endpoint(e2);
         std::string remote = e2 ? "?" : ep.address().to_string();
         if (tls)

@@ -1,6 +1,8 @@
 #include "server/workstation/workstation.hpp"
 
 #include <sodium.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -117,6 +119,8 @@ std::string gzip(const std::string& in) {
   deflateEnd(&z);
   return rc == Z_STREAM_END ? out : std::string();
 }
+
+constexpr int kJobNice = 5;
 
 constexpr const char* kCalibrationFile = "calibration-record.json";  // in DATA/workstation/
 
@@ -347,6 +351,10 @@ void Workstation::Impl::run(JobInfo j, std::function<Status()> work) {
   job = j;
   running = true;
   worker = std::thread([this, work = std::move(work)]() {
+    // A scan is batch work beside the staff's clicks: a little lower priority keeps
+    // the API's answers quick while both want the cores (docs/benchmarks.md §9).
+    // Mild, so that a real rig's acquisition still keeps pace with its cameras.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kJobNice);
     publish_job();
     publish_rig();
     Status st;
