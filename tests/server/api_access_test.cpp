@@ -241,7 +241,7 @@ TEST_F(ApiAccess, EventsNeedAStaffSession) {
   const nlohmann::json j = nlohmann::json::parse(*hello);
   EXPECT_EQ(j["type"], "hello");
   EXPECT_EQ(j["rig"]["cameras"].size(), 3u);
-  EXPECT_EQ(Client{server_->port}.get("/api/events").status, 401);
+  EXPECT_EQ(anonymous(server_->port).get("/api/events").status, 401);
   EXPECT_EQ(t.get("/api/events").status, 426);
 }
 

@@ -159,7 +159,7 @@ TEST(ApiScan, CancelStopsTheScanAndTurnsTheLasersOff) {
     ASSERT_LT(std::chrono::steady_clock::now(), until);
     std::this_thread::sleep_for(100ms);
   }
-  EXPECT_EQ(Client{s.port}.post("/api/jobs/" + job + "/cancel").status, 401);
+  EXPECT_EQ(anonymous(s.port).post("/api/jobs/" + job + "/cancel").status, 401);
   EXPECT_EQ(s.as("tailor").post("/api/jobs/" + job + "/cancel").status, 403);
   EXPECT_EQ(op.post("/api/jobs/" + job + "/cancel").status, 202);
   const nlohmann::json j = wait_job(op, job, 30);

@@ -59,6 +59,12 @@ struct Client {
   HttpReply request(const std::string& method, const std::string& target, const std::string& body,
                     std::map<std::string, std::string> headers = {}) const;
 };
+// No session: what anyone on the network can send.
+inline Client anonymous(int port) {
+  Client c;
+  c.port = port;
+  return c;
+}
 // Logs in; an empty cookie when it failed.
 Client login(int port, const std::string& user, const std::string& password, bool tls = false);
 

@@ -91,9 +91,9 @@ TEST_F(HttpLimits, StaticFilesStayInTheWebRootWithTheirMimeTypes) {
   EXPECT_NE(http(port, "GET", "/s/sometoken").body.find("<title>bodyscan</title>"), std::string::npos);
   EXPECT_EQ(http(port, "GET", "/missing.js").status, 404);
   // Escapes, encoded or not, hidden files, and symlinks out of the root.
-  for (const std::string& evil : {"/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd", "/assets/..%2f..%2fsecret",
+  for (const char* evil : {"/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd", "/assets/..%2f..%2fsecret",
                                   "/.env", "/%2eenv", "/assets/%00x", "/a\\..\\b", "/link.txt", "//etc/passwd"}) {
-    const std::string reply = raw(port, "GET " + evil + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+    const std::string reply = raw(port, std::string("GET ") + evil + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
     const int st = status_of(reply);
     EXPECT_TRUE(st == 400 || st == 404) << evil << ": " << st;
     EXPECT_EQ(reply.find("secret"), std::string::npos) << evil;
