@@ -15,6 +15,7 @@
 #include <mutex>
 #include <unordered_map>
 
+#include "storage/archive/ids.hpp"
 #include "storage/archive/sqlite.hpp"
 
 namespace bodyscan::server {
@@ -65,23 +66,7 @@ int64_t system_now() {
       .count();
 }
 
-std::string iso_utc(int64_t unix_s) {
-  const std::time_t t = static_cast<std::time_t>(unix_s);
-  std::tm utc{};
-  gmtime_r(&t, &utc);
-  char b[40];
-  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return b;
-}
 
-std::string random_hex(size_t bytes) {
-  std::vector<unsigned char> b(bytes);
-  randombytes_buf(b.data(), b.size());
-  std::string hex(bytes * 2 + 1, '\0');
-  sodium_bin2hex(hex.data(), hex.size(), b.data(), b.size());
-  hex.pop_back();
-  return hex;
-}
 
 constexpr int kBase64Url = sodium_base64_VARIANT_URLSAFE_NO_PADDING;
 
@@ -457,7 +442,7 @@ StatusOr<std::unique_ptr<AuthStore>> AuthStore::open(const std::string& db_path,
   ASSIGN_OR_RETURN(Database db, Database::open(db_path));
   auto impl = std::make_unique<Impl>(std::move(db), std::move(options));
   RETURN_IF_ERROR(impl->schema().with_context(db_path));
-  ASSIGN_OR_RETURN(impl->dummy_hash, impl->hash_password(random_hex(32)));
+  ASSIGN_OR_RETURN(impl->dummy_hash, impl->hash_password(storage::random_hex(32)));
   return std::unique_ptr<AuthStore>(new AuthStore(std::move(impl)));
 }
 
@@ -480,7 +465,7 @@ StatusOr<Account> AuthStore::add_account(const std::string& username, const std:
   ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
   if (existing)
     return failed_precondition("an account named '" + existing->username + "' already exists");
-  Account a{username, role, iso_utc(impl_->now())};
+  Account a{username, role, storage::iso8601_utc(impl_->now())};
   ASSIGN_OR_RETURN(
       Statement st,
       impl_->db.prepare(
@@ -688,11 +673,11 @@ StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id,
   NewShare out;
   out.token = random_token(kShareTokenBytes);
   ShareLink& l = out.link;
-  l.id = "sh_" + random_hex(8);
+  l.id = "sh_" + storage::random_hex(8);
   l.scan_id = scan_id;
   l.measurements = measurements;
   l.created_by = created_by;
-  l.created_at = iso_utc(now);
+  l.created_at = storage::iso8601_utc(now);
   l.expires_at = now + valid_for_s;
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(

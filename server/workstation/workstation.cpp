@@ -23,6 +23,7 @@
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/scan_recording.hpp"
 #include "server/pipeline/sim_backend.hpp"
+#include "storage/archive/ids.hpp"
 
 namespace bodyscan::server {
 
@@ -59,24 +60,9 @@ nlohmann::json to_json(const JobInfo& j) {
 
 namespace {
 
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
 
 int64_t unix_now() { return static_cast<int64_t>(std::time(nullptr)); }
 
-std::string random_id(const char* prefix) {
-  unsigned char b[8];
-  randombytes_buf(b, sizeof b);
-  char hex[17];
-  sodium_bin2hex(hex, sizeof hex, b, sizeof b);
-  return std::string(prefix) + hex;
-}
 
 std::string base64(const std::string& bytes) {
   std::string out(sodium_base64_encoded_len(bytes.size(), sodium_base64_VARIANT_ORIGINAL), '\0');
@@ -234,10 +220,10 @@ struct Workstation::Impl {
     // subscribers so; it is joined later, off this lock (see shutdown).
     if (worker.joinable()) retired.push_back(std::move(worker));
     JobInfo j;
-    j.id = random_id("j_");
+    j.id = "j_" + storage::random_hex(8);
     j.kind = kind;
     j.actor = actor;
-    j.started_at = utc_now();
+    j.started_at = storage::iso8601_utc(unix_now());
     j.stage = "starting";
     cancel = false;
     cancel_reason.clear();
@@ -368,7 +354,7 @@ void Workstation::Impl::run(JobInfo j, std::function<Status()> work) {
     nlohmann::json finished;
     {
       std::lock_guard lock(mutex);
-      job->finished_at = utc_now();
+      job->finished_at = storage::iso8601_utc(unix_now());
       if (st.ok()) {
         job->state = JobState::kComplete;
         job->fraction = 1;

@@ -2,11 +2,10 @@
 
 #include <fcntl.h>
 #include <sodium.h>
-
-#include <atomic>
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -16,6 +15,7 @@
 #include <sstream>
 
 #include "recon/io/atomic_file.hpp"
+#include "storage/archive/ids.hpp"
 #include "storage/archive/sqlite.hpp"
 
 namespace bodyscan::storage {
@@ -59,14 +59,6 @@ std::string now_iso() {
   return out;
 }
 
-std::string random_hex(size_t bytes) {
-  std::vector<unsigned char> b(bytes);
-  randombytes_buf(b.data(), b.size());
-  std::string hex(bytes * 2 + 1, '\0');
-  sodium_bin2hex(hex.data(), hex.size(), b.data(), b.size());
-  hex.pop_back();
-  return hex;
-}
 
 // "s_20261122_101530_" + 8 hex digits: sorts by time, unguessable enough to be no
 // one's business, short enough to read out.

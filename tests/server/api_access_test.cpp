@@ -22,16 +22,7 @@ std::set<std::string> access_names(unsigned a) {
   return out;
 }
 
-class ApiAccess : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { server_ = new ServerUnderTest(); }
-  static void TearDownTestSuite() {
-    delete server_;
-    server_ = nullptr;
-  }
-  static ServerUnderTest* server_;
-};
-ServerUnderTest* ApiAccess::server_ = nullptr;
+class ApiAccess : public SharedServerTest {};
 
 // The served description is the file in the repository, and it lists exactly the
 // routes the server has, each with the callers it admits.

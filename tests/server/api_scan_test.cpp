@@ -140,6 +140,30 @@ TEST(ApiScan, SimulatedScanThroughTheApiWithLiveEvents) {
   auto truth = mesh_girth(truth_mesh, cut, Eigen::Vector3d(0, waist_y, 0));
   ASSERT_TRUE(truth.ok());
   EXPECT_NEAR(served, truth->value_mm, 0.05 * truth->value_mm);
+
+  // Found again by the customer's name, and listed under the customer.
+  const nlohmann::json found = parse(op.get("/api/customers?q=walk"));
+  ASSERT_EQ(found["customers"].size(), 1u) << found.dump();
+  const std::string customer = found["customers"][0]["id"];
+  EXPECT_EQ(parse(op.get("/api/customers/" + customer))["scans"][0]["id"], scan_id);
+  EXPECT_EQ(parse(op.get("/api/scans?customer=" + customer))["scans"].size(), 1u);
+  EXPECT_EQ(parse(op.get("/api/scans?q=" + scan_id))["scans"].size(), 1u);
+  EXPECT_EQ(op.get("/api/scans?limit=0").status, 400);
+
+  // An admin reprocesses it from its raw record: version 2, the same surface
+  // (the same stripes, the same processing), version 1 kept and still served.
+  Client admin = s.as("admin");
+  const HttpReply re = admin.post("/api/scans/" + scan_id + "/reprocess");
+  ASSERT_EQ(re.status, 202) << re.body;
+  const nlohmann::json done = wait_job(admin, parse(re)["job"]["id"]);
+  EXPECT_EQ(done["state"], "complete") << done.dump();
+  EXPECT_EQ(done["version"], 2);
+  const nlohmann::json again = parse(op.get("/api/scans/" + scan_id));
+  EXPECT_EQ(again["current_version"], 2);
+  EXPECT_EQ(again["versions"].size(), 2u);
+  EXPECT_EQ(op.get("/api/scans/" + scan_id + "/mesh.glb?version=1").body, glb.body);
+  const HttpReply girth2 = op.post("/api/scans/" + scan_id + "/measure", plane);
+  EXPECT_NEAR(parse(girth2)["value_mm"].get<double>(), served, 0.01) << "the same stripes give the same surface";
 }
 
 // Cancelling stops the scan at the next frame: the job and the archived scan say

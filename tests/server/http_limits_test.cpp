@@ -25,16 +25,7 @@ std::string raw(int port, const std::string& bytes) {
 
 int status_of(const std::string& reply) { return reply.size() > 12 ? std::atoi(reply.c_str() + 9) : 0; }
 
-class HttpLimits : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { server_ = new ServerUnderTest(); }
-  static void TearDownTestSuite() {
-    delete server_;
-    server_ = nullptr;
-  }
-  static ServerUnderTest* server_;
-};
-ServerUnderTest* HttpLimits::server_ = nullptr;
+class HttpLimits : public SharedServerTest {};
 
 TEST_F(HttpLimits, MalformedRequestsGetClearErrors) {
   const int port = server_->port;

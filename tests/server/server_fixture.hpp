@@ -3,6 +3,7 @@
 // mesh as the surface, measured), and the HTTP server on a free port.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sodium.h>
 
 #include <memory>
@@ -86,6 +87,18 @@ struct ServerUnderTest {
     const Status s = pipeline::archive_scan(ws->archive(), scan_id, r, {});
     if (!s.ok()) throw std::runtime_error(s.message());
   }
+};
+
+// A suite whose tests share one server (ctest runs each test in a process of its
+// own; run by hand, the suite's tests see each other's changes).
+class SharedServerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { server_ = new ServerUnderTest(); }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+  inline static ServerUnderTest* server_ = nullptr;
 };
 
 inline nlohmann::json parse(const HttpReply& r) { return nlohmann::json::parse(r.body, nullptr, false); }
