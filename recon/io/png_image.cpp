@@ -95,7 +95,7 @@ StatusOr<GrayImage> read_png(const std::string& path) {
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_read_struct(&png, &info, nullptr);
-    return internal_error("libpng could not start");
+    return internal_error(path + ": libpng could not start");
   }
   GrayImage image;
   std::vector<uint8_t> row;
