@@ -210,6 +210,34 @@ struct Workstation::Impl {
     calibrated_at = keep.value("calibrated_at", int64_t{0});
   }
 
+  // With none kept, the newest archived scan made on this rig (by `bodyscan scan
+  // --archive`, say) carries its calibration in its raw record: the rig's last.
+  void load_calibration_from_archive() {
+    if (calibration) return;
+    storage::ScanQuery q;
+    q.limit = 20;
+    StatusOr<std::vector<storage::ScanRecord>> scans = archive->scans(q);
+    if (!scans.ok()) return;
+    for (const storage::ScanRecord& r : *scans) {
+      if (r.status != storage::ScanStatus::kComplete || !r.rig.is_object() ||
+          r.rig.value("name", "") != rig_json.value("name", ""))
+        continue;
+      StatusOr<std::string> path = archive->file_path(r.id, -1, pipeline::kRawRecordFile);
+      if (!path.ok()) continue;
+      StatusOr<std::string> text = read_whole_file(*path);
+      if (!text.ok()) continue;
+      StatusOr<pipeline::RigCalibration> cal =
+          pipeline::calibration_from_record(nlohmann::json::parse(*text, nullptr, false));
+      if (!cal.ok()) continue;
+      std::tm tm{};
+      if (!strptime(r.started_at.c_str(), "%Y-%m-%dT%H:%M:%S", &tm)) continue;
+      calibration = std::move(*cal);
+      calibration_id = r.calibration_id;
+      calibrated_at = static_cast<int64_t>(timegm(&tm));
+      return;
+    }
+  }
+
   StatusOr<JobInfo> begin(JobKind kind, const std::string& actor) {  // under mutex
     if (stopped) return failed_precondition("the workstation is stopping");
     if (running) {
@@ -290,6 +318,7 @@ StatusOr<std::unique_ptr<Workstation>> Workstation::open(const WorkstationOption
   // Whatever state the rig was left in, no laser shines until a scan asks.
   RETURN_IF_ERROR(impl->rig.controller->all_lasers_off());
   impl->load_calibration();
+  impl->load_calibration_from_archive();
   return std::unique_ptr<Workstation>(new Workstation(std::move(impl)));
 }
 
