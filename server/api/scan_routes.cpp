@@ -5,11 +5,14 @@
 
 #include "recon/io/atomic_file.hpp"
 #include "server/api/api.hpp"
+#include "server/api/scan_views.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/evaluate_measurement.hpp"
 #include "storage/formats/measurement_sheet.hpp"
 
 namespace bodyscan::server {
+
+namespace {
 
 nlohmann::json customer_json(const storage::Customer& c) {
   return {{"id", c.id}, {"name", c.name ? nlohmann::json(*c.name) : nlohmann::json()},
@@ -38,6 +41,8 @@ nlohmann::json scan_json(const storage::ScanRecord& r) {
           {"current_version", r.current_version},
           {"versions", versions}};
 }
+
+}  // namespace
 
 nlohmann::json measurement_json(const storage::MeasurementRecord& m) {
   return {{"id", m.id},       {"version", m.version},       {"source", m.source},
@@ -84,6 +89,8 @@ HttpResponse scan_file(Workstation& ws, const std::string& scan_id, const std::s
   return out;
 }
 
+namespace {
+
 // A cached JSON body: 304 on a matching ETag, gzip when the client takes it.
 HttpResponse cached_json(const Workstation::CachedText& text, const HttpRequest& request) {
   HttpResponse out;
@@ -103,8 +110,6 @@ HttpResponse cached_json(const Workstation::CachedText& text, const HttpRequest&
   }
   return out;
 }
-
-namespace {
 
 HttpResponse no_content() {
   HttpResponse r;

@@ -5,12 +5,9 @@
 #include <cmath>
 
 #include "server/api/api.hpp"
+#include "server/api/scan_views.hpp"
 
 namespace bodyscan::server {
-
-nlohmann::json measurement_json(const storage::MeasurementRecord& m);
-HttpResponse scan_file(Workstation& ws, const std::string& scan_id, const std::string& name,
-                       const std::string& version_text, const std::string& if_none_match);
 
 namespace {
 

@@ -483,9 +483,8 @@ Status Workstation::Impl::do_scan(int every) {
   // (run_scan_job's acquisition already switched them off; this is belt and braces).
   rig.controller->all_lasers_off();
   if (!result.ok()) return fail(result.status());
-  if (!result->surface_error.empty()) {
-    // The cloud is good; the archive keeps it with the reason in the version note.
-  }
+  // A failed surface still archives: the cloud is good, the reason goes in the
+  // version's note.
   const Status stored = pipeline::archive_scan(*archive, scan_id, *result, o);
   if (!stored.ok()) return fail(Status(stored.code(), "could not store the results: " + stored.message()));
   return Status::Ok();
