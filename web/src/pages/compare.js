@@ -1,0 +1,99 @@
+// Two scans of one customer side by side: the bodies turn together, the table
+// gives both values and the change; a row draws its line on both bodies.
+import { enc, get } from '../api.js';
+import { preferredUnit, setPreferredUnit, UNITS } from '../units.js';
+import { clear, errorText, h, when } from '../ui/dom.js';
+import { BodyView } from '../viewer/body-view.js';
+import { COLOURS, drawMeasurement, measurementTable } from '../viewer/measurement-table.js';
+
+export async function mount(container, { a, b }) {
+  let unit = preferredUnit();
+  let selected = null;
+  let scans;
+  try {
+    scans = await Promise.all([a, b].map((id) => get(`/api/scans/${enc(id)}`)));
+  } catch (e) {
+    container.append(h('section', { class: 'page narrow' }, h('h1', {}, 'Scans not found'), h('p', {}, errorText(e))));
+    return;
+  }
+  // Older first on the left.
+  scans.sort((x, y) => (x.started_at < y.started_at ? -1 : 1));
+  const [older, newer] = scans;
+  const customer = await get(`/api/customers/${enc(newer.customer_id)}`).catch(() => null);
+  const ports = scans.map(() => h('div', { class: 'viewport' }));
+  const tableBox = h('div', { class: 'table-box' });
+  const unitSelect = h(
+    'select',
+    {
+      'aria-label': 'Unit',
+      onchange: (e) => {
+        unit = e.target.value;
+        setPreferredUnit(unit);
+        render();
+      },
+    },
+    Object.keys(UNITS).map((u) => h('option', { value: u, selected: u === unit }, UNITS[u].label)),
+  );
+  container.append(
+    h(
+      'section',
+      { class: 'page compare-page' },
+      h(
+        'div',
+        { class: 'page-head' },
+        h('h1', {}, `Compare: ${customer ? customer.name : ''}`),
+        customer ? h('a', { href: `/customers/${enc(customer.id)}` }, 'All scans of this customer') : null,
+        h('label', { class: 'unit-select' }, unitSelect),
+      ),
+      older.customer_id !== newer.customer_id ? h('p', { class: 'form-error' }, 'These scans are of two different customers.') : null,
+      h(
+        'div',
+        { class: 'compare-views' },
+        scans.map((s, i) => h('figure', { class: 'compare-view' }, ports[i], h('figcaption', {}, h('a', { href: `/scans/${enc(s.id)}` }, when(s.started_at)), i === 0 ? ' (earlier)' : ' (later)'))),
+      ),
+      h('h2', {}, 'Measurements: later scan, earlier scan, change'),
+      tableBox,
+    ),
+  );
+  const views = ports.map((p) => new BodyView(p));
+  // The cameras follow each other (the change event of one moves the other).
+  let syncing = false;
+  views.forEach((v, i) =>
+    v.onCameraChange(() => {
+      if (syncing) return;
+      syncing = true;
+      views[1 - i].copyCamera(v);
+      syncing = false;
+    }),
+  );
+  let sets = [[], []];
+  function render() {
+    clear(
+      tableBox,
+      measurementTable({
+        measurements: sets[1],
+        compareWith: sets[0],
+        unit,
+        selected,
+        onSelect: (m) => {
+          selected = selected === m.name ? null : m.name;
+          views.forEach((v, i) => {
+            v.clearOverlays('sel');
+            const mine = sets[i].find((x) => x.name === selected);
+            if (mine) drawMeasurement(v, 'sel', mine, i === 0 ? COLOURS.compare : COLOURS.selected);
+          });
+          render();
+        },
+      }),
+    );
+  }
+  try {
+    const [m0, m1] = await Promise.all(scans.map((s) => get(`/api/scans/${enc(s.id)}/measurements`)));
+    sets = [m0.measurements, m1.measurements];
+    render();
+  } catch (e) {
+    clear(tableBox, h('p', { class: 'form-error' }, errorText(e)));
+  }
+  scans.forEach((s, i) => views[i].loadMesh(`/api/scans/${enc(s.id)}/mesh.glb?version=${s.current_version}`).catch((e) => ports[i].append(h('p', { class: 'form-error overlay' }, errorText(e)))));
+  return () => views.forEach((v) => v.dispose());
+}

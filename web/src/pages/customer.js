@@ -1,0 +1,82 @@
+// The customer's page, opened from a share link: that scan's model and the
+// measurements staff chose, read-only. It calls only /api/share/{token}/…; the
+// token is the whole of the customer's access.
+import { enc, get } from '../api.js';
+import { preferredUnit, setPreferredUnit, UNITS } from '../units.js';
+import { clear, errorText, h, when } from '../ui/dom.js';
+import { BodyView } from '../viewer/body-view.js';
+import { COLOURS, drawMeasurement, measurementTable } from '../viewer/measurement-table.js';
+
+export async function mount(container, { token }) {
+  const t0 = performance.now();
+  let unit = preferredUnit();
+  let selected = null;
+  let share;
+  try {
+    share = await get(`/api/share/${enc(token)}`, { quiet401: true });
+  } catch (e) {
+    container.append(
+      h(
+        'section',
+        { class: 'page narrow customer-page' },
+        h('h1', {}, 'This link does not open a scan'),
+        h('p', {}, e.status === 404 ? 'It may have expired or been withdrawn. Ask the shop for a new link.' : errorText(e)),
+      ),
+    );
+    return;
+  }
+  const viewport = h('div', { class: 'viewport', id: 'viewport' });
+  const tableBox = h('div', { class: 'table-box' });
+  const unitSelect = h(
+    'select',
+    {
+      'aria-label': 'Unit',
+      onchange: (e) => {
+        unit = e.target.value;
+        setPreferredUnit(unit);
+        renderTable();
+      },
+    },
+    Object.keys(UNITS).map((u) => h('option', { value: u, selected: u === unit }, UNITS[u].label)),
+  );
+  container.append(
+    h(
+      'section',
+      { class: 'page viewer-page customer-page' },
+      h('div', { class: 'viewer-main' }, viewport, h('p', { class: 'hint' }, 'Drag to turn, pinch or scroll to zoom.')),
+      h(
+        'aside',
+        { class: 'viewer-side' },
+        h('h1', {}, 'Your body scan'),
+        h('p', { class: 'muted' }, `Taken ${when(share.taken_at)} · link valid until ${when(new Date(share.expires_at * 1000).toISOString())}`),
+        h('div', { class: 'row' }, h('h2', {}, 'Measurements'), h('label', { class: 'unit-select' }, unitSelect)),
+        tableBox,
+      ),
+    ),
+  );
+  const view = new BodyView(viewport, { label: 'Your body in 3-D' });
+
+  function renderTable() {
+    clear(
+      tableBox,
+      share.measurements.length
+        ? measurementTable({
+            measurements: share.measurements,
+            unit,
+            selected,
+            onSelect: (m) => {
+              selected = selected === m.name ? null : m.name;
+              view.clearOverlays('sel');
+              if (selected) drawMeasurement(view, 'sel', m, COLOURS.selected);
+              renderTable();
+            },
+          })
+        : h('p', { class: 'muted' }, 'The shop shared no measurements with this link.'),
+    );
+  }
+  renderTable();
+  view.loadMesh(share.mesh || `/api/share/${enc(token)}/mesh.glb`, { t0 }).catch((e) => {
+    viewport.append(h('p', { class: 'form-error overlay' }, `The model did not load: ${errorText(e)}`));
+  });
+  return () => view.dispose();
+}

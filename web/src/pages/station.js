@@ -1,0 +1,321 @@
+// The operator's page: the rig at a glance, calibration, a scan for a new or
+// returning customer, its progress live over the WebSocket (stage, progress,
+// the cameras' previews), cancel, and the result opening by itself when done.
+import { enc, get, post, query } from '../api.js';
+import { overallFraction, stageText } from '../progress.js';
+import { ago, clear, errorText, h, toast, when } from '../ui/dom.js';
+
+
+export async function mount(container, _params, ctx) {
+  const state = { rig: null, job: null, connection: 'connecting', customerMode: 'new', customerId: null, previews: new Map(), myJob: null };
+  const rigBox = h('div', { class: 'card rig-card', id: 'rig-status' });
+  const jobBox = h('div', { class: 'card job-card', id: 'job', 'aria-live': 'polite' });
+  const formBox = h('div', { class: 'card scan-card' });
+  const recentBox = h('div', { class: 'card recent-card' });
+  const conn = h('span', { class: 'conn' });
+  container.append(
+    h(
+      'section',
+      { class: 'page station-page' },
+      h('div', { class: 'page-head' }, h('h1', {}, 'Scan station'), conn),
+      h('div', { class: 'station-grid' }, h('div', { class: 'col' }, formBox, jobBox), h('div', { class: 'col' }, rigBox, recentBox)),
+    ),
+  );
+
+  // ---- rig status
+  function renderRig() {
+    const rig = state.rig;
+    if (!rig) {
+      clear(rigBox, h('h2', {}, 'Rig'), h('p', { class: 'muted' }, 'Reading the rig…'));
+      return;
+    }
+    const cal = rig.calibration;
+    const calByCamera = new Map((cal?.cameras || []).map((c) => [c.id, c]));
+    const busy = rig.busy || (state.job && state.job.state === 'running');
+    clear(
+      rigBox,
+      h('h2', {}, `Rig: ${rig.rig}`, rig.simulated ? h('span', { class: 'badge' }, 'simulated') : null),
+      h(
+        'p',
+        { class: cal ? '' : 'form-error', id: 'calibration-age' },
+        cal ? `Calibrated ${ago(cal.age_s)} (${when(new Date(cal.calibrated_at * 1000).toISOString())})` : 'Not calibrated: the first scan calibrates first, or calibrate now.',
+      ),
+      h(
+        'table',
+        { class: 'compact' },
+        h('thead', {}, h('tr', {}, h('th', {}, 'Camera'), h('th', {}, 'Side'), h('th', { class: 'num', title: 'lens correction, held-out points' }, 'Lens RMS'), h('th', { class: 'num', title: 'spread of the rays through the frame markers' }, 'Ray spread'))),
+        h(
+          'tbody',
+          {},
+          rig.cameras.map((c) => {
+            const k = calByCamera.get(c.id);
+            return h(
+              'tr',
+              { class: c.error ? 'fault' : '' },
+              h('td', {}, h('span', { class: `dot ${c.error ? 'bad' : 'good'}`, title: c.error || 'connected' }), ` ${c.id} `, h('small', { class: 'muted' }, `${c.width}×${c.height}`)),
+              h('td', {}, k ? k.side : '—'),
+              h('td', { class: 'num' }, k ? `${k.lens_held_out_rms_px.toFixed(3)} px` : '—'),
+              h('td', { class: 'num' }, k ? `${k.ray_spread_mm.toFixed(2)} mm` : '—'),
+            );
+          }),
+        ),
+      ),
+      h('p', { class: 'lasers' }, 'Lasers: ', rig.lasers.map((l) => h('span', { class: `laser ${l.on === null ? 'job' : l.on ? 'on' : 'off'}`, title: l.on === null ? 'switched by the job' : l.on ? 'on' : 'off' }, `${l.id}: ${l.on === null ? 'job' : l.on ? 'ON' : 'off'}`))),
+      h('button', { type: 'button', disabled: busy, onclick: calibrate }, 'Calibrate'),
+    );
+  }
+
+  async function calibrate() {
+    try {
+      const { job } = await post('/api/rig/calibrate', {});
+      state.myJob = job.id;
+      setJob(job);
+    } catch (e) {
+      toast(errorText(e), 'error');
+    }
+  }
+
+  // ---- the scan form
+  const name = h('input', { name: 'name', autocomplete: 'off', placeholder: 'First and last name', maxlength: 200 });
+  const contact = h('input', { name: 'contact', autocomplete: 'off', placeholder: 'Phone or e-mail (optional)', maxlength: 200 });
+  const search = h('input', { type: 'search', placeholder: 'Search by name, contact or id', 'aria-label': 'Search customers' });
+  const results = h('div', { class: 'pick-list', role: 'listbox', 'aria-label': 'Customers' });
+  const startButton = h('button', { class: 'primary big', type: 'submit', id: 'start-scan' }, 'Start scan');
+  const modeNew = h('div', { class: 'mode-new' }, h('label', { class: 'field' }, h('span', {}, 'Name'), name), h('label', { class: 'field' }, h('span', {}, 'Contact'), contact));
+  const modeExisting = h('div', { class: 'mode-existing', hidden: true }, search, results);
+  let searchTimer = null;
+  search.addEventListener('input', () => {
+    clearTimeout(searchTimer);
+    searchTimer = setTimeout(findCustomers, 200);
+  });
+
+  async function findCustomers() {
+    try {
+      const { customers } = await get(`/api/customers${query({ q: search.value.trim() })}`);
+      clear(
+        results,
+        customers.length
+          ? customers.slice(0, 50).map((c) =>
+              h(
+                'button',
+                {
+                  type: 'button',
+                  role: 'option',
+                  class: 'pick',
+                  'aria-selected': state.customerId === c.id ? 'true' : 'false',
+                  onclick: () => {
+                    state.customerId = c.id;
+                    for (const b of results.children) b.setAttribute('aria-selected', b === document.activeElement ? 'true' : 'false');
+                  },
+                },
+                h('strong', {}, c.name),
+                h('small', { class: 'muted' }, ` ${c.contact || ''} · since ${when(c.created_at)}`),
+              ),
+            )
+          : h('p', { class: 'muted' }, 'No customer matches.'),
+      );
+    } catch (e) {
+      clear(results, h('p', { class: 'form-error' }, errorText(e)));
+    }
+  }
+
+  const modeSwitch = h(
+    'div',
+    { class: 'segmented', role: 'radiogroup', 'aria-label': 'Customer' },
+    [
+      ['new', 'New customer'],
+      ['existing', 'Returning customer'],
+    ].map(([v, t]) =>
+      h(
+        'button',
+        {
+          type: 'button',
+          role: 'radio',
+          'aria-checked': v === 'new' ? 'true' : 'false',
+          onclick: (e) => {
+            state.customerMode = v;
+            for (const b of e.target.parentElement.children) b.setAttribute('aria-checked', b === e.target ? 'true' : 'false');
+            modeNew.hidden = v !== 'new';
+            modeExisting.hidden = v !== 'existing';
+            if (v === 'existing') {
+              findCustomers();
+              search.focus();
+            } else name.focus();
+          },
+        },
+        t,
+      ),
+    ),
+  );
+
+  formBox.append(
+    h(
+      'form',
+      {
+        onsubmit: async (e) => {
+          e.preventDefault();
+          const body = {};
+          if (state.customerMode === 'new') {
+            if (!name.value.trim()) {
+              toast('Give the customer’s name.', 'error');
+              name.focus();
+              return;
+            }
+            body.customer = { name: name.value.trim(), ...(contact.value.trim() ? { contact: contact.value.trim() } : {}) };
+          } else {
+            if (!state.customerId) {
+              toast('Pick the customer from the list.', 'error');
+              return;
+            }
+            body.customer_id = state.customerId;
+          }
+          startButton.disabled = true;
+          try {
+            const { job } = await post('/api/scans', body);
+            state.myJob = job.id;
+            state.previews.clear();
+            setJob(job);
+            name.value = '';
+            contact.value = '';
+          } catch (err) {
+            toast(errorText(err), 'error');
+          } finally {
+            renderForm();
+          }
+        },
+      },
+      h('h2', {}, 'New scan'),
+      modeSwitch,
+      modeNew,
+      modeExisting,
+      h('p', { class: 'muted small' }, 'Ask the customer to stand on the marks, arms slightly away from the body, and to hold still for about two minutes.'),
+      startButton,
+    ),
+  );
+
+  function renderForm() {
+    const busy = (state.rig && state.rig.busy) || (state.job && state.job.state === 'running');
+    startButton.disabled = !!busy;
+    startButton.textContent = busy ? 'The rig is busy' : 'Start scan';
+  }
+
+  // ---- the job
+  const previewGrid = h('div', { class: 'previews' });
+  function setJob(job) {
+    if (!state.job || state.job.id !== job.id) state.lastFraction = 0;
+    state.job = job;
+    renderJob();
+    renderForm();
+    renderRig();
+  }
+
+  function renderJob() {
+    const j = state.job;
+    if (!j) {
+      clear(jobBox, h('h2', {}, 'Progress'), h('p', { class: 'muted' }, 'No job is running.'));
+      return;
+    }
+    const running = j.state === 'running';
+    const overall = overallFraction(j.kind, j.stage, j.fraction);
+    // A stage the bar does not know keeps the last position rather than jumping.
+    if (overall !== null) state.lastFraction = running ? Math.max(state.lastFraction || 0, overall) : overall;
+    const pct = j.state === 'complete' ? 100 : Math.round((state.lastFraction || 0) * 100);
+    clear(
+      jobBox,
+      h('h2', {}, j.kind === 'calibrate' ? 'Calibration' : j.kind === 'reprocess' ? 'Reprocessing' : 'Scan'),
+      h('p', { class: `job-state ${j.state}`, dataset: { state: j.state, stage: j.stage || '' } }, running ? `${stageText(j.stage)}…` : { complete: 'Done', failed: 'Failed', cancelled: 'Cancelled' }[j.state] || j.state),
+      h('progress', { max: 100, value: pct, 'aria-label': 'Progress' }),
+      h('p', { class: 'muted small' }, `${pct} %${j.frames ? ` · ${j.frames} frames` : ''}`),
+      j.error ? h('p', { class: 'form-error' }, j.error) : null,
+      j.kind === 'scan' ? previewGrid : null,
+      running ? h('button', { type: 'button', class: 'danger', onclick: () => cancel(j) }, 'Cancel') : null,
+      !running && j.scan_id && j.state === 'complete' ? h('a', { class: 'button primary', href: `/scans/${enc(j.scan_id)}` }, 'Open the result') : null,
+    );
+  }
+
+  async function cancel(j) {
+    try {
+      await post(`/api/jobs/${enc(j.id)}/cancel`, {});
+    } catch (e) {
+      toast(errorText(e), 'error');
+    }
+  }
+
+  function showPreview(p) {
+    let img = state.previews.get(p.camera);
+    if (!img) {
+      img = h('img', { alt: `Camera ${p.camera}`, width: 160, dataset: { camera: p.camera } });
+      state.previews.set(p.camera, img);
+      previewGrid.append(h('figure', {}, img, h('figcaption', {}, p.camera)));
+    }
+    img.src = `data:image/png;base64,${p.png_base64}`;
+  }
+
+  async function renderRecent() {
+    try {
+      const { scans } = await get(`/api/scans${query({ limit: 6 })}`);
+      clear(
+        recentBox,
+        h('h2', {}, 'Latest scans'),
+        scans.length
+          ? h('ul', { class: 'plain' }, scans.map((s) => h('li', {}, h('a', { href: `/scans/${enc(s.id)}` }, when(s.started_at)), ` · ${s.status}`, s.operator ? ` · ${s.operator}` : '')))
+          : h('p', { class: 'muted' }, 'None yet.'),
+      );
+    } catch (e) {
+      clear(recentBox, h('h2', {}, 'Latest scans'), h('p', { class: 'form-error' }, errorText(e)));
+    }
+  }
+
+  // ---- events
+  const stop = ctx.events().subscribe((msg) => {
+    switch (msg.type) {
+      case 'connection':
+        state.connection = msg.state;
+        conn.textContent = msg.state === 'open' ? '● live' : '○ reconnecting…';
+        conn.className = `conn ${msg.state}`;
+        break;
+      case 'hello':
+      case 'rig':
+        state.rig = msg.rig;
+        if (msg.rig.job && (!state.job || state.job.id === msg.rig.job.id || msg.rig.job.state === 'running')) state.job = msg.rig.job;
+        renderRig();
+        renderJob();
+        renderForm();
+        break;
+      case 'job':
+        if (!state.job || state.job.id === msg.job.id || msg.job.state === 'running') setJob(msg.job);
+        break;
+      case 'preview':
+        if (state.job && msg.job === state.job.id) showPreview(msg);
+        break;
+      case 'scan_finished':
+        setJob(msg.job);
+        renderRecent();
+        if (msg.job.state === 'complete' && msg.job.id === state.myJob && msg.job.scan_id) {
+          toast('Scan done; opening the result.', 'ok');
+          ctx.router.navigate(`/scans/${enc(msg.job.scan_id)}`);
+        }
+        break;
+      default:
+    }
+  });
+  conn.textContent = ctx.events().state === 'open' ? '● live' : '○ connecting…';
+
+  renderRig();
+  renderJob();
+  renderRecent();
+  try {
+    const rig = await get('/api/rig');
+    state.rig = rig;
+    if (rig.job) state.job = rig.job;
+    renderRig();
+    renderJob();
+    renderForm();
+  } catch (e) {
+    toast(errorText(e), 'error');
+  }
+  return () => {
+    stop();
+    clearTimeout(searchTimer);
+  };
+}

@@ -1,0 +1,321 @@
+// The tailor's page: one scan's body, its measurements, new ones drawn on it and
+// evaluated by the server, saved by name, exported, shared with the customer.
+import { del, enc, get, post } from '../api.js';
+import { formatLength, preferredUnit, setPreferredUnit, UNITS } from '../units.js';
+import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
+import { BodyView } from '../viewer/body-view.js';
+import { MeasureTool, TOOLS } from '../viewer/measure-tool.js';
+import { COLOURS, drawMeasurement, KIND_LABEL, measurementTable, slug } from '../viewer/measurement-table.js';
+import { shareDialog } from './share-dialog.js';
+
+export async function mount(container, { id }, ctx) {
+  const t0 = performance.now();
+  performance.mark('bodyscan:open-scan');
+  const role = ctx.session.role;
+  const state = { unit: preferredUnit(), selected: null, fresh: null, measurements: [], scan: null, customer: null };
+
+  const viewport = h('div', { class: 'viewport', id: 'viewport' });
+  const hint = h('p', { class: 'hint', role: 'status' }, TOOLS.rotate.hint);
+  const toolbar = h('div', { class: 'viewer-toolbar', role: 'toolbar', 'aria-label': 'Viewer' });
+  const heading = h('div', { class: 'scan-heading' }, h('h1', {}, 'Scan'));
+  const resultBox = h('div', { class: 'result card', hidden: true, 'aria-live': 'polite' });
+  const tableBox = h('div', { class: 'table-box' });
+  const actions = h('div', { class: 'actions' });
+  const side = h('aside', { class: 'viewer-side' }, heading, resultBox, h('h2', {}, 'Measurements'), tableBox, h('h2', {}, 'Sheet and sharing'), actions);
+  const page = h('section', { class: 'page viewer-page' }, h('div', { class: 'viewer-main' }, toolbar, viewport, hint), side);
+  container.append(page);
+
+  const view = new BodyView(viewport);
+  const tool = new MeasureTool(view, { onRequest: (r, name) => evaluate(r, name), onHint: (t) => (hint.textContent = t) });
+  let stopEvents = null;
+  let disposed = false;
+
+  // ---- toolbar
+  const segmented = (name, options, current, onPick) => {
+    const group = h('div', { class: 'segmented', role: 'radiogroup', 'aria-label': name });
+    for (const [value, text] of options) {
+      const b = h('button', { type: 'button', role: 'radio', 'aria-checked': value === current ? 'true' : 'false', dataset: { value } }, text);
+      b.addEventListener('click', () => {
+        for (const other of group.children) other.setAttribute('aria-checked', other === b ? 'true' : 'false');
+        onPick(value);
+      });
+      group.append(b);
+    }
+    return group;
+  };
+  let pointsLoaded = false;
+  toolbar.append(
+    segmented('Show', [['mesh', 'Surface'], ['points', 'Points']], 'mesh', async (mode) => {
+      if (mode === 'points' && !pointsLoaded) {
+        pointsLoaded = true;
+        try {
+          await view.loadPoints(`/api/scans/${enc(id)}/points.drc?version=${state.scan.current_version}`);
+        } catch (e) {
+          toast(`The point cloud did not load: ${errorText(e)}`, 'error');
+        }
+      }
+      view.setMode(mode);
+      if (mode === 'points' && tool.mode !== 'rotate') hint.textContent = 'Measuring works on the surface; switch back to it.';
+    }),
+    segmented('View', [['front', 'Front'], ['left', 'Side'], ['back', 'Back']], 'front', (v) => view.setView(v)),
+    segmented('Tool', Object.entries(TOOLS).map(([k, t]) => [k, t.label]), 'rotate', (m) => tool.setMode(m)),
+    h(
+      'label',
+      { class: 'unit-select' },
+      h('span', { class: 'sr-only' }, 'Unit'),
+      h(
+        'select',
+        {
+          'aria-label': 'Unit',
+          onchange: (e) => {
+            state.unit = e.target.value;
+            setPreferredUnit(state.unit);
+            renderTable();
+            renderResult();
+            renderActions();
+          },
+        },
+        Object.keys(UNITS).map((u) => h('option', { value: u, selected: u === state.unit }, UNITS[u].label)),
+      ),
+    ),
+  );
+
+  // ---- data
+  async function loadScan() {
+    state.scan = await get(`/api/scans/${enc(id)}`);
+    try {
+      state.customer = await get(`/api/customers/${enc(state.scan.customer_id)}`);
+    } catch {
+      state.customer = null;
+    }
+    renderHeading();
+  }
+
+  async function loadMeasurements() {
+    const m = await get(`/api/scans/${enc(id)}/measurements`);
+    state.measurements = m.measurements;
+    renderTable();
+    renderActions();
+  }
+
+  function renderHeading() {
+    const s = state.scan;
+    const others = (state.customer?.scans || []).filter((x) => x.id !== s.id && x.status === 'complete');
+    clear(
+      heading,
+      h('h1', {}, state.customer ? state.customer.name : 'Scan'),
+      h(
+        'p',
+        { class: 'muted' },
+        `Scanned ${when(s.started_at)} by ${s.operator || '—'} · version ${s.current_version}`,
+        s.status !== 'complete' ? h('span', { class: `badge ${s.status}` }, s.status) : null,
+      ),
+      s.status_reason ? h('p', { class: 'form-error' }, s.status_reason) : null,
+      h(
+        'p',
+        { class: 'links' },
+        state.customer ? h('a', { href: `/customers/${enc(s.customer_id)}` }, 'All scans of this customer') : null,
+        others.length ? h('a', { href: `/compare/${enc(s.id)}/${enc(others[0].id)}` }, 'Compare with the previous scan') : null,
+      ),
+    );
+  }
+
+  function renderTable() {
+    clear(
+      tableBox,
+      state.measurements.length
+        ? measurementTable({
+            measurements: state.measurements,
+            unit: state.unit,
+            selected: state.selected,
+            onSelect: (m) => select(m),
+            onDelete: ctx.can.saveMeasurements(role) ? (m) => removeMeasurement(m) : null,
+          })
+        : h('p', { class: 'muted' }, 'No measurements yet.'),
+    );
+  }
+
+  function select(m) {
+    state.selected = state.selected === m.name ? null : m.name;
+    view.clearOverlays('sel');
+    if (state.selected) drawMeasurement(view, 'sel', m, COLOURS.selected);
+    for (const row of tableBox.querySelectorAll('tr[data-name]')) {
+      const on = row.dataset.name === state.selected;
+      row.classList.toggle('selected', on);
+      row.setAttribute('aria-selected', on ? 'true' : 'false');
+    }
+  }
+
+  // ---- a new measurement, evaluated by the server
+  let evaluating = 0;
+  async function evaluate(request, toolName) {
+    const seq = ++evaluating;
+    state.fresh = { request, toolName, pending: true };
+    renderResult();
+    try {
+      const result = await post(`/api/scans/${enc(id)}/measure`, request);
+      if (seq !== evaluating || disposed) return;
+      state.fresh = { request, toolName, result };
+      view.clearOverlays('pick:');
+      drawMeasurement(view, 'fresh', result, COLOURS.fresh);
+    } catch (e) {
+      if (seq !== evaluating || disposed) return;
+      state.fresh = { request, toolName, error: e.status === 422 ? `Nothing to measure there: ${e.message}` : errorText(e) };
+      view.clearOverlays('pick:');
+    }
+    renderResult();
+  }
+
+  function renderResult() {
+    const f = state.fresh;
+    resultBox.hidden = !f;
+    if (!f) return;
+    if (f.pending) {
+      clear(resultBox, h('p', { class: 'muted' }, `Measuring the ${f.toolName.toLowerCase()}…`));
+      return;
+    }
+    if (f.error) {
+      clear(resultBox, h('p', { class: 'form-error' }, f.error), h('button', { onclick: discard }, 'Close'));
+      return;
+    }
+    const r = f.result;
+    const name = h('input', { name: 'label', required: true, maxlength: 100, placeholder: 'e.g. Jacket chest', 'aria-label': 'Name' });
+    const canSave = ctx.can.saveMeasurements(role);
+    clear(
+      resultBox,
+      h('p', { class: 'result-value', dataset: { valueMm: String(r.value_mm) } }, h('strong', {}, formatLength(r.value_mm, state.unit)), ` ${KIND_LABEL[r.kind] || r.kind}`),
+      r.crosses_filled_hole ? h('p', { class: 'badge warn' }, 'crosses skin the cameras did not see') : null,
+      canSave
+        ? h(
+            'form',
+            {
+              class: 'row',
+              onsubmit: async (e) => {
+                e.preventDefault();
+                await save(name.value.trim(), f.request);
+              },
+            },
+            name,
+            h('button', { class: 'primary', type: 'submit' }, 'Save'),
+            h('button', { type: 'button', onclick: discard }, 'Discard'),
+          )
+        : h('div', { class: 'row' }, h('button', { type: 'button', onclick: discard }, 'Close')),
+    );
+    if (canSave) name.focus({ preventScroll: true });
+  }
+
+  function discard() {
+    state.fresh = null;
+    view.clearOverlays('fresh');
+    renderResult();
+  }
+
+  async function save(labelText, request) {
+    if (!labelText) return;
+    const taken = new Set(state.measurements.map((m) => m.name));
+    try {
+      const saved = await post(`/api/scans/${enc(id)}/measurements`, { name: slug(labelText, taken), label: labelText, request });
+      toast(`Saved “${saved.label}”: ${formatLength(saved.value_mm, state.unit)}`, 'ok');
+      discard();
+      await loadMeasurements();
+      select(state.measurements.find((m) => m.id === saved.id) || saved);
+    } catch (e) {
+      toast(`Not saved: ${errorText(e)}`, 'error');
+    }
+  }
+
+  async function removeMeasurement(m) {
+    if (!(await confirmDialog(`Delete the saved measurement “${m.label || m.name}”?`, { confirm: 'Delete', danger: true }))) return;
+    try {
+      await del(`/api/scans/${enc(id)}/measurements/${m.id}`);
+      if (state.selected === m.name) select(m);
+      await loadMeasurements();
+    } catch (e) {
+      toast(errorText(e), 'error');
+    }
+  }
+
+  // ---- sheets, sharing, admin
+  function renderActions() {
+    const u = state.unit;
+    clear(
+      actions,
+      h(
+        'div',
+        { class: 'row wrap' },
+        h('a', { class: 'button', href: `/api/scans/${enc(id)}/sheet.csv?unit=${u}`, download: `${id}-measurements.csv` }, 'Export CSV'),
+        h('a', { class: 'button', href: `/api/scans/${enc(id)}/sheet.pdf?unit=${u}`, download: `${id}-measurements.pdf` }, 'Export PDF'),
+        ctx.can.share(role) ? h('button', { type: 'button', onclick: () => shareDialog(id, state.measurements, state.unit) }, 'Share with customer…') : null,
+      ),
+      ctx.can.deleteRecords(role)
+        ? h(
+            'div',
+            { class: 'row wrap admin-actions' },
+            ctx.can.reprocess(role) ? h('button', { type: 'button', onclick: reprocess }, 'Reprocess') : null,
+            h('button', { type: 'button', class: 'danger', onclick: deleteScan }, 'Delete scan…'),
+          )
+        : null,
+    );
+  }
+
+  async function reprocess() {
+    if (!(await confirmDialog('Process this scan again from its raw record? It becomes a new version; the old one is kept.', { confirm: 'Reprocess' }))) return;
+    try {
+      await post(`/api/scans/${enc(id)}/reprocess`, {});
+      toast('Reprocessing; the new version opens when it is done.', 'ok');
+      watchJob();
+    } catch (e) {
+      toast(errorText(e), 'error');
+    }
+  }
+
+  async function deleteScan() {
+    if (!(await confirmDialog('Delete this scan, its model, measurements and share links? This cannot be undone.', { title: 'Delete scan', confirm: 'Delete', danger: true }))) return;
+    try {
+      await del(`/api/scans/${enc(id)}`);
+      toast('Scan deleted.', 'ok');
+      ctx.router.navigate(state.scan?.customer_id ? `/customers/${enc(state.scan.customer_id)}` : '/archive');
+    } catch (e) {
+      toast(errorText(e), 'error');
+    }
+  }
+
+  // A scan or reprocess still running: reload when it ends.
+  function watchJob() {
+    if (stopEvents) return;
+    stopEvents = ctx.events().subscribe((msg) => {
+      if (msg.type === 'scan_finished' && msg.job && msg.job.scan_id === id) {
+        stopEvents();
+        stopEvents = null;
+        ctx.router.render();
+      }
+    });
+  }
+
+  // ---- open
+  try {
+    await loadScan();
+  } catch (e) {
+    clear(page, h('div', { class: 'page narrow' }, h('h1', {}, 'Scan not found'), h('p', {}, errorText(e)), h('a', { href: '/archive' }, 'Back to the archive')));
+    view.dispose();
+    return () => {};
+  }
+  if (state.scan.status === 'running') {
+    hint.textContent = 'This scan is still being made; it opens when it is done.';
+    watchJob();
+  } else if (state.scan.status === 'complete' || state.scan.current_version > 0) {
+    const glb = `/api/scans/${enc(id)}/mesh.glb?version=${state.scan.current_version}`;
+    Promise.all([view.loadMesh(glb, { t0 }), loadMeasurements()]).catch((e) => {
+      if (!disposed) toast(`The model did not load: ${errorText(e)}`, 'error');
+    });
+  } else {
+    hint.textContent = 'This scan has no model.';
+  }
+
+  return () => {
+    disposed = true;
+    if (stopEvents) stopEvents();
+    tool.dispose();
+    view.dispose();
+  };
+}

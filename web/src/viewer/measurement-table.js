@@ -1,0 +1,119 @@
+// The measurement table: the automatic set (ISO 8559-1) and the saved ones,
+// each row selecting its line on the body. Values shown in the chosen unit.
+import { formatDifference, formatLength } from '../units.js';
+import { h } from '../ui/dom.js';
+
+export const KIND_LABEL = {
+  girth: 'girth',
+  height: 'height',
+  distance: 'straight',
+  surface_length: 'over skin',
+  arc: 'along tape',
+};
+
+export const FILLED_NOTE = 'Part of this line crosses skin the cameras did not see (filled in by the reconstruction): check it with a tape if it matters.';
+
+export const COLOURS = { selected: 0xd6336c, fresh: 0x0b7a75, compare: 0x7048e8 };
+
+// Draws a measurement's geometry on a BodyView under `key`.
+export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
+  const g = m.geometry || m;
+  view.clearOverlays(key);
+  if (g.path && g.path.length >= 2) view.showPath(`${key}:path`, g.path, { closed: !!g.closed, color: colour, width: 3.5 });
+  if (g.from && g.to && g.kind !== 'height') {
+    view.showMarker(`${key}:from`, g.from, { color: colour, radius: 6 });
+    view.showMarker(`${key}:to`, g.to, { color: colour, radius: 6 });
+  }
+}
+
+// rows: [{m, other?}] - `other` is the same measurement on a second scan (compare).
+export function measurementTable({ measurements, unit, selected, onSelect, onDelete, compareWith = null, caption }) {
+  const byName = new Map((compareWith || []).map((m) => [m.name, m]));
+  const head = h(
+    'tr',
+    {},
+    h('th', { scope: 'col' }, 'Measurement'),
+    h('th', { scope: 'col', class: 'num' }, compareWith ? 'This scan' : 'Value'),
+    compareWith ? h('th', { scope: 'col', class: 'num' }, 'Other') : null,
+    compareWith ? h('th', { scope: 'col', class: 'num' }, 'Change') : null,
+    onDelete ? h('th', { scope: 'col' }, h('span', { class: 'sr-only' }, 'Delete')) : null,
+  );
+  const body = h('tbody');
+  let lastSource = null;
+  for (const m of measurements) {
+    if (m.source !== lastSource) {
+      lastSource = m.source;
+      body.append(h('tr', { class: 'group' }, h('th', { colspan: 5, scope: 'colgroup' }, m.source === 'automatic' ? 'Automatic (ISO 8559-1)' : 'Saved by staff')));
+    }
+    const g = m.geometry || {};
+    const other = byName.get(m.name);
+    const row = h(
+      'tr',
+      {
+        class: `row-select${selected === m.name ? ' selected' : ''}`,
+        tabindex: 0,
+        dataset: { name: m.name },
+        'aria-selected': selected === m.name ? 'true' : 'false',
+        onclick: () => onSelect && onSelect(m),
+        onkeydown: (e) => {
+          if ((e.key === 'Enter' || e.key === ' ') && onSelect) {
+            e.preventDefault();
+            onSelect(m);
+          }
+        },
+      },
+      h(
+        'td',
+        {},
+        h('span', { class: 'm-label' }, m.label || m.name),
+        h('small', { class: 'muted' }, ` ${KIND_LABEL[m.kind] || m.kind}${m.iso_clause ? ` · ISO ${m.iso_clause}` : ''}`),
+      ),
+      h(
+        'td',
+        { class: 'num value' },
+        g.crosses_filled_hole ? h('span', { class: 'filled', title: FILLED_NOTE }, '≈ ') : null,
+        formatLength(m.value_mm, unit),
+      ),
+      compareWith ? h('td', { class: 'num' }, other ? formatLength(other.value_mm, unit) : '—') : null,
+      compareWith ? h('td', { class: 'num' }, other ? formatDifference(m.value_mm - other.value_mm, unit) : '—') : null,
+      onDelete
+        ? h(
+            'td',
+            {},
+            m.source === 'user'
+              ? h(
+                  'button',
+                  {
+                    class: 'icon danger-text',
+                    title: `Delete ${m.label || m.name}`,
+                    'aria-label': `Delete ${m.label || m.name}`,
+                    onclick: (e) => {
+                      e.stopPropagation();
+                      onDelete(m);
+                    },
+                  },
+                  '✕',
+                )
+              : null,
+          )
+        : null,
+    );
+    body.append(row);
+  }
+  return h('table', { class: 'measurements' }, caption ? h('caption', {}, caption) : null, h('thead', {}, head), body);
+}
+
+// "Bust girth" -> "bust_girth"; names the server stores (unique per scan here).
+export function slug(text, taken = new Set()) {
+  const base =
+    text
+      .normalize('NFKD')
+      .replace(/[\u0300-\u036f]/g, '')
+      .toLowerCase()
+      .replace(/[^a-z0-9]+/g, '_')
+      .replace(/^_+|_+$/g, '')
+      .slice(0, 80) || 'measurement';
+  let name = base;
+  for (let i = 2; taken.has(name); i++) name = `${base}_${i}`;
+  return name;
+}

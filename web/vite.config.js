@@ -1,0 +1,53 @@
+// Builds the browser UI into web/dist, the folder `bodyscan serve` serves by
+// default. Hashed bundles go to dist/assets/ (the server marks them immutable),
+// the Draco decoder of the `three` package among them (DRACOLoader finds it by
+// import.meta.url); every text and wasm file also gets a .gz twin the server
+// sends to browsers that take gzip.
+import { defineConfig } from 'vite';
+import { readdirSync, readFileSync, statSync, writeFileSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { gzipSync, constants } from 'node:zlib';
+
+function gzipTwins() {
+  const compressible = /\.(js|mjs|css|html|svg|json|wasm|txt)$/;
+  const walk = (dir) =>
+    readdirSync(dir).flatMap((n) => {
+      const p = join(dir, n);
+      return statSync(p).isDirectory() ? walk(p) : [p];
+    });
+  return {
+    name: 'bodyscan-gzip-twins',
+    apply: 'build',
+    closeBundle: {
+      order: 'post',
+      sequential: true,
+      handler() {
+        const dist = resolve(import.meta.dirname, 'dist');
+        for (const file of walk(dist)) {
+          if (!compressible.test(file)) continue;
+          const raw = readFileSync(file);
+          if (raw.length < 1024) continue;
+          const gz = gzipSync(raw, { level: constants.Z_BEST_COMPRESSION });
+          if (gz.length < raw.length * 0.9) writeFileSync(`${file}.gz`, gz);
+        }
+      },
+    },
+  };
+}
+
+export default defineConfig({
+  root: import.meta.dirname,
+  base: '/',
+  plugins: [gzipTwins()],
+  build: {
+    outDir: 'dist',
+    emptyOutDir: true,
+    target: 'es2022',
+    sourcemap: true,
+    chunkSizeWarningLimit: 1200,
+  },
+  server: {
+    // `npm run dev` next to `bodyscan serve --port 8080`.
+    proxy: { '/api': { target: 'http://localhost:8080', ws: true } },
+  },
+});
