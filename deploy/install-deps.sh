@@ -3,7 +3,10 @@
 # present are skipped, so the README commands can call it on every run.
 #
 #   deploy/install-deps.sh            build + test dependencies
+#   deploy/install-deps.sh --browser  also Chromium, for the browser UI's tests
 #   deploy/install-deps.sh --bench    also the peers the benchmarks compare with (Open3D)
+#
+# The browser UI's npm packages are installed by deploy/install-web.sh.
 set -euo pipefail
 
 packages=(
@@ -23,9 +26,13 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   poppler-utils        # pdftotext: the tests read the PDF sheets back
 )
-if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(python3-open3d python3-numpy time wrk curl)
-fi
+for arg in "$@"; do
+  case "$arg" in
+    --browser) packages+=(chromium) ;;  # driven headless by playwright-core (web/tests/e2e)
+    --bench) packages+=(python3-open3d python3-numpy time wrk curl chromium) ;;
+    *) echo "install-deps: unknown option '$arg'" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

@@ -28,7 +28,7 @@ done
 SERVICE_USER=bodyscan
 BIN_SRC=${BIN_SRC:-build/server/bodyscan}
 BIN_DEST=/usr/local/bin/bodyscan
-WEB_SRC=${WEB_SRC:-web/public}
+WEB_SRC=${WEB_SRC:-build/web}
 WEB_DEST=/usr/local/share/bodyscan/web
 DOC_DEST=/usr/local/share/doc/bodyscan/deployment.md
 UNIT_DEST=/etc/systemd/system/bodyscan.service

@@ -16,6 +16,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 deploy/install-deps.sh
+deploy/install-web.sh
 deploy/build.sh
 OUT=${OUT:-out/demo}
 DATA=${DATA:-out/data}

@@ -3,7 +3,8 @@
 # every test. CI calls this through .ci/run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-deploy/install-deps.sh
+deploy/install-deps.sh --browser
+deploy/install-web.sh
 BUILD_DIR=${BUILD_DIR:-build-test} BUILD_TYPE=RelWithDebInfo deploy/build.sh
 cd "${BUILD_DIR:-build-test}"
 ctest --output-on-failure -j "$(nproc)" --timeout 600

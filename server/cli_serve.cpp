@@ -34,7 +34,7 @@ void usage(FILE* out) {
       "  --body BODY.ply    the simulated subject (mm, Y up)\n"
       "  --every N          scans use every Nth laser step unless asked otherwise\n"
       "                     (default 1)\n"
-      "  --web DIR          the browser UI's files (default: the repository's web/public)\n"
+      "  --web DIR          the browser UI's files (default: the UI this build made, BUILD/web)\n"
       "  --tls-cert PEM --tls-key PEM\n"
       "                     serve HTTPS (session cookies become Secure)\n"
       "  --behind-tls-proxy a TLS proxy in front forwards to us: cookies Secure\n"

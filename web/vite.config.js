@@ -1,8 +1,9 @@
-// Builds the browser UI into web/dist, the folder `bodyscan serve` serves by
-// default. Hashed bundles go to dist/assets/ (the server marks them immutable),
-// the Draco decoder of the `three` package among them (DRACOLoader finds it by
-// import.meta.url); every text and wasm file also gets a .gz twin the server
-// sends to browsers that take gzip.
+// Builds the browser UI. CMake runs it with --outDir BUILD/web, the folder
+// `bodyscan serve` serves by default; `npm run build` alone writes web/dist.
+// Hashed bundles go to assets/ (the server marks them immutable), the Draco
+// decoder of the `three` package among them (DRACOLoader finds it by
+// import.meta.url). Every text and wasm file also gets a .gz twin, which the
+// server sends to browsers that take gzip.
 import { defineConfig } from 'vite';
 import { readdirSync, readFileSync, statSync, writeFileSync } from 'node:fs';
 import { join, resolve } from 'node:path';
@@ -15,15 +16,18 @@ function gzipTwins() {
       const p = join(dir, n);
       return statSync(p).isDirectory() ? walk(p) : [p];
     });
+  let outDir = null;
   return {
     name: 'bodyscan-gzip-twins',
     apply: 'build',
+    configResolved(config) {
+      outDir = resolve(config.root, config.build.outDir);
+    },
     closeBundle: {
       order: 'post',
       sequential: true,
       handler() {
-        const dist = resolve(import.meta.dirname, 'dist');
-        for (const file of walk(dist)) {
+        for (const file of walk(outDir)) {
           if (!compressible.test(file)) continue;
           const raw = readFileSync(file);
           if (raw.length < 1024) continue;

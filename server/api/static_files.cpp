@@ -2,8 +2,10 @@
 
 #include "recon/io/atomic_file.hpp"
 
+#include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <string_view>
 #include <system_error>
 
 namespace bodyscan::server {
@@ -65,6 +67,28 @@ bool under(const fs::path& root, const fs::path& p) {
   return true;
 }
 
+// Accept-Encoding names gzip without q=0.
+bool accepts_gzip(std::string_view header) {
+  size_t at = 0;
+  while (at < header.size()) {
+    size_t end = header.find(',', at);
+    if (end == std::string_view::npos) end = header.size();
+    std::string_view item = header.substr(at, end - at);
+    at = end + 1;
+    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
+    const size_t semi = item.find(';');
+    std::string_view coding = item.substr(0, semi);
+    while (!coding.empty() && coding.back() == ' ') coding.remove_suffix(1);
+    if (coding != "gzip" && coding != "*") continue;
+    if (semi == std::string_view::npos) return true;
+    std::string_view params = item.substr(semi + 1);
+    const size_t q = params.find("q=");
+    if (q == std::string_view::npos) return true;
+    return std::strtod(std::string(params.substr(q + 2)).c_str(), nullptr) > 0;
+  }
+  return false;
+}
+
 }  // namespace
 
 HttpResponse serve_static(const std::string& web_root, const HttpRequest& request) {
@@ -88,15 +112,23 @@ HttpResponse serve_static(const std::string& web_root, const HttpRequest& reques
   }
   const fs::path real = fs::canonical(file, ec);
   if (ec || !under(root, real) || !fs::is_regular_file(real, ec)) return error_response(404, "no such file: " + request.path);
-  const auto size = fs::file_size(real, ec);
-  const auto mtime = fs::last_write_time(real, ec).time_since_epoch().count();
+  // The UI's build leaves a .gz twin beside each large text or wasm file; a
+  // browser that takes gzip gets it, the rest the file itself.
+  const fs::path twin = real.string() + ".gz";
+  const bool has_twin = fs::is_regular_file(twin, ec) && under(root, fs::canonical(twin, ec)) && !ec;
+  const bool gzip = has_twin && accepts_gzip(request.header("accept-encoding"));
+  const fs::path& sent = gzip ? twin : real;
+  const auto size = fs::file_size(sent, ec);
+  const auto mtime = fs::last_write_time(sent, ec).time_since_epoch().count();
   char etag[64];
-  std::snprintf(etag, sizeof etag, "\"%llx-%llx\"", static_cast<unsigned long long>(size),
-                static_cast<unsigned long long>(mtime));
+  std::snprintf(etag, sizeof etag, "\"%llx-%llx%s\"", static_cast<unsigned long long>(size),
+                static_cast<unsigned long long>(mtime), gzip ? "-gz" : "");
   HttpResponse r;
   r.set("Content-Type", mime_type(real.filename().string()));
   r.set("ETag", etag);
   r.set("X-Content-Type-Options", "nosniff");
+  if (has_twin) r.set("Vary", "Accept-Encoding");
+  if (gzip) r.set("Content-Encoding", "gzip");
   if (rel.rfind("assets/", 0) == 0) r.set("Cache-Control", "public, max-age=31536000, immutable");
   else r.set("Cache-Control", "no-cache");
   if (request.header("if-none-match") == etag) {
@@ -104,7 +136,7 @@ HttpResponse serve_static(const std::string& web_root, const HttpRequest& reques
     return r;
   }
   // Read on the worker pool (see scan_file); the UI's files are at most a few MB.
-  auto bytes = read_whole_file(real.string());
+  auto bytes = read_whole_file(sent.string());
   if (!bytes.ok()) return error_response(bytes.status());
   r.body = std::move(*bytes);
   return r;

@@ -94,6 +94,35 @@ TEST_F(HttpLimits, StaticFilesStayInTheWebRootWithTheirMimeTypes) {
   EXPECT_EQ(http(port, "POST", "/index.html").status, 405);
 }
 
+// The UI's build leaves .gz twins: a browser that takes gzip gets the twin with
+// Content-Encoding, any other client the file itself, and caches keep them apart.
+TEST_F(HttpLimits, StaticFilesComeGzippedToBrowsersThatTakeIt) {
+  const std::string& web = server_->web;
+  std::filesystem::create_directories(web + "/assets");
+  const std::string plain(4000, 'x');
+  std::ofstream(web + "/assets/big-1.js") << plain;
+  std::ofstream(web + "/assets/big-1.js.gz") << "GZIPPED-TWIN";
+  std::ofstream(web + "/assets/alone-1.js") << "no twin";
+  const int port = server_->port;
+  const HttpReply zipped = http(port, "GET", "/assets/big-1.js", {{"Accept-Encoding", "br, gzip;q=0.8"}});
+  EXPECT_EQ(zipped.status, 200);
+  EXPECT_EQ(zipped.header("content-encoding"), "gzip");
+  EXPECT_EQ(zipped.body, "GZIPPED-TWIN");
+  EXPECT_EQ(zipped.header("content-type"), "text/javascript; charset=utf-8");
+  EXPECT_EQ(zipped.header("vary"), "Accept-Encoding");
+  for (const char* ae : {"", "identity", "gzip;q=0", "br"}) {
+    const HttpReply r = http(port, "GET", "/assets/big-1.js", ae[0] ? std::map<std::string, std::string>{{"Accept-Encoding", ae}}
+                                                                     : std::map<std::string, std::string>{});
+    EXPECT_EQ(r.body, plain) << ae;
+    EXPECT_EQ(r.header("content-encoding"), "") << ae;
+    EXPECT_NE(r.header("etag"), zipped.header("etag")) << ae;
+  }
+  const HttpReply alone = http(port, "GET", "/assets/alone-1.js", {{"Accept-Encoding", "gzip"}});
+  EXPECT_EQ(alone.body, "no twin");
+  EXPECT_EQ(alone.header("content-encoding"), "");
+  EXPECT_EQ(http(port, "GET", "/assets/big-1.js", {{"Accept-Encoding", "gzip"}, {"If-None-Match", zipped.header("etag")}}).status, 304);
+}
+
 // A client that asks for the model and hangs up after the first bytes: the
 // server carries on serving everyone else.
 TEST_F(HttpLimits, AClientThatDisconnectsMidDownloadHarmsNothing) {

@@ -43,15 +43,14 @@ export async function mount(container, { token }) {
     h(
       'section',
       { class: 'page viewer-page customer-page' },
-      h('div', { class: 'viewer-main' }, viewport, h('p', { class: 'hint' }, 'Drag to turn, pinch or scroll to zoom.')),
       h(
-        'aside',
-        { class: 'viewer-side' },
+        'header',
+        { class: 'customer-head' },
         h('h1', {}, 'Your body scan'),
-        h('p', { class: 'muted' }, `Taken ${when(share.taken_at)} · link valid until ${when(new Date(share.expires_at * 1000).toISOString())}`),
-        h('div', { class: 'row' }, h('h2', {}, 'Measurements'), h('label', { class: 'unit-select' }, unitSelect)),
-        tableBox,
+        h('p', { class: 'muted' }, `Taken ${when(share.taken_at)} · this link works until ${when(new Date(share.expires_at * 1000).toISOString())}`),
       ),
+      h('div', { class: 'viewer-main' }, viewport, h('p', { class: 'hint' }, 'Drag to turn, pinch or scroll to zoom. Tap a measurement to see it on the body.')),
+      h('aside', { class: 'viewer-side' }, h('div', { class: 'row' }, h('h2', {}, 'Measurements'), h('label', { class: 'unit-select' }, unitSelect)), tableBox),
     ),
   );
   const view = new BodyView(viewport, { label: 'Your body in 3-D' });
@@ -64,6 +63,7 @@ export async function mount(container, { token }) {
             measurements: share.measurements,
             unit,
             selected,
+            groups: { automatic: 'Body measurements', user: 'Taken by the shop' },
             onSelect: (m) => {
               selected = selected === m.name ? null : m.name;
               view.clearOverlays('sel');

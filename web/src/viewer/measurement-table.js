@@ -27,7 +27,7 @@ export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
 }
 
 // rows: [{m, other?}] - `other` is the same measurement on a second scan (compare).
-export function measurementTable({ measurements, unit, selected, onSelect, onDelete, compareWith = null, caption }) {
+export function measurementTable({ measurements, unit, selected, onSelect, onDelete, compareWith = null, caption, groups = { automatic: 'Automatic (ISO 8559-1)', user: 'Saved by staff' } }) {
   const byName = new Map((compareWith || []).map((m) => [m.name, m]));
   const head = h(
     'tr',
@@ -43,7 +43,7 @@ export function measurementTable({ measurements, unit, selected, onSelect, onDel
   for (const m of measurements) {
     if (m.source !== lastSource) {
       lastSource = m.source;
-      body.append(h('tr', { class: 'group' }, h('th', { colspan: 5, scope: 'colgroup' }, m.source === 'automatic' ? 'Automatic (ISO 8559-1)' : 'Saved by staff')));
+      body.append(h('tr', { class: 'group' }, h('th', { colspan: 5, scope: 'colgroup' }, groups[m.source] || m.source)));
     }
     const g = m.geometry || {};
     const other = byName.get(m.name);

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the browser UI's npm packages (web/node_modules) exactly as
+# web/package-lock.json pins them: three, three-mesh-bvh, Vite, playwright-core.
+# Idempotent: skipped while the lockfile is unchanged since the last install.
+# Needs Node.js >= 20.19 and the npm registry (no CDN at run time: the UI is
+# bundled from these packages by the CMake build).
+set -euo pipefail
+cd "$(dirname "$0")/../web"
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  echo "install-web: Node.js and npm are needed (Node.js >= 20.19)" >&2
+  exit 1
+fi
+version=$(node -p 'process.versions.node')
+if ! node -e 'const [a,b]=process.versions.node.split(".").map(Number); process.exit(a>20||(a===20&&b>=19)?0:1)'; then
+  echo "install-web: Node.js $version is too old; the UI's build (Vite) needs 20.19 or newer" >&2
+  exit 1
+fi
+stamp=node_modules/.bodyscan-lock.sha256
+want=$(sha256sum package-lock.json | cut -d' ' -f1)
+if [[ -f "$stamp" && "$(cat "$stamp")" == "$want" && -f node_modules/vite/package.json ]]; then
+  echo "install-web: npm packages up to date"
+  exit 0
+fi
+echo "install-web: npm ci (Node.js $version)"
+npm ci --no-audit --no-fund --loglevel=error
+echo "$want" >"$stamp"

@@ -1,0 +1,155 @@
+// What the browser tests stand on: a real `bodyscan serve` on a fresh data
+// folder (simulated rig, a free port), Debian's Chromium driven by playwright-core
+// (no browser download), screenshots kept as artefacts, and ground truth from the
+// demo body the simulated rig scans.
+import { spawn } from 'node:child_process';
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+export const REPO = resolve(here, '../../..');
+export const ADMIN_PASSWORD = 'correct horse battery';
+
+function required(name, fallback) {
+  const v = process.env[name] || fallback;
+  if (!v || !existsSync(v)) throw new Error(`${name} must name an existing path (got ${v || 'nothing'}); run the tests through ctest (deploy/run-tests.sh)`);
+  return v;
+}
+
+export const BIN = () => required('BODYSCAN_BIN', join(REPO, 'build-test/server/bodyscan'));
+export const WEB_ROOT = () => required('BODYSCAN_WEB_ROOT', join(REPO, 'build-test/web'));
+export const CHROMIUM = () => {
+  const p = process.env.CHROMIUM || '/usr/bin/chromium';
+  if (!existsSync(p)) throw new Error(`no Chromium at ${p}: install it with deploy/install-deps.sh --browser`);
+  return p;
+};
+export const ARTEFACTS = process.env.BODYSCAN_TEST_ARTIFACTS || join(REPO, 'web/test-results');
+mkdirSync(ARTEFACTS, { recursive: true });
+
+// The demo body the simulated rig scans (mm, Y up, soles on Y=0, facing +Z).
+export function demoBodyBounds() {
+  const bytes = readFileSync(join(REPO, 'hw/sim/bodies/male_average.ply'));
+  const end = bytes.indexOf('end_header\n') + 'end_header\n'.length;
+  const header = bytes.subarray(0, end).toString('latin1');
+  if (!/format binary_little_endian/.test(header) || !/element vertex (\d+)\nproperty float x\nproperty float y\nproperty float z\n/.test(header))
+    throw new Error('unexpected PLY layout for the demo body');
+  const n = Number(/element vertex (\d+)/.exec(header)[1]);
+  const min = [Infinity, Infinity, Infinity];
+  const max = [-Infinity, -Infinity, -Infinity];
+  const view = new DataView(bytes.buffer, bytes.byteOffset + end, n * 12);
+  for (let i = 0; i < n; i++)
+    for (let k = 0; k < 3; k++) {
+      const v = view.getFloat32(i * 12 + k * 4, true);
+      if (v < min[k]) min[k] = v;
+      if (v > max[k]) max[k] = v;
+    }
+  return { min, max };
+}
+
+// `bodyscan serve` on a fresh data folder; resolves once it prints its URL.
+export async function startServer({ every = 6, extraArgs = [] } = {}) {
+  const data = mkdtempSync(join(tmpdir(), 'bodyscan-ui-'));
+  const proc = spawn(BIN(), ['serve', '--address', '127.0.0.1', '--port', '0', '--data', data, '--every', String(every), '--web', WEB_ROOT(), ...extraArgs], {
+    env: { ...process.env, BODYSCAN_ADMIN_PASSWORD: ADMIN_PASSWORD },
+    stdio: ['ignore', 'pipe', 'pipe'],
+  });
+  let log = '';
+  const url = await new Promise((resolveUrl, reject) => {
+    const timer = setTimeout(() => reject(new Error(`bodyscan serve did not start:\n${log}`)), 30000);
+    const onData = (chunk) => {
+      log += chunk;
+      const m = /open (https?:\/\/\S+?)\/?\s/.exec(log);
+      if (m) {
+        clearTimeout(timer);
+        resolveUrl(m[1].replace('localhost', '127.0.0.1'));
+      }
+    };
+    proc.stdout.on('data', onData);
+    proc.stderr.on('data', onData);
+    proc.on('exit', (code) => reject(new Error(`bodyscan serve exited (${code}):\n${log}`)));
+  });
+  return {
+    url,
+    data,
+    log: () => log,
+    async stop() {
+      if (proc.exitCode !== null) return proc.exitCode;
+      const exited = new Promise((r) => proc.on('exit', (code) => r(code)));
+      proc.kill('SIGTERM');
+      const code = await exited;
+      rmSync(data, { recursive: true, force: true });
+      return code;
+    },
+  };
+}
+
+export async function launchBrowser() {
+  return chromium.launch({
+    executablePath: CHROMIUM(),
+    args: [
+      '--no-sandbox',
+      '--disable-background-networking',
+      '--disable-component-update',
+      '--disable-sync',
+      '--no-first-run',
+      '--disable-quic',
+      // WebGL in a headless machine without a GPU: ANGLE on SwiftShader.
+      '--use-angle=swiftshader',
+      '--enable-unsafe-swiftshader',
+      '--ignore-gpu-blocklist',
+    ],
+  });
+}
+
+// A page that fails the test on any uncaught script error.
+export async function newPage(context, errors) {
+  const page = await context.newPage();
+  page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
+  page.on('console', (m) => {
+    if (m.type() === 'error' && !/status of (401|404|409|422)/.test(m.text())) errors.push(`console: ${m.text()}`);
+  });
+  return page;
+}
+
+export async function shot(page, name) {
+  await page.screenshot({ path: join(ARTEFACTS, `${name}.png`) });
+}
+
+export async function login(page, base, username, password) {
+  await page.goto(`${base}/login`);
+  await page.fill('input[name=username]', username);
+  await page.fill('input[name=password]', password);
+  await Promise.all([page.waitForURL((u) => !u.pathname.startsWith('/login')), page.click('form.login button[type=submit]')]);
+}
+
+export async function logout(page) {
+  await Promise.all([page.waitForURL('**/login'), page.click('#who button')]);
+}
+
+// The share of the viewport's pixels that differ from its background, read from
+// a real screenshot (what the compositor shows, not the WebGL buffer).
+export async function coverage(page, selector) {
+  const png = (await page.locator(selector).screenshot()).toString('base64');
+  return page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width;
+    c.height = img.height;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    const bg = [d[0], d[1], d[2]]; // a corner is background
+    let differ = 0;
+    for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 60) differ++;
+    return differ / (d.length / 4);
+  }, png);
+}
+
+export function removeDir(dir) {
+  rmSync(dir, { recursive: true, force: true });
+}

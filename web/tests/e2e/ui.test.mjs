@@ -1,0 +1,356 @@
+// The browser UI end to end, in real headless Chromium against a real
+// `bodyscan serve` on the simulated rig: staff accounts made in the UI, a scan run
+// from the station with its live progress and previews, the body rendered (not a
+// blank canvas; its bounds against the true body), a girth line drawn on screen
+// and measured by the server, saved by a tailor, the sheet exported, a second scan
+// of the same customer compared, a customer's share link that reaches nothing
+// else, and an admin deleting the scan. Screenshots go to the artefacts folder.
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import { after, before, describe, it } from 'node:test';
+import { ADMIN_PASSWORD, ARTEFACTS, coverage, demoBodyBounds, launchBrowser, login, logout, newPage, shot, startServer } from './harness.mjs';
+
+const SCAN_TIMEOUT = 420_000;
+const OPERATOR = ['olivia', 'operator pass 1'];
+const TAILOR = ['theo', 'tailor pass 12'];
+
+let server;
+let browser;
+let context;
+let page;
+const errors = [];
+const state = {};
+
+async function addAccount(name, role, password) {
+  await page.click('button:has-text("Add account")');
+  const dialog = page.locator('dialog[open]');
+  await dialog.locator('input[name=username]').fill(name);
+  await dialog.locator('select[name=role]').selectOption(role);
+  await dialog.locator('input[name=password]').fill(password);
+  await dialog.locator('button[value=ok]').click();
+  await page.locator(`tr[data-user="${name}"]`).waitFor();
+}
+
+// The scan the station started, through to the result opening by itself.
+async function runScanFromStation(label) {
+  const stages = new Set();
+  let maxProgress = 0;
+  const started = Date.now();
+  await page.click('#start-scan');
+  await page.locator('#job .job-state[data-state=running]').waitFor({ timeout: 30000 });
+  // Watch the live progress until the page moves to the result.
+  while (!/\/scans\//.test(page.url())) {
+    const s = await page
+      .locator('#job .job-state')
+      .getAttribute('data-stage', { timeout: 1000 })
+      .catch(() => null);
+    if (s) stages.add(s);
+    const v = await page
+      .locator('#job progress')
+      .evaluate((p) => p.value, null, { timeout: 1000 })
+      .catch(() => null);
+    if (v !== null) maxProgress = Math.max(maxProgress, v);
+    if (!state[`${label}Preview`]) {
+      const src = await page
+        .locator('#job .previews img')
+        .first()
+        .getAttribute('src', { timeout: 200 })
+        .catch(() => null);
+      if (src) {
+        state[`${label}Preview`] = src;
+        await shot(page, `${label}-station-scanning`);
+      }
+    }
+    const failed = await page.locator('#job .job-state[data-state=failed], #job .job-state[data-state=cancelled]').count();
+    assert.equal(failed, 0, `the scan ended badly: ${await page.locator('#job').innerText()}`);
+    assert.ok(Date.now() - started < SCAN_TIMEOUT, `the scan took longer than ${SCAN_TIMEOUT / 1000} s`);
+    await page.waitForTimeout(250);
+  }
+  return { stages, maxProgress, seconds: (Date.now() - started) / 1000 };
+}
+
+async function openedModel() {
+  await page.locator('#viewport[data-state=ready]').waitFor({ timeout: 120000 });
+  const d = await page.locator('#viewport').evaluate((e) => ({ ...e.dataset }));
+  return { bounds: JSON.parse(d.bounds), triangles: Number(d.triangles), firstFrameMs: Number(d.firstFrameMs) };
+}
+
+async function drawLine(x1f, y1f, x2f, y2f) {
+  const box = await page.locator('#viewport canvas').boundingBox();
+  const at = (fx, fy) => [box.x + box.width * fx, box.y + box.height * fy];
+  const [x1, y1] = at(x1f, y1f);
+  const [x2, y2] = at(x2f, y2f);
+  await page.mouse.move(x1, y1);
+  await page.mouse.down();
+  for (let i = 1; i <= 8; i++) await page.mouse.move(x1 + ((x2 - x1) * i) / 8, y1 + ((y2 - y1) * i) / 8);
+  await page.mouse.up();
+}
+
+// The tool's request to /measure and the server's answer, for the next action.
+function nextMeasure() {
+  return page.waitForResponse((r) => r.url().includes('/measure') && r.request().method() === 'POST', { timeout: 60000 }).then(async (r) => ({
+    request: r.request().postDataJSON(),
+    status: r.status(),
+    body: await r.json(),
+  }));
+}
+
+describe('the browser UI', { timeout: 1_800_000 }, () => {
+  before(async () => {
+    server = await startServer();
+    browser = await launchBrowser();
+    context = await browser.newContext({ viewport: { width: 1366, height: 1024 }, acceptDownloads: true, hasTouch: true });
+    page = await newPage(context, errors);
+  });
+
+  after(async () => {
+    if (browser) await browser.close();
+    if (server) {
+      const code = await server.stop();
+      assert.equal(code, 0, `bodyscan serve did not stop cleanly:\n${server.log()}`);
+    }
+    assert.deepEqual(errors, [], 'the pages threw or logged errors');
+  });
+
+  it('refuses a wrong password and lets the admin in, who adds an operator and a tailor', async () => {
+    await page.goto(`${server.url}/archive`);
+    await page.waitForURL('**/login?next=%2Farchive');
+    await page.fill('input[name=username]', 'admin');
+    await page.fill('input[name=password]', 'not the password');
+    await page.click('form.login button[type=submit]');
+    await page.locator('.form-error:has-text("Wrong username or password")').waitFor();
+    await page.fill('input[name=password]', ADMIN_PASSWORD);
+    await Promise.all([page.waitForURL('**/archive'), page.click('form.login button[type=submit]')]);
+    await page.click('nav a:has-text("Accounts")');
+    await addAccount(OPERATOR[0], 'operator', OPERATOR[1]);
+    await addAccount(TAILOR[0], 'tailor', TAILOR[1]);
+    await shot(page, 'accounts');
+    await logout(page);
+  });
+
+  it('runs a scan from the station: live stages, progress, camera previews, the result opening by itself', async () => {
+    await login(page, server.url, ...OPERATOR);
+    assert.match(page.url(), /\/station$/);
+    // An operator has no Accounts page.
+    assert.equal(await page.locator('nav a:has-text("Accounts")').count(), 0);
+    await page.locator('#rig-status table').waitFor();
+    assert.match(await page.locator('#rig-status').innerText(), /front-left/);
+    await page.fill('input[name=name]', 'Ada Lovelace');
+    await page.fill('input[name=contact]', 'ada@example.org');
+    await shot(page, 'station');
+    const run = await runScanFromStation('first');
+    console.log(`first scan (with calibration) through the UI: ${run.seconds.toFixed(0)} s, stages ${[...run.stages].join(', ')}`);
+    assert.ok(run.stages.has('scan'), `stages seen: ${[...run.stages]}`);
+    assert.ok([...run.stages].some((s) => s.startsWith('calibration')), 'the first scan calibrates the rig first');
+    assert.ok(run.maxProgress > 10, `the bar moved (${run.maxProgress})`);
+    assert.match(state.firstPreview || '', /^data:image\/png;base64,iVBOR/, 'a camera preview was shown');
+    state.scanA = /\/scans\/([^/?]+)/.exec(page.url())[1];
+  });
+
+  it('renders the scanned body: not blank, in mm, where the true body stands', async () => {
+    const model = await openedModel();
+    const truth = demoBodyBounds();
+    // The reconstruction closes the unseen crown and soles; 35 mm covers that,
+    // while a unit (m/mm) or axis mistake is off by far more.
+    for (let k = 0; k < 3; k++) {
+      assert.ok(Math.abs(model.bounds.min[k] - truth.min[k]) < 35, `min[${k}] ${model.bounds.min[k]} vs ${truth.min[k]}`);
+      assert.ok(Math.abs(model.bounds.max[k] - truth.max[k]) < 35, `max[${k}] ${model.bounds.max[k]} vs ${truth.max[k]}`);
+    }
+    assert.ok(model.triangles > 50000, `${model.triangles} triangles`);
+    const covered = await coverage(page, '#viewport canvas');
+    assert.ok(covered > 0.04, `the body covers ${(covered * 100).toFixed(1)} % of the view`);
+    await page.locator('table.measurements tr[data-name=waist_girth]').waitFor();
+    await shot(page, 'viewer-operator');
+    // A row highlights its line: the picture changes.
+    const before = await coverage(page, '#viewport canvas');
+    await page.click('table.measurements tr[data-name=hip_girth]');
+    await page.waitForTimeout(300);
+    assert.equal(await page.locator('tr[data-name=hip_girth]').getAttribute('aria-selected'), 'true');
+    assert.notEqual(await coverage(page, '#viewport canvas'), before);
+  });
+
+  it('measures a girth line drawn across the body: the server evaluates the plane the screen shows', async () => {
+    await page.click('.segmented button[data-value=girth]');
+    const pending = nextMeasure();
+    // Straight across the waist, level, in the front view.
+    await drawLine(0.4, 0.43, 0.6, 0.43);
+    const { request, status, body } = await pending;
+    assert.equal(status, 200, JSON.stringify(body));
+    assert.equal(request.kind, 'girth');
+    // The screen line is level and the camera looks level at the body's middle:
+    // the plane is near horizontal.
+    assert.ok(Math.abs(request.line.from[1] - request.line.to[1]) < 1, JSON.stringify(request.line));
+    assert.ok(Math.abs(request.view[1]) < 0.25 && request.view[2] < -0.9, JSON.stringify(request.view));
+    const y = request.line.from[1];
+    assert.ok(y > 700 && y < 1300, `the line is at ${y} mm`);
+    assert.ok(body.value_mm > 550 && body.value_mm < 1200, `a torso girth: ${body.value_mm} mm`);
+    // What the page shows is the server's value, in the chosen unit (cm by default).
+    const shown = await page.locator('.result-value').getAttribute('data-value-mm');
+    assert.equal(Number(shown), body.value_mm);
+    assert.match(await page.locator('.result-value strong').innerText(), new RegExp(`^${(body.value_mm / 10).toFixed(1)} cm$`));
+    // The same plane asked of the server directly gives the same girth.
+    const direct = await page.evaluate(
+      async ({ scan, req }) => {
+        const s = await (await fetch('/api/session')).json();
+        const r = await fetch(`/api/scans/${scan}/measure`, { method: 'POST', headers: { 'Content-Type': 'application/json', 'X-CSRF-Token': s.csrf_token }, body: JSON.stringify(req) });
+        return r.json();
+      },
+      { scan: state.scanA, req: request },
+    );
+    assert.ok(Math.abs(direct.value_mm - body.value_mm) < 0.01);
+    assert.ok(body.path.length > 10 && body.closed, 'the loop comes back to be drawn');
+    await shot(page, 'viewer-girth');
+    // An operator may measure but not save.
+    assert.equal(await page.locator('.result button:has-text("Save")').count(), 0);
+    await logout(page);
+  });
+
+  it('lets a tailor draw, save and name a girth, measure a distance by two taps, and export the sheet', async () => {
+    await login(page, server.url, ...TAILOR);
+    assert.match(page.url(), /\/archive$/);
+    await page.fill('input[name=q]', 'Lovelace');
+    await page.click('form.filters button[type=submit]');
+    await page.click(`tr[data-scan="${state.scanA}"] a.button`);
+    await openedModel();
+    await page.click('.segmented button[data-value=girth]');
+    let pending = nextMeasure();
+    await drawLine(0.4, 0.43, 0.6, 0.43);
+    const girth = await pending;
+    assert.equal(girth.status, 200);
+    await page.fill('.result input[name=label]', 'Jacket waist');
+    const saved = page.waitForResponse((r) => r.url().endsWith('/measurements') && r.request().method() === 'POST');
+    await page.click('.result button:has-text("Save")');
+    const savedBody = await (await saved).json();
+    assert.equal(savedBody.label, 'Jacket waist');
+    assert.ok(Math.abs(savedBody.value_mm - girth.body.value_mm) < 0.01, 'saved as the server measured it');
+    await page.locator('tr[data-name=jacket_waist]').waitFor();
+    assert.match(await page.locator('tr[data-name=jacket_waist] .value').innerText(), new RegExp(`${(girth.body.value_mm / 10).toFixed(1)} cm`));
+
+    // Two taps: the straight distance between the picked points.
+    await page.click('.segmented button[data-value=distance]');
+    const box = await page.locator('#viewport canvas').boundingBox();
+    pending = nextMeasure();
+    await page.mouse.click(box.x + box.width * 0.47, box.y + box.height * 0.35);
+    await page.mouse.click(box.x + box.width * 0.53, box.y + box.height * 0.6);
+    const distance = await pending;
+    assert.equal(distance.status, 200, JSON.stringify(distance.body));
+    const [a, b] = [distance.request.from, distance.request.to];
+    const straight = Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    assert.ok(Math.abs(distance.body.value_mm - straight) < 0.01, `${distance.body.value_mm} vs ${straight}`);
+    assert.ok(straight > 150, 'the taps landed on two places of the body');
+
+    // Units: inches.
+    await page.selectOption('select[aria-label=Unit]', 'in');
+    assert.match(await page.locator('tr[data-name=jacket_waist] .value').innerText(), new RegExp(`${(girth.body.value_mm / 25.4).toFixed(2)} in`));
+    await shot(page, 'viewer-tailor');
+
+    // The sheet, as CSV, in the chosen unit.
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('a:has-text("Export CSV")')]);
+    const csv = readFileSync(await download.path(), 'utf8');
+    assert.match(csv, /Jacket waist/);
+    assert.match(csv, /Waist girth/);
+    assert.match(download.suggestedFilename(), /\.csv$/);
+    await download.saveAs(`${ARTEFACTS}/sheet.csv`);
+    await page.selectOption('select[aria-label=Unit]', 'cm');
+  });
+
+  it('makes a share link the customer opens on a phone, which shows that scan and reaches nothing else', async () => {
+    await page.click('button:has-text("Share with customer")');
+    const dialog = page.locator('dialog[open]');
+    await dialog.locator('button:has-text("None")').click();
+    await dialog.locator('input[value=jacket_waist]').check();
+    await dialog.locator('input[value=waist_girth]').check();
+    await dialog.locator('button:has-text("Make link")').click();
+    const link = await dialog.locator('input.share-url').inputValue();
+    assert.match(link, /\/s\/[A-Za-z0-9_-]{20,}$/);
+    await shot(page, 'share-dialog');
+    await dialog.locator('button:has-text("Close")').click();
+    state.link = link.replace(/^https?:\/\/[^/]+/, server.url);
+
+    const phone = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true, deviceScaleFactor: 2 });
+    const customer = await newPage(phone, errors);
+    await customer.goto(state.link);
+    await customer.locator('#viewport[data-state=ready]').waitFor({ timeout: 120000 });
+    const names = await customer.locator('table.measurements tr[data-name]').evaluateAll((rows) => rows.map((r) => r.dataset.name).sort());
+    assert.deepEqual(names, ['jacket_waist', 'waist_girth']);
+    assert.ok((await coverage(customer, '#viewport canvas')) > 0.02, 'the customer sees the body');
+    assert.equal(await customer.locator('#topbar').isHidden(), true, 'no staff navigation');
+    const overflow = await customer.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+    assert.ok(overflow <= 0, `the page is ${overflow} px wider than the phone`);
+    await shot(customer, 'customer-phone');
+    // Nothing else: no staff API, no other scan's model, no staff page.
+    const probes = await customer.evaluate(async (scan) => {
+      const status = async (u) => (await fetch(u)).status;
+      return {
+        scans: await status('/api/scans'),
+        model: await status(`/api/scans/${scan}/mesh.glb`),
+        measurements: await status(`/api/scans/${scan}/measurements`),
+        rig: await status('/api/rig'),
+        otherToken: await status('/api/share/AAAAAAAAAAAAAAAAAAAAAA'),
+      };
+    }, state.scanA);
+    assert.deepEqual(probes, { scans: 401, model: 401, measurements: 401, rig: 401, otherToken: 404 });
+    await customer.goto(`${server.url}/archive`);
+    await customer.waitForURL('**/login?next=%2Farchive');
+    await customer.goto(`${server.url}/s/not-a-real-token`);
+    await customer.locator('h1:has-text("This link does not open a scan")').waitFor();
+    await phone.close();
+  });
+
+  it('scans the returning customer and compares the two scans side by side', async () => {
+    await logout(page);
+    await login(page, server.url, ...OPERATOR);
+    await page.click('.segmented button:has-text("Returning customer")');
+    await page.fill('input[type=search]', 'Lovelace');
+    await page.click('.pick-list button:has-text("Ada Lovelace")');
+    const run = await runScanFromStation('second');
+    console.log(`second scan through the UI: ${run.seconds.toFixed(0)} s`);
+    state.scanB = /\/scans\/([^/?]+)/.exec(page.url())[1];
+    assert.notEqual(state.scanB, state.scanA);
+    await openedModel();
+    await page.click('a:has-text("Compare with the previous scan")');
+    await page.waitForURL('**/compare/**');
+    await page.locator('.compare-view .viewport[data-state=ready]').nth(1).waitFor({ timeout: 120000 });
+    await page.locator('.compare-view .viewport[data-state=ready]').first().waitFor({ timeout: 120000 });
+    const row = page.locator('table.measurements tr[data-name=waist_girth]');
+    const cells = await row.locator('td').allInnerTexts();
+    assert.equal(cells.length, 4, cells.join(' | '));
+    // Two scans of one body on one rig: the waist agrees within 2 cm.
+    const [later, earlier] = [cells[1], cells[2]].map((t) => Number(t.replace(/[^0-9.]/g, '')));
+    assert.ok(Math.abs(later - earlier) < 2, cells.join(' | '));
+    await row.click();
+    await shot(page, 'compare');
+  });
+
+  it('lets an admin delete a scan after confirming, which withdraws its share link', async () => {
+    await logout(page);
+    await login(page, server.url, 'admin', ADMIN_PASSWORD);
+    await page.goto(`${server.url}/archive`);
+    const row = page.locator(`tr[data-scan="${state.scanA}"]`);
+    await row.locator('button:has-text("Delete")').click();
+    // Cancelled first: nothing happens.
+    await page.locator('dialog[open] button[value=cancel]').click();
+    assert.equal(await row.count(), 1);
+    await row.locator('button:has-text("Delete")').click();
+    await page.locator('dialog[open] button[value=ok]').click();
+    await row.waitFor({ state: 'detached' });
+    assert.equal(await page.locator(`tr[data-scan="${state.scanB}"]`).count(), 1, 'the other scan stays');
+    const status = await page.evaluate(async (link) => (await fetch(link.replace('/s/', '/api/share/'))).status, state.link);
+    assert.equal(status, 404);
+  });
+
+  it('fits a 1024×768 tablet without sideways scrolling', async () => {
+    const tablet = await browser.newContext({ viewport: { width: 1024, height: 768 }, hasTouch: true });
+    const p = await newPage(tablet, errors);
+    await login(p, server.url, 'admin', ADMIN_PASSWORD);
+    for (const path of ['/station', '/archive', `/scans/${state.scanB}`, '/accounts']) {
+      await p.goto(`${server.url}${path}`);
+      if (path.startsWith('/scans/')) await p.locator('#viewport[data-state=ready]').waitFor({ timeout: 120000 });
+      else await p.waitForLoadState('networkidle');
+      const overflow = await p.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+      assert.ok(overflow <= 0, `${path} is ${overflow} px too wide at 1024×768`);
+      await shot(p, `tablet${path.replace(/\//g, '-').replace(/-s_.*/, '-viewer')}`);
+    }
+    await tablet.close();
+  });
+});
