@@ -49,6 +49,9 @@ export class Router {
     const params = found ? found.params : {};
     for (const k of Object.keys(params)) params[k] = decodeURIComponent(params[k]);
     const route = found ? found.route : this.routes.find((r) => r.notFound);
+    // The page's code loads while the session is checked.
+    const loading = Promise.resolve().then(() => route.load());
+    loading.catch(() => {});
     const allowed = await this.ctx.guard(route);
     if (seq !== this.seq) return;
     if (allowed !== true) {
@@ -58,7 +61,14 @@ export class Router {
     this.container.replaceChildren();
     document.title = route.title ? `${route.title} · bodyscan` : 'bodyscan';
     this.ctx.onRoute(route);
-    const page = await route.load();
+    let page;
+    try {
+      page = await loading;
+    } catch (e) {
+      // A new version was installed while the page was open: its old chunks are gone.
+      this.container.textContent = `This page could not load (${e.message}). Reload the page.`;
+      return;
+    }
     if (seq !== this.seq) return;
     const cleanup = await page.mount(this.container, params, this.ctx);
     if (seq !== this.seq) {

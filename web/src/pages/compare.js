@@ -51,7 +51,7 @@ export async function mount(container, { a, b }) {
         { class: 'compare-views' },
         scans.map((s, i) => h('figure', { class: 'compare-view' }, ports[i], h('figcaption', {}, h('a', { href: `/scans/${enc(s.id)}` }, when(s.started_at)), i === 0 ? ' (earlier)' : ' (later)'))),
       ),
-      h('h2', {}, 'Measurements: later scan, earlier scan, change'),
+      h('h2', {}, 'Measurements'),
       tableBox,
     ),
   );
@@ -73,6 +73,7 @@ export async function mount(container, { a, b }) {
       measurementTable({
         measurements: sets[1],
         compareWith: sets[0],
+        columns: [`Later (${when(newer.started_at)})`, `Earlier (${when(older.started_at)})`],
         unit,
         selected,
         onSelect: (m) => {

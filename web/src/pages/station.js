@@ -173,7 +173,6 @@ export async function mount(container, _params, ctx) {
           try {
             const { job } = await post('/api/scans', body);
             state.myJob = job.id;
-            state.previews.clear();
             setJob(job);
             name.value = '';
             contact.value = '';
@@ -202,7 +201,11 @@ export async function mount(container, _params, ctx) {
   // ---- the job
   const previewGrid = h('div', { class: 'previews' });
   function setJob(job) {
-    if (!state.job || state.job.id !== job.id) state.lastFraction = 0;
+    if (!state.job || state.job.id !== job.id) {
+      state.lastFraction = 0;
+      state.previews.clear();
+      previewGrid.replaceChildren();
+    }
     state.job = job;
     renderJob();
     renderForm();

@@ -3,14 +3,34 @@
 import { del, enc, get, post } from '../api.js';
 import { formatLength, preferredUnit, setPreferredUnit, UNITS } from '../units.js';
 import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
-import { BodyView } from '../viewer/body-view.js';
+import { BodyView, ModelDecoding } from '../viewer/body-view.js';
 import { MeasureTool, TOOLS } from '../viewer/measure-tool.js';
 import { COLOURS, drawMeasurement, KIND_LABEL, measurementTable, slug } from '../viewer/measurement-table.js';
 import { shareDialog } from './share-dialog.js';
 
+// The model's bytes, asked for at once (the current version, revalidated by its
+// ETag), beside the scan's record rather than after it.
+function fetchModel(id) {
+  const bytes = fetch(`/api/scans/${enc(id)}/mesh.glb`, { credentials: 'same-origin' }).then((r) => {
+    if (!r.ok) throw new Error(`the model is not available (${r.status})`);
+    return r.arrayBuffer();
+  });
+  bytes.catch(() => {}); // a scan without a model never reads it
+  return bytes;
+}
+
 export async function mount(container, { id }, ctx) {
   const t0 = performance.now();
   performance.mark('bodyscan:open-scan');
+  const bytes = fetchModel(id);
+  const record = get(`/api/scans/${enc(id)}`);
+  record.catch(() => {});
+  // The model decodes in a worker while the page and its renderer are built:
+  // wait (briefly) for its bytes, then one task more, so that the decoder's
+  // worker has its job before the renderer's context takes the main thread.
+  const model = new ModelDecoding(bytes);
+  const nextTask = () => new Promise((r) => setTimeout(r, 0));
+  await Promise.race([bytes.then(nextTask, () => {}), new Promise((r) => setTimeout(r, 250))]);
   const role = ctx.session.role;
   const state = { unit: preferredUnit(), selected: null, fresh: null, measurements: [], scan: null, customer: null };
 
@@ -81,8 +101,7 @@ export async function mount(container, { id }, ctx) {
   );
 
   // ---- data
-  async function loadScan() {
-    state.scan = await get(`/api/scans/${enc(id)}`);
+  async function loadCustomer() {
     try {
       state.customer = await get(`/api/customers/${enc(state.scan.customer_id)}`);
     } catch {
@@ -294,18 +313,19 @@ export async function mount(container, { id }, ctx) {
 
   // ---- open
   try {
-    await loadScan();
+    state.scan = await record;
+    renderHeading();
   } catch (e) {
     clear(page, h('div', { class: 'page narrow' }, h('h1', {}, 'Scan not found'), h('p', {}, errorText(e)), h('a', { href: '/archive' }, 'Back to the archive')));
     view.dispose();
     return () => {};
   }
+  loadCustomer();
   if (state.scan.status === 'running') {
     hint.textContent = 'This scan is still being made; it opens when it is done.';
     watchJob();
   } else if (state.scan.status === 'complete' || state.scan.current_version > 0) {
-    const glb = `/api/scans/${enc(id)}/mesh.glb?version=${state.scan.current_version}`;
-    Promise.all([view.loadMesh(glb, { t0 }), loadMeasurements()]).catch((e) => {
+    Promise.all([view.loadMesh(model, { t0 }), loadMeasurements()]).catch((e) => {
       if (!disposed) toast(`The model did not load: ${errorText(e)}`, 'error');
     });
   } else {

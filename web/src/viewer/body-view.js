@@ -1,12 +1,14 @@
 // A body in a canvas: the archived surface (glTF binary with Draco, metres,
-// no normals) or the point cloud (Draco, mm), shown in mm in the scan frame
+// no normals) or the point cloud (Draco, metres), shown in mm in the scan frame
 // (Y up, floor at 0), turned, zoomed and panned by touch or mouse, with the
 // measurement lines drawn on it and picking through a BVH (three-mesh-bvh), so a
 // tap on a 500k-triangle body answers at once.
 //
-// It renders on demand (a tablet's battery), and records when its first frame
-// with the model was drawn: performance mark `bodyscan:first-frame`, and the
-// container's data-state / data-bounds / data-triangles for the tests.
+// It renders on demand (a tablet's battery). What it costs is in the page's
+// User Timing (DevTools, the benchmark): marks bodyscan:model-decoded,
+// bodyscan:normals-done and bodyscan:first-frame, measures bodyscan:bvh and
+// bodyscan:pick. The container's data-state / data-bounds / data-triangles /
+// data-first-frame-ms tell the tests what was drawn.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
@@ -15,6 +17,7 @@ import { Line2 } from 'three/addons/lines/Line2.js';
 import { LineGeometry } from 'three/addons/lines/LineGeometry.js';
 import { LineMaterial } from 'three/addons/lines/LineMaterial.js';
 import { acceleratedRaycast, computeBoundsTree, disposeBoundsTree } from 'three-mesh-bvh';
+import { computeNormals } from './normals.js';
 
 THREE.BufferGeometry.prototype.computeBoundsTree = computeBoundsTree;
 THREE.BufferGeometry.prototype.disposeBoundsTree = disposeBoundsTree;
@@ -30,6 +33,20 @@ function dracoLoader() {
   }
   return draco;
 }
+
+// A model decoded (Draco, in a worker) from a URL or from a promise of its
+// bytes; needs no renderer, so it can run while the page builds one.
+export class ModelDecoding {
+  constructor(source) {
+    const loader = new GLTFLoader();
+    loader.setDRACOLoader(dracoLoader());
+    this.gltf = typeof source === 'string' ? loader.loadAsync(source) : Promise.resolve(source).then((bytes) => loader.parseAsync(bytes, ''));
+    this.gltf.catch(() => {}); // reported by loadMesh, if it is ever shown
+  }
+}
+
+// The decoder's script and wasm start loading as soon as the viewer's code does.
+dracoLoader();
 
 const SKIN = 0xd8b49c;
 const VIEWS = {
@@ -108,7 +125,9 @@ export class BodyView {
   }
 
   render() {
-    if (this.disposed) return;
+    // Nothing to show yet: the first draw (and its shader compiles) waits for
+    // the model, so the main thread is free when the model's bytes arrive.
+    if (this.disposed || (!this.mesh && !this.points)) return;
     this.renderer.render(this.scene, this.camera);
     for (const fn of this.renderListeners) fn();
   }
@@ -118,27 +137,27 @@ export class BodyView {
     return () => this.controls.removeEventListener('change', fn);
   }
 
-  // Loads the surface; resolves once its first frame is drawn, with the time it
-  // took from `t0` (performance.now() when the scan was opened).
-  async loadMesh(url, { t0 = performance.now() } = {}) {
+  // Shows the surface: `source` is a URL, a promise of the GLB's bytes, or a
+  // ModelDecoding already under way. Resolves once its first frame is
+  // drawn, with the time it took from `t0` (when the scan was opened).
+  async loadMesh(source, { t0 = performance.now() } = {}) {
     this.container.dataset.state = 'loading';
     try {
-      const loader = new GLTFLoader();
-      loader.setDRACOLoader(dracoLoader());
-      const gltf = await loader.loadAsync(url);
+      const gltf = await (source instanceof ModelDecoding ? source : new ModelDecoding(source)).gltf;
       if (this.disposed) return null;
+      performance.mark('bodyscan:model-decoded');
       gltf.scene.updateMatrixWorld(true);
-      let source = null;
+      let found = null;
       gltf.scene.traverse((o) => {
-        if (!source && o.isMesh) source = o;
+        if (!found && o.isMesh) found = o;
       });
-      if (!source) throw new Error('the model holds no mesh');
-      const geometry = source.geometry;
-      geometry.applyMatrix4(new THREE.Matrix4().makeScale(1000, 1000, 1000).multiply(source.matrixWorld)); // m -> mm
-      geometry.deleteAttribute('normal');
-      geometry.computeVertexNormals();
+      if (!found) throw new Error('the model holds no mesh');
+      const geometry = found.geometry;
+      geometry.applyMatrix4(new THREE.Matrix4().makeScale(1000, 1000, 1000).multiply(found.matrixWorld)); // m -> mm
+      computeNormals(geometry);
       geometry.computeBoundingBox();
       geometry.computeBoundingSphere();
+      performance.mark('bodyscan:normals-done');
       const material = new THREE.MeshStandardMaterial({
         color: SKIN,
         roughness: 0.75,
@@ -167,8 +186,10 @@ export class BodyView {
   async loadPoints(url) {
     const geometry = await dracoLoader().loadAsync(url);
     if (this.disposed) return;
+    geometry.scale(1000, 1000, 1000); // served in metres like the model (docs/archive.md)
     geometry.computeBoundingBox();
-    const material = new THREE.PointsMaterial({ color: 0x2f6f9f, size: 2.5, sizeAttenuation: true });
+    // About the points' spacing on the skin (5 mm), so the cloud reads as a surface.
+    const material = new THREE.PointsMaterial({ color: 0x2f6f9f, size: 6, sizeAttenuation: true });
     this.points = new THREE.Points(geometry, material);
     this.points.name = 'points';
     this.scene.add(this.points);
@@ -207,7 +228,11 @@ export class BodyView {
   }
 
   ensureBvh() {
-    if (this.mesh && !this.mesh.geometry.boundsTree) this.mesh.geometry.computeBoundsTree();
+    if (this.mesh && !this.mesh.geometry.boundsTree) {
+      const t = performance.now();
+      this.mesh.geometry.computeBoundsTree();
+      performance.measure('bodyscan:bvh', { start: t, end: performance.now() });
+    }
     return true;
   }
 
@@ -256,7 +281,9 @@ export class BodyView {
     const raycaster = new THREE.Raycaster();
     raycaster.firstHitOnly = true;
     raycaster.setFromCamera(this.ndc(clientX, clientY), this.camera);
+    const t = performance.now();
     const hit = raycaster.intersectObject(this.mesh, false)[0];
+    performance.measure('bodyscan:pick', { start: t, end: performance.now() });
     return hit ? hit.point.clone() : null;
   }
 

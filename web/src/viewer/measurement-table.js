@@ -27,14 +27,24 @@ export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
 }
 
 // rows: [{m, other?}] - `other` is the same measurement on a second scan (compare).
-export function measurementTable({ measurements, unit, selected, onSelect, onDelete, compareWith = null, caption, groups = { automatic: 'Automatic (ISO 8559-1)', user: 'Saved by staff' } }) {
+export function measurementTable({
+  measurements,
+  unit,
+  selected,
+  onSelect,
+  onDelete,
+  compareWith = null,
+  columns = ['This scan', 'Other'],
+  caption,
+  groups = { automatic: 'Automatic (ISO 8559-1)', user: 'Saved by staff' },
+}) {
   const byName = new Map((compareWith || []).map((m) => [m.name, m]));
   const head = h(
     'tr',
     {},
     h('th', { scope: 'col' }, 'Measurement'),
-    h('th', { scope: 'col', class: 'num' }, compareWith ? 'This scan' : 'Value'),
-    compareWith ? h('th', { scope: 'col', class: 'num' }, 'Other') : null,
+    h('th', { scope: 'col', class: 'num' }, compareWith ? columns[0] : 'Value'),
+    compareWith ? h('th', { scope: 'col', class: 'num' }, columns[1]) : null,
     compareWith ? h('th', { scope: 'col', class: 'num' }, 'Change') : null,
     onDelete ? h('th', { scope: 'col' }, h('span', { class: 'sr-only' }, 'Delete')) : null,
   );

@@ -239,6 +239,36 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.ok(Math.abs(distance.body.value_mm - straight) < 0.01, `${distance.body.value_mm} vs ${straight}`);
     assert.ok(straight > 150, 'the taps landed on two places of the body');
 
+    // The same two places over the skin and along the tape: never shorter than
+    // the straight line, and not absurdly longer.
+    for (const tool of ['surface', 'arc']) {
+      await page.click(`.segmented button[data-value=${tool}]`);
+      pending = nextMeasure();
+      await page.mouse.click(box.x + box.width * 0.47, box.y + box.height * 0.35);
+      await page.mouse.click(box.x + box.width * 0.53, box.y + box.height * 0.6);
+      const m = await pending;
+      assert.equal(m.status, 200, `${tool}: ${JSON.stringify(m.body)}`);
+      assert.equal(m.request.kind, tool);
+      const [p, q] = [m.request.from, m.request.to];
+      const chord = Math.hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+      assert.ok(m.body.value_mm >= chord - 0.01 && m.body.value_mm < chord * 2, `${tool}: ${m.body.value_mm} mm over a ${chord} mm chord`);
+    }
+    await page.click('.segmented button[data-value=rotate]');
+
+    // The point cloud instead of the surface (the lines put away first: the
+    // picture is the cloud's).
+    await page.click('.result button:has-text("Discard")');
+    await page.click('tr[data-name=jacket_waist]');
+    assert.equal(await page.locator('tr.selected').count(), 0);
+    const pointsLoaded = page.waitForResponse((r) => r.url().includes('/points.drc'));
+    await page.click('.segmented button[data-value=points]');
+    assert.equal((await pointsLoaded).status(), 200);
+    await page.waitForTimeout(1000);
+    const cloud = await coverage(page, '#viewport canvas');
+    assert.ok(cloud > 0.03, `the point cloud covers ${(cloud * 100).toFixed(1)} % of the view`);
+    await shot(page, 'viewer-points');
+    await page.click('.segmented button[data-value=mesh]');
+
     // Units: inches.
     await page.selectOption('select[aria-label=Unit]', 'in');
     assert.match(await page.locator('tr[data-name=jacket_waist] .value').innerText(), new RegExp(`${(girth.body.value_mm / 25.4).toFixed(2)} in`));
