@@ -1,7 +1,8 @@
 // Two scans of one customer side by side: the bodies turn together, the table
 // gives both values and the change; a row draws its line on both bodies.
 import { enc, get } from '../api.js';
-import { preferredUnit, setPreferredUnit, UNITS } from '../units.js';
+import { preferredUnit } from '../units.js';
+import { unitSelect } from '../ui/unit-select.js';
 import { clear, errorText, h, when } from '../ui/dom.js';
 import { BodyView } from '../viewer/body-view.js';
 import { COLOURS, drawMeasurement, measurementTable } from '../viewer/measurement-table.js';
@@ -22,18 +23,6 @@ export async function mount(container, { a, b }) {
   const customer = await get(`/api/customers/${enc(newer.customer_id)}`).catch(() => null);
   const ports = scans.map(() => h('div', { class: 'viewport' }));
   const tableBox = h('div', { class: 'table-box' });
-  const unitSelect = h(
-    'select',
-    {
-      'aria-label': 'Unit',
-      onchange: (e) => {
-        unit = e.target.value;
-        setPreferredUnit(unit);
-        render();
-      },
-    },
-    Object.keys(UNITS).map((u) => h('option', { value: u, selected: u === unit }, UNITS[u].label)),
-  );
   container.append(
     h(
       'section',
@@ -43,7 +32,10 @@ export async function mount(container, { a, b }) {
         { class: 'page-head' },
         h('h1', {}, `Compare: ${customer ? customer.name : ''}`),
         customer ? h('a', { href: `/customers/${enc(customer.id)}` }, 'All scans of this customer') : null,
-        h('label', { class: 'unit-select' }, unitSelect),
+        unitSelect(unit, (u) => {
+          unit = u;
+          render();
+        }),
       ),
       older.customer_id !== newer.customer_id ? h('p', { class: 'form-error' }, 'These scans are of two different customers.') : null,
       h(

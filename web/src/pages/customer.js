@@ -2,7 +2,8 @@
 // measurements staff chose, read-only. It calls only /api/share/{token}/…; the
 // token is the whole of the customer's access.
 import { enc, get } from '../api.js';
-import { preferredUnit, setPreferredUnit, UNITS } from '../units.js';
+import { preferredUnit } from '../units.js';
+import { unitSelect } from '../ui/unit-select.js';
 import { clear, errorText, h, when } from '../ui/dom.js';
 import { BodyView } from '../viewer/body-view.js';
 import { COLOURS, drawMeasurement, measurementTable } from '../viewer/measurement-table.js';
@@ -27,18 +28,6 @@ export async function mount(container, { token }) {
   }
   const viewport = h('div', { class: 'viewport', id: 'viewport' });
   const tableBox = h('div', { class: 'table-box' });
-  const unitSelect = h(
-    'select',
-    {
-      'aria-label': 'Unit',
-      onchange: (e) => {
-        unit = e.target.value;
-        setPreferredUnit(unit);
-        renderTable();
-      },
-    },
-    Object.keys(UNITS).map((u) => h('option', { value: u, selected: u === unit }, UNITS[u].label)),
-  );
   container.append(
     h(
       'section',
@@ -50,7 +39,20 @@ export async function mount(container, { token }) {
         h('p', { class: 'muted' }, `Taken ${when(share.taken_at)} · this link works until ${when(new Date(share.expires_at * 1000).toISOString())}`),
       ),
       h('div', { class: 'viewer-main' }, viewport, h('p', { class: 'hint' }, 'Drag to turn, pinch or scroll to zoom. Tap a measurement to see it on the body.')),
-      h('aside', { class: 'viewer-side' }, h('div', { class: 'row' }, h('h2', {}, 'Measurements'), h('label', { class: 'unit-select' }, unitSelect)), tableBox),
+      h(
+        'aside',
+        { class: 'viewer-side' },
+        h(
+          'div',
+          { class: 'row' },
+          h('h2', {}, 'Measurements'),
+          unitSelect(unit, (u) => {
+            unit = u;
+            renderTable();
+          }),
+        ),
+        tableBox,
+      ),
     ),
   );
   const view = new BodyView(viewport, { label: 'Your body in 3-D' });

@@ -1,7 +1,8 @@
 // The tailor's page: one scan's body, its measurements, new ones drawn on it and
 // evaluated by the server, saved by name, exported, shared with the customer.
 import { del, enc, get, post } from '../api.js';
-import { formatLength, preferredUnit, setPreferredUnit, UNITS } from '../units.js';
+import { formatLength, preferredUnit } from '../units.js';
+import { unitSelect } from '../ui/unit-select.js';
 import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 import { BodyView, ModelDecoding } from '../viewer/body-view.js';
 import { MeasureTool, TOOLS } from '../viewer/measure-tool.js';
@@ -79,25 +80,12 @@ export async function mount(container, { id }, ctx) {
     }),
     segmented('View', [['front', 'Front'], ['left', 'Side'], ['back', 'Back']], 'front', (v) => view.setView(v)),
     segmented('Tool', Object.entries(TOOLS).map(([k, t]) => [k, t.label]), 'rotate', (m) => tool.setMode(m)),
-    h(
-      'label',
-      { class: 'unit-select' },
-      h('span', { class: 'sr-only' }, 'Unit'),
-      h(
-        'select',
-        {
-          'aria-label': 'Unit',
-          onchange: (e) => {
-            state.unit = e.target.value;
-            setPreferredUnit(state.unit);
-            renderTable();
-            renderResult();
-            renderActions();
-          },
-        },
-        Object.keys(UNITS).map((u) => h('option', { value: u, selected: u === state.unit }, UNITS[u].label)),
-      ),
-    ),
+    unitSelect(state.unit, (u) => {
+      state.unit = u;
+      renderTable();
+      renderResult();
+      renderActions();
+    }),
   );
 
   // ---- data
