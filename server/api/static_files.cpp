@@ -67,6 +67,11 @@ bool under(const fs::path& root, const fs::path& p) {
   return true;
 }
 
+constexpr const char* kPageCsp =
+    "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; worker-src 'self' blob:; "
+    "img-src 'self' data: blob:; style-src 'self'; connect-src 'self'; object-src 'none'; "
+    "base-uri 'none'; form-action 'self'; frame-ancestors 'none'";
+
 // Accept-Encoding names gzip without q=0.
 bool accepts_gzip(std::string_view header) {
   size_t at = 0;
@@ -131,6 +136,13 @@ HttpResponse serve_static(const std::string& web_root, const HttpRequest& reques
   if (gzip) r.set("Content-Encoding", "gzip");
   if (rel.rfind("assets/", 0) == 0) r.set("Cache-Control", "public, max-age=31536000, immutable");
   else r.set("Cache-Control", "no-cache");
+  if (real.extension() == ".html") {
+    // The UI's page: its own scripts only (and the Draco decoder's wasm and
+    // worker), no framing, and no Referer: a share link's token never leaves in one.
+    r.set("Content-Security-Policy", kPageCsp);
+    r.set("Referrer-Policy", "no-referrer");
+    r.set("X-Frame-Options", "DENY");
+  }
   if (request.header("if-none-match") == etag) {
     r.status = 304;
     return r;

@@ -18,11 +18,11 @@
 
 #include "hw/rig_description.hpp"
 #include "recon/io/atomic_file.hpp"
-#include "recon/io/png_image.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/scan_recording.hpp"
 #include "server/pipeline/sim_backend.hpp"
+#include "server/workstation/preview.hpp"
 #include "storage/archive/ids.hpp"
 
 namespace bodyscan::server {
@@ -70,26 +70,6 @@ std::string base64(const std::string& bytes) {
                     sodium_base64_VARIANT_ORIGINAL);
   out.pop_back();  // the terminating NUL
   return out;
-}
-
-// A camera frame shrunk to `width` pixels across (box filter), 8 bits, as PNG.
-StatusOr<std::string> preview_png(const hw::Frame& f, int width) {
-  if (f.width <= 0 || f.height <= 0) return invalid_argument("empty frame");
-  const int step = std::max(1, (f.width + width - 1) / width);
-  GrayImage img;
-  img.width = f.width / step;
-  img.height = f.height / step;
-  img.bit_depth = 8;
-  img.pixels.resize(static_cast<size_t>(img.width) * img.height);
-  const int shift = std::max(0, hw::bits_per_pixel(f.format) - 8);
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) {
-      uint32_t sum = 0;
-      for (int dy = 0; dy < step; ++dy)
-        for (int dx = 0; dx < step; ++dx) sum += f.at(x * step + dx, y * step + dy);
-      img.pixels[static_cast<size_t>(y) * img.width + x] = static_cast<uint16_t>((sum / (step * step)) >> shift);
-    }
-  return encode_png(img, 6);
 }
 
 std::string gzip(const std::string& in) {

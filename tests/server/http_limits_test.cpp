@@ -78,6 +78,13 @@ TEST_F(HttpLimits, StaticFilesStayInTheWebRootWithTheirMimeTypes) {
   EXPECT_EQ(type("/model.glb"), "model/gltf-binary");
   EXPECT_EQ(type("/cloud.drc"), "application/octet-stream");
   EXPECT_NE(http(port, "GET", "/assets/app-1234.mjs").header("cache-control").find("immutable"), std::string::npos);
+  // The page itself: a content security policy, no framing, no Referer (share
+  // links carry their token in the path).
+  const HttpReply page = http(port, "GET", "/s/sometoken");
+  EXPECT_NE(page.header("content-security-policy").find("default-src 'self'"), std::string::npos);
+  EXPECT_NE(page.header("content-security-policy").find("frame-ancestors 'none'"), std::string::npos);
+  EXPECT_EQ(page.header("referrer-policy"), "no-referrer");
+  EXPECT_EQ(http(port, "GET", "/assets/app-1234.mjs").header("content-security-policy"), "");
   // The UI's own routes are the app's page.
   EXPECT_NE(http(port, "GET", "/s/sometoken").body.find("<title>bodyscan</title>"), std::string::npos);
   EXPECT_EQ(http(port, "GET", "/missing.js").status, 404);

@@ -256,12 +256,13 @@ export async function mount(container, _params, ctx) {
 
   async function renderRecent() {
     try {
-      const { scans } = await get(`/api/scans${query({ limit: 6 })}`);
+      const [{ scans }, { customers }] = await Promise.all([get(`/api/scans${query({ limit: 6 })}`), get('/api/customers')]);
+      const names = new Map(customers.map((c) => [c.id, c.name]));
       clear(
         recentBox,
         h('h2', {}, 'Latest scans'),
         scans.length
-          ? h('ul', { class: 'plain' }, scans.map((s) => h('li', {}, h('a', { href: `/scans/${enc(s.id)}` }, when(s.started_at)), ` · ${s.status}`, s.operator ? ` · ${s.operator}` : '')))
+          ? h('ul', { class: 'plain' }, scans.map((s) => h('li', {}, h('a', { href: `/scans/${enc(s.id)}` }, names.get(s.customer_id) || s.customer_id), ` · ${when(s.started_at)} · ${s.status}`)))
           : h('p', { class: 'muted' }, 'None yet.'),
       );
     } catch (e) {

@@ -91,9 +91,10 @@ export function errorText(e) {
   return e && e.message ? e.message : String(e);
 }
 
-// "3 min ago", "2 h ago", "5 days ago".
+// "just now", "3 min ago", "2 h ago", "5 days ago".
 export function ago(seconds) {
   if (!Number.isFinite(seconds)) return '—';
+  if (seconds < 10) return 'just now';
   if (seconds < 90) return `${Math.round(seconds)} s ago`;
   if (seconds < 5400) return `${Math.round(seconds / 60)} min ago`;
   if (seconds < 2 * 86400) return `${Math.round(seconds / 3600)} h ago`;

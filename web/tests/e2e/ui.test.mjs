@@ -205,6 +205,31 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await logout(page);
   });
 
+  it('calibrates the rig from the station, and cancels a scan with the lasers left off', async () => {
+    await login(page, server.url, ...OPERATOR);
+    const before = await page.locator('#calibration-age').innerText();
+    await page.click('#rig-status button:has-text("Calibrate")');
+    await page.locator('#job .job-state[data-state=running]').waitFor({ timeout: 30000 });
+    assert.match(await page.locator('#job h2').innerText(), /Calibration/);
+    await page.locator('#job .job-state[data-state=complete]').waitFor({ timeout: 180000 });
+    await page.waitForFunction((old) => document.querySelector('#calibration-age').innerText !== old, before, { timeout: 30000 });
+    assert.match(await page.locator('#calibration-age').innerText(), /Calibrated (just now|\d+ s ago)/);
+    assert.match(await page.locator('#rig-status table').innerText(), /\d\.\d{3} px/);
+    await shot(page, 'station-calibrated');
+
+    await page.fill('input[name=name]', 'Grace Hopper');
+    await page.click('#start-scan');
+    await page.locator('#job .job-state[data-stage=scan]').waitFor({ timeout: 60000 });
+    await page.click('#job button:has-text("Cancel")');
+    await page.locator('#job .job-state[data-state=cancelled]').waitFor({ timeout: 60000 });
+    assert.match(page.url(), /\/station$/, 'a cancelled scan does not open');
+    // Once the job has ended the rig reports every laser off.
+    await page.waitForFunction(() => [...document.querySelectorAll('#rig-status .laser')].every((l) => l.classList.contains('off')), null, { timeout: 30000 });
+    assert.equal(await page.locator('#start-scan').isEnabled(), true);
+    await shot(page, 'station-cancelled');
+    await logout(page);
+  });
+
   it('lets a tailor draw, save and name a girth, measure a distance by two taps, and export the sheet', async () => {
     await login(page, server.url, ...TAILOR);
     assert.match(page.url(), /\/archive$/);
@@ -281,6 +306,9 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.match(csv, /Waist girth/);
     assert.match(download.suggestedFilename(), /\.csv$/);
     await download.saveAs(`${ARTEFACTS}/sheet.csv`);
+    const [pdf] = await Promise.all([page.waitForEvent('download'), page.click('a:has-text("Export PDF")')]);
+    assert.equal(readFileSync(await pdf.path()).subarray(0, 5).toString(), '%PDF-');
+    await pdf.saveAs(`${ARTEFACTS}/sheet.pdf`);
     await page.selectOption('select[aria-label=Unit]', 'cm');
   });
 
@@ -363,10 +391,27 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.equal(await row.count(), 1);
     await row.locator('button:has-text("Delete")').click();
     await page.locator('dialog[open] button[value=ok]').click();
+    // The list goes and is made again: the other scan is back in it, the deleted
+    // one not.
     await row.waitFor({ state: 'detached' });
-    assert.equal(await page.locator(`tr[data-scan="${state.scanB}"]`).count(), 1, 'the other scan stays');
+    await page.locator(`tr[data-scan="${state.scanB}"]`).waitFor({ timeout: 10000 });
+    assert.equal(await row.count(), 0);
     const status = await page.evaluate(async (link) => (await fetch(link.replace('/s/', '/api/share/'))).status, state.link);
     assert.equal(status, 404);
+  });
+
+  it('finds scans by date in the archive', async () => {
+    const today = new Date().toISOString().slice(0, 10);
+    await page.goto(`${server.url}/archive`);
+    await page.fill('input[name=from]', today);
+    await page.fill('input[name=to]', today);
+    await page.click('form.filters button[type=submit]');
+    await page.locator(`tr[data-scan="${state.scanB}"]`).waitFor();
+    await page.fill('input[name=from]', '2020-01-01');
+    await page.fill('input[name=to]', '2020-12-31');
+    await page.click('form.filters button[type=submit]');
+    await page.locator('.results:has-text("No scan matches")').waitFor();
+    assert.match(page.url(), /from=2020-01-01&to=2020-12-31/);
   });
 
   it('fits a 1024×768 tablet without sideways scrolling', async () => {
@@ -382,5 +427,20 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
       await shot(p, `tablet${path.replace(/\//g, '-').replace(/-s_.*/, '-viewer')}`);
     }
     await tablet.close();
+  });
+
+  it('lets an admin erase a customer with everything derived from them', async () => {
+    await page.goto(`${server.url}/archive`);
+    await page.fill('input[name=q]', 'Lovelace');
+    await page.click('form.filters button[type=submit]');
+    await page.click(`tr[data-scan="${state.scanB}"] td:nth-child(2) a`);
+    await page.waitForURL('**/customers/**');
+    await page.click('button:has-text("Erase customer")');
+    await page.locator('dialog[open] button[value=ok]').click();
+    await page.waitForURL('**/archive');
+    const left = await page.evaluate(async () => (await (await fetch('/api/customers?q=Lovelace')).json()).customers.length);
+    assert.equal(left, 0);
+    const scan = await page.evaluate(async (id) => (await fetch(`/api/scans/${id}`)).status, state.scanB);
+    assert.equal(scan, 404);
   });
 });
