@@ -110,8 +110,14 @@ TEST(MeasureCli, SurfaceLengthsAndTheAutomaticSet) {
   // A floor given: heights grow by the gap, girths stay.
   r = bodyscan("measure " + quote(body) + " --auto --floor -10", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const nlohmann::json& x : nlohmann::json::parse(r.out)["measurements"])
-    if (x["name"] == "stature") EXPECT_NEAR(x["value_mm"].get<double>(), 1729.3 + 10, 0.1);
+  bool stature_seen = false;
+  const nlohmann::json lowered = nlohmann::json::parse(r.out);  // kept: a range-for over a temporary's member dangles
+  for (const nlohmann::json& x : lowered["measurements"]) {
+    if (x["name"] != "stature") continue;
+    stature_seen = true;
+    EXPECT_NEAR(x["value_mm"].get<double>(), 1729.3 + 10, 0.1);
+  }
+  EXPECT_TRUE(stature_seen);
 
   // What cannot be done says why.
   r = bodyscan("measure " + quote(mesh) + " --auto", dir);

@@ -3,13 +3,15 @@
 // request (docs/api.md, "Evaluating") handed to `onRequest`; the server measures.
 //
 // Rotate: one finger or the left button turns, two fingers or the wheel zoom,
-// right button / two-finger drag pans (OrbitControls). Girth: a drag draws the
-// line (turning is off in this mode). Two-tap tools: a tap picks, a drag turns.
+// right button / two-finger drag pans (OrbitControls). Girth: one finger or the
+// left button draws the line; two fingers, the wheel and the right button still
+// zoom and pan. Two-tap tools: a tap picks, a drag turns.
+import { MOUSE, TOUCH } from 'three';
 import { arcRequest, girthRequestFromScreenLine } from './girth-line.js';
 
 export const TOOLS = {
   rotate: { label: 'Rotate', hint: 'Drag to turn the body, pinch or scroll to zoom, two fingers to move.' },
-  girth: { label: 'Girth', hint: 'Draw a line across the body where the tape goes.' },
+  girth: { label: 'Girth', hint: 'Draw a line across the body where the tape goes (two fingers still zoom and move).' },
   distance: { label: 'Distance', hint: 'Tap two points: the straight distance.' },
   arc: { label: 'Arc', hint: 'Tap two points: the length along the tape between them.' },
   surface: { label: 'Over skin', hint: 'Tap two points: the shortest path over the skin.' },
@@ -47,7 +49,10 @@ export class MeasureTool {
     this.mode = mode;
     this.picked = [];
     this.view.clearOverlays('pick:');
-    this.view.controls.enabled = mode !== 'girth';
+    // In girth mode a one-finger or left-button drag is the line, not a turn.
+    const controls = this.view.controls;
+    controls.mouseButtons.LEFT = mode === 'girth' ? null : MOUSE.ROTATE;
+    controls.touches.ONE = mode === 'girth' ? null : TOUCH.ROTATE;
     this.view.canvas.style.cursor = mode === 'girth' ? 'crosshair' : mode === 'rotate' ? 'grab' : 'pointer';
     this.onHint(TOOLS[mode].hint);
   }
