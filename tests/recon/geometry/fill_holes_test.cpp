@@ -113,7 +113,9 @@ TEST(FillHoles, CurvedHoleFollowsTheSphere) {
     lowest_top[f] = top;
     if (fairings[f] == HoleFairing::kThinPlate) {
       for (size_t v = 0; v < m.vertices.size(); ++v) {
-        if (m.confidence[v] == 0.f) EXPECT_NEAR(m.vertices[v].norm(), 1.0f, 0.08f);
+        if (m.confidence[v] == 0.f) {
+          EXPECT_NEAR(m.vertices[v].norm(), 1.0f, 0.08f);
+        }
       }
     }
   }
@@ -133,7 +135,9 @@ TEST(FillHoles, LongLoopsAreSplitAndStillClose) {
   EXPECT_GT(s.largest_hole_edges, 200u);
   expect_closed(m, "split loop");
   for (size_t v = 0; v < m.vertices.size(); ++v) {
-    if (m.confidence[v] == 0.f) EXPECT_GT(m.vertices[v].y(), 0.45f);
+    if (m.confidence[v] == 0.f) {
+      EXPECT_GT(m.vertices[v].y(), 0.45f);
+    }
   }
 }
 

@@ -130,7 +130,9 @@ TEST(ImplicitFieldEvaluate, BentKernelZeroSetIsTheOsculatingSphere) {
     const double sag = sphere(r2);
     ImplicitField::evaluate({k}, 1e-3f, Vec3d(u, 0.3 * u, sag), &v, &w);
     EXPECT_NEAR(v, 0.0, 1e-7) << u;
-    if (std::abs(u) < 0.3) EXPECT_NEAR(sag, -0.4 * r2, 0.01 * std::abs(sag)) << "paraboloid near the centre";
+    if (std::abs(u) < 0.3) {
+      EXPECT_NEAR(sag, -0.4 * r2, 0.01 * std::abs(sag)) << "paraboloid near the centre";
+    }
     const double sag0 = sphere(u * u);
     ImplicitField::evaluate({k}, 1e-3f, Vec3d(u, 0.0, sag0 - 0.02), &v, &w);
     EXPECT_GT(v, 0.0) << u;  // below the sphere: inside

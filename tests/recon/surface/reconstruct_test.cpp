@@ -83,7 +83,7 @@ TEST(ReconstructSurface, IsolatedStraysGetNoKernel) {
   // A sphere and three stray points far off (a floor sample, a speck): each would
   // get a kernel as wide as the gap to its neighbours and the grid with it.
   PointCloud c = fibonacci_sphere(4096, 1.0);
-  for (const Vec3f p : {Vec3f(12, 0, 0), Vec3f(0, -9, 7), Vec3f(-15, 4, 0)}) {
+  for (const Vec3f& p : {Vec3f(12, 0, 0), Vec3f(0, -9, 7), Vec3f(-15, 4, 0)}) {
     c.positions.push_back(p);
     c.normals.push_back(Vec3f::UnitY());
   }
@@ -95,7 +95,9 @@ TEST(ReconstructSurface, IsolatedStraysGetNoKernel) {
   ReconstructOptions keep;
   keep.isolated_spacing_ratio = 0;
   auto all = reconstruct_surface(c, keep);
-  if (all.ok()) EXPECT_EQ(all->stats.isolated_points, 0u);
+  if (all.ok()) {
+    EXPECT_EQ(all->stats.isolated_points, 0u);
+  }
 }
 
 TEST(ReconstructSurface, NoisyUnitSphere) {
