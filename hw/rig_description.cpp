@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -50,6 +51,13 @@ Vec3d LaserDescription::plane_normal(int step) const {
   const Eigen::AngleAxisd turn(step * step_angle_deg * M_PI / 180.0, a);
   const Vec3d dir = turn * aim;
   return a.cross(dir).normalized();
+}
+
+bool RigDescription::has_real_devices() const {
+  if (controller.backend != "sim") return true;
+  for (const CameraDescription& c : cameras)
+    if (c.device.backend != "sim") return true;
+  return false;
 }
 
 const LaserDescription* RigDescription::find_laser(const std::string& id) const {
@@ -193,10 +201,28 @@ Distortion read_distortion(const Reader& r) {
 
 CameraDescription read_camera(const Reader& r) {
   r.only({"id", "position", "look_at", "focal_mm", "pixel_size_um", "width", "height", "distortion",
-          "pixel_format", "full_well_e", "read_noise_e", "exposure_us", "gain_db", "blur_px"});
+          "pixel_format", "full_well_e", "read_noise_e", "exposure_us", "gain_db", "blur_px", "device"});
   CameraDescription c;
   c.id = r.text("id", "", true);
   if (c.id.empty()) r.fail("id must not be empty");
+  if (r.has("device")) {
+    const Reader d = r.child("device");
+    d.only({"backend", "id", "trigger", "timeout_ms", "packet_size"});
+    c.device.backend = d.text("backend", "sim");
+    if (c.device.backend != "sim" && c.device.backend != "aravis") {
+      d.fail("backend must be 'sim' or 'aravis', got '" + c.device.backend + "'");
+    }
+    c.device.id = d.text("id", "");
+    if (c.device.backend == "aravis" && c.device.id.empty()) {
+      d.fail("an aravis camera needs its 'id' (as `bodyscan devices` lists it, or its IP address)");
+    }
+    c.device.trigger = d.text("trigger", "software");
+    if (c.device.trigger.empty()) d.fail("trigger must be 'software' or a line name such as 'Line1'");
+    c.device.timeout_ms = d.integer("timeout_ms", c.device.timeout_ms);
+    if (c.device.timeout_ms < 10 || c.device.timeout_ms > 600000) d.fail("timeout_ms must be 10..600000");
+    c.device.packet_size = d.integer("packet_size", 0);
+    if (c.device.packet_size < 0 || c.device.packet_size > 16384) d.fail("packet_size must be 0..16384");
+  }
   c.position = r.vec3("position", c.position, true);
   c.look_at = r.vec3("look_at", c.look_at, true);
   if ((c.look_at - c.position).norm() < 1) r.fail("look_at must differ from position");
@@ -251,6 +277,77 @@ LaserDescription read_laser(const Reader& r) {
   l.line_width_mm = r.positive("line_width_mm", l.line_width_mm);
   l.power = r.positive("power", l.power);
   return l;
+}
+
+uint16_t usb_id(const Reader& r, const char* key, uint16_t fallback) {
+  if (!r.has(key)) return fallback;
+  const std::string t = r.text(key, "");
+  char* end = nullptr;
+  const unsigned long v = std::strtoul(t.c_str(), &end, 16);
+  if (t.empty() || t.size() > 4 || *end != '\0') r.fail(std::string("'") + key + "' must be 4 hex digits, got '" + t + "'");
+  return static_cast<uint16_t>(v);
+}
+
+ControllerDescription read_controller(const Reader& r, const std::vector<LaserDescription>& lasers) {
+  r.only({"backend", "port", "usb", "module_address", "lasers", "room_lights_output", "front_lights_output",
+          "back_lights_output", "reply_timeout_ms", "move_timeout_ms", "home_timeout_ms", "watchdog_ms"});
+  ControllerDescription c;
+  c.backend = r.text("backend", "sim");
+  if (c.backend != "sim" && c.backend != "tmcl") r.fail("backend must be 'sim' or 'tmcl', got '" + c.backend + "'");
+  c.port = r.text("port", "");
+  if (r.has("usb")) {
+    const Reader u = r.child("usb");
+    u.only({"vendor", "product", "serial"});
+    c.usb_vendor = usb_id(u, "vendor", c.usb_vendor);
+    c.usb_product = usb_id(u, "product", c.usb_product);
+    c.usb_serial = u.text("serial", "");
+  }
+  c.module_address = r.integer("module_address", 1);
+  if (c.module_address < 0 || c.module_address > 255) r.fail("module_address must be 0..255");
+  c.room_lights_output = r.integer("room_lights_output", -1);
+  c.front_lights_output = r.integer("front_lights_output", -1);
+  c.back_lights_output = r.integer("back_lights_output", -1);
+  c.reply_timeout_ms = r.integer("reply_timeout_ms", c.reply_timeout_ms);
+  c.move_timeout_ms = r.integer("move_timeout_ms", c.move_timeout_ms);
+  c.home_timeout_ms = r.integer("home_timeout_ms", c.home_timeout_ms);
+  c.watchdog_ms = r.integer("watchdog_ms", c.watchdog_ms);
+  if (c.reply_timeout_ms < 10 || c.move_timeout_ms < 10 || c.home_timeout_ms < 10) r.fail("timeouts must be at least 10 ms");
+  if (c.watchdog_ms != 0 && (c.watchdog_ms < 100 || c.watchdog_ms > 60000)) {
+    r.fail("watchdog_ms must be 0 (none) or 100..60000");
+  }
+  c.lasers.assign(lasers.size(), {});
+  if (c.backend == "sim") return c;
+  std::set<int> outputs, axes;
+  auto output = [&](const Reader& at, int o, const std::string& what) {
+    if (o < 0) return;
+    if (o > 255) at.fail(what + ": output " + std::to_string(o) + " does not exist");
+    if (!outputs.insert(o).second) at.fail(what + ": output " + std::to_string(o) + " is wired twice");
+  };
+  output(r, c.room_lights_output, "room lights");
+  output(r, c.front_lights_output, "front frame lights");
+  output(r, c.back_lights_output, "back frame lights");
+  const Reader lw = r.child("lasers");
+  if (!lw.raw().is_object()) lw.fail("must map each laser id to its wiring");
+  for (auto it = lw.raw().begin(); it != lw.raw().end(); ++it) {
+    size_t i = 0;
+    while (i < lasers.size() && lasers[i].id != it.key()) ++i;
+    if (i == lasers.size()) lw.fail("unknown laser id '" + it.key() + "'");
+    const Reader w(it.value(), lw.path() + "." + it.key());
+    w.only({"output", "axis", "microsteps_per_step", "home_offset"});
+    ControllerDescription::LaserWiring& l = c.lasers[i];
+    l.output = w.integer("output", -1, true);
+    l.axis = w.integer("axis", -1, true);
+    l.microsteps_per_step = w.integer("microsteps_per_step", 1);
+    l.home_offset = w.integer("home_offset", 0);
+    if (l.output < 0) w.fail("output must be 0 or more");
+    output(w, l.output, "laser '" + it.key() + "'");
+    if (l.axis < 0 || l.axis > 255) w.fail("axis must be 0..255");
+    if (!axes.insert(l.axis).second) w.fail("axis " + std::to_string(l.axis) + " turns two lasers");
+    if (l.microsteps_per_step < 1) w.fail("microsteps_per_step must be at least 1");
+  }
+  for (size_t i = 0; i < lasers.size(); ++i)
+    if (c.lasers[i].output < 0) lw.fail("laser '" + lasers[i].id + "' is not wired (give its output and axis)");
+  return c;
 }
 
 SimulationDescription read_simulation(const Reader& r, const std::string& source) {
@@ -323,7 +420,7 @@ bool planes_cross_inside(const LaserDescription& a, const LaserDescription& b, c
 
 RigDescription read_rig(const json& j, const std::string& source) {
   const Reader r(j, "rig");
-  r.only({"name", "frame", "cameras", "lasers", "laser_groups", "simulation", "processing"});
+  r.only({"name", "frame", "cameras", "lasers", "laser_groups", "controller", "simulation", "processing"});
   RigDescription rig;
   rig.source = source;
   rig.name = r.text("name", std::filesystem::path(source).stem().string());
@@ -361,6 +458,8 @@ RigDescription read_rig(const json& j, const std::string& source) {
   }
   for (const LaserDescription& l : rig.lasers)
     if (!grouped.count(l.id)) rig.laser_groups.push_back({l.id});  // runs alone
+  rig.controller.lasers.assign(rig.lasers.size(), {});
+  if (r.has("controller")) rig.controller = read_controller(r.child("controller"), rig.lasers);
   if (r.has("simulation")) rig.simulation = read_simulation(r.child("simulation"), source);
   if (r.has("processing")) {
     const Reader p = r.child("processing");
@@ -427,6 +526,13 @@ std::string to_json(const RigDescription& rig) {
                             {"blur_px", c.blur_px},
                             {"exposure_us", c.exposure_us},
                             {"gain_db", c.gain_db}});
+    if (c.device.backend != "sim") {
+      j["cameras"].back()["device"] = {{"backend", c.device.backend},
+                                       {"id", c.device.id},
+                                       {"trigger", c.device.trigger},
+                                       {"timeout_ms", c.device.timeout_ms},
+                                       {"packet_size", c.device.packet_size}};
+    }
   }
   j["lasers"] = json::array();
   for (const LaserDescription& l : rig.lasers) {
@@ -441,6 +547,32 @@ std::string to_json(const RigDescription& rig) {
                            {"power", l.power}});
   }
   j["laser_groups"] = rig.laser_groups;
+  if (rig.controller.backend != "sim") {
+    const ControllerDescription& c = rig.controller;
+    char vendor[8], product[8];
+    std::snprintf(vendor, sizeof vendor, "%04x", c.usb_vendor);
+    std::snprintf(product, sizeof product, "%04x", c.usb_product);
+    json lasers_j = json::object();
+    for (size_t i = 0; i < rig.lasers.size() && i < c.lasers.size(); ++i) {
+      const auto& w = c.lasers[i];
+      lasers_j[rig.lasers[i].id] = {{"output", w.output},
+                                    {"axis", w.axis},
+                                    {"microsteps_per_step", w.microsteps_per_step},
+                                    {"home_offset", w.home_offset}};
+    }
+    j["controller"] = {{"backend", c.backend},
+                       {"port", c.port},
+                       {"usb", {{"vendor", vendor}, {"product", product}, {"serial", c.usb_serial}}},
+                       {"module_address", c.module_address},
+                       {"lasers", lasers_j},
+                       {"room_lights_output", c.room_lights_output},
+                       {"front_lights_output", c.front_lights_output},
+                       {"back_lights_output", c.back_lights_output},
+                       {"reply_timeout_ms", c.reply_timeout_ms},
+                       {"move_timeout_ms", c.move_timeout_ms},
+                       {"home_timeout_ms", c.home_timeout_ms},
+                       {"watchdog_ms", c.watchdog_ms}};
+  }
   const SimulationDescription& s = rig.simulation;
   j["simulation"] = {{"subject", s.subject},
                      {"subject_offset", vec(s.subject_offset)},

@@ -40,8 +40,19 @@ enum class PixelFormat { kMono8, kMono12, kMono16 };
 const char* to_string(PixelFormat f);
 int bits_per_pixel(PixelFormat f);  // significant bits: 8, 12 or 16
 
+// Which device a camera is: the simulator renders it, or a GenICam camera is
+// opened through Aravis (hw/aravis). docs/rig-description.md, "Devices".
+struct CameraDevice {
+  std::string backend = "sim";        // "sim" or "aravis"
+  std::string id;                     // aravis: as `bodyscan devices` lists it, or the camera's IP address
+  std::string trigger = "software";   // "software", or the line a hardware trigger arrives on ("Line1")
+  int timeout_ms = 2000;              // a frame not complete by then is an error
+  int packet_size = 0;                // GigE Vision: bytes per stream packet; 0 negotiates the largest
+};
+
 struct CameraDescription {
   std::string id;
+  CameraDevice device;
   Vec3d position = Vec3d::Zero();  // centre of projection, world mm
   Vec3d look_at = Vec3d::Zero();   // a world point on the optical axis
   double focal_mm = 6;
@@ -82,6 +93,29 @@ struct LaserDescription {
   double plane_offset(int step) const { return plane_normal(step).dot(position); }
 };
 
+// The controller: the simulator's, or a TMCL stepper module (hw/usb) whose digital
+// outputs switch the lasers and lights (through relays or the lasers' TTL enable)
+// and whose axes turn the lasers. docs/rig-description.md, "Devices".
+struct ControllerDescription {
+  std::string backend = "sim";        // "sim" or "tmcl"
+  std::string port;                   // a serial device node; empty: USB through libusb
+  uint16_t usb_vendor = 0x2a3c, usb_product = 0x0100;  // Trinamic's TMCM modules
+  std::string usb_serial;             // to pick one of several boards; empty: the first
+  int module_address = 1;
+  struct LaserWiring {
+    int output = -1;                  // digital output switching this laser
+    int axis = -1;                    // motor axis turning it
+    int microsteps_per_step = 1;      // motor microsteps per laser step (step_angle_deg)
+    int home_offset = 0;              // microsteps from the reference switch to step 0
+  };
+  std::vector<LaserWiring> lasers;    // by laser index
+  int room_lights_output = -1, front_lights_output = -1, back_lights_output = -1;  // -1: not wired
+  int reply_timeout_ms = 250;
+  int move_timeout_ms = 10000;
+  int home_timeout_ms = 60000;
+  int watchdog_ms = 500;              // board-side laser watchdog period; 0: none
+};
+
 struct SubjectMotion {
   double sway_mm = 0, sway_hz = 0.25;        // side-to-side (X) and front-back (Z) sway
   double breathing_mm = 0, breathing_hz = 0.25;  // chest radius change
@@ -118,8 +152,12 @@ struct RigDescription {
   // Lasers that may run together (thesis §2.3): each group's planes never cross
   // inside the frame at any pair of steps. Every laser is in exactly one group.
   std::vector<std::vector<std::string>> laser_groups;
+  ControllerDescription controller;
   SimulationDescription simulation;
   ProcessingHints processing;
+
+  // Whether any device is real (not simulated).
+  bool has_real_devices() const;
 
   const LaserDescription* find_laser(const std::string& id) const;
 };

@@ -1,0 +1,124 @@
+// Laser safety on every failure path the simulation can produce, each in a child
+// process that opens the rig's TMCL controller over a pseudo-terminal, switches a
+// laser on and then dies a different way. The board (here, in the parent) must
+// see the laser off:
+// - by the process's own emergency stop (crash signals, std::terminate, SIGTERM,
+//   SIGINT) - with the board's watchdog set to a minute, so only that path can
+//   have done it, and fast;
+// - by the board's watchdog when nothing in the process can run (SIGKILL).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <thread>
+
+#include "hw/controller.hpp"
+#include "hw/safety.hpp"
+#include "hw/usb/serial_link.hpp"
+#include "hw/usb/sim_tmcl_board.hpp"
+#include "hw/usb/tmcl_controller.hpp"
+#include "tests/hw/usb/tmcl_rig.hpp"
+
+namespace bodyscan::hw::usb {
+namespace {
+
+using namespace std::chrono_literals;
+
+enum class Death { kSegfault, kAbort, kTerminate, kSigterm, kSigint, kSigkill };
+
+// Runs the child; returns its wait status. `laser_output` is the board output of
+// laser 0.
+int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoard& board, int laser_output,
+              bool* was_on) {
+  int ready[2];
+  if (pipe(ready) != 0) return -1;
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(ready[0]);
+    install_laser_safety_handlers(true);
+    auto c = TmclController::open(testing::tmcl_rig(port, watchdog_ms));
+    if (!c.ok() || !(*c)->set_laser(0, true).ok()) _exit(3);
+    const char one = 1;
+    (void)!write(ready[1], &one, 1);
+    switch (death) {
+      case Death::kSegfault: raise(SIGSEGV); break;
+      case Death::kAbort: std::abort();
+      case Death::kTerminate: std::terminate();
+      default: break;
+    }
+    for (;;) pause();  // the parent signals it
+  }
+  close(ready[1]);
+  char byte = 0;
+  const bool started = read(ready[0], &byte, 1) == 1;
+  close(ready[0]);
+  *was_on = started && board.output(laser_output);
+  if (death == Death::kSigterm) kill(pid, SIGTERM);
+  if (death == Death::kSigint) kill(pid, SIGINT);
+  if (death == Death::kSigkill) kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return status;
+}
+
+// How long after the child's death the laser output went off; -1 if not within `limit`.
+double off_within(SimTmclBoard& board, int output, std::chrono::milliseconds limit) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < limit) {
+    if (!board.output(output)) return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    std::this_thread::sleep_for(1ms);
+  }
+  return -1;
+}
+
+class LaserSafety : public ::testing::TestWithParam<std::pair<Death, int>> {};
+
+TEST_P(LaserSafety, LaserGoesOffWhenTheProcessDies) {
+  const auto [death, expected_signal] = GetParam();
+  SimTmclBoard board;
+  auto pty = PtyBoard::start(board);
+  ASSERT_TRUE(pty.ok());
+  const int output = testing::tmcl_rig((*pty)->path(), 0).controller.lasers[0].output;
+  const bool uncatchable = death == Death::kSigkill;
+  bool was_on = false;
+  const int status = run_child((*pty)->path(), uncatchable ? 300 : 60000, death, board, output, &was_on);
+  ASSERT_TRUE(was_on) << "the child never switched the laser on";
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the child should die of its signal, status " << status;
+  EXPECT_EQ(WTERMSIG(status), expected_signal);
+  if (uncatchable) {
+    // Only the board's watchdog can do it: within its period plus a feed interval.
+    const double ms = off_within(board, output, 1500ms);
+    EXPECT_GE(ms, 0) << "the board's watchdog did not switch the laser off";
+    EXPECT_GE(board.watchdog_trips(), 1);
+  } else {
+    const double ms = off_within(board, output, 500ms);
+    EXPECT_GE(ms, 0) << "the emergency stop did not switch the laser off";
+    EXPECT_EQ(board.watchdog_trips(), 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryDeath, LaserSafety,
+                         ::testing::Values(std::pair{Death::kSegfault, SIGSEGV}, std::pair{Death::kAbort, SIGABRT},
+                                           std::pair{Death::kTerminate, SIGABRT}, std::pair{Death::kSigterm, SIGTERM},
+                                           std::pair{Death::kSigint, SIGINT}, std::pair{Death::kSigkill, SIGKILL}));
+
+TEST(LaserSafetyInProcess, ExceptionUnwindingThroughLasersOff) {
+  SimTmclBoard board;
+  auto pty = PtyBoard::start(board);
+  ASSERT_TRUE(pty.ok());
+  const RigDescription rig = testing::tmcl_rig((*pty)->path(), 0);
+  auto c = TmclController::open(rig);
+  ASSERT_TRUE(c.ok());
+  try {
+    LasersOff guard(**c);
+    ASSERT_TRUE((*c)->set_laser(1, true).ok());
+    ASSERT_TRUE(board.output(rig.controller.lasers[1].output));
+    throw std::runtime_error("a stage failed");
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_FALSE(board.output(rig.controller.lasers[1].output));
+}
+
+}  // namespace
+}  // namespace bodyscan::hw::usb
