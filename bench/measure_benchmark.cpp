@@ -27,7 +27,7 @@
 #include "recon/measure/body_measurements.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "server/pipeline/scan_job.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 
 using namespace bodyscan;
 using Clock = std::chrono::steady_clock;

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "server/pipeline/acquire.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 
 using namespace bodyscan;
 

@@ -15,7 +15,7 @@
 
 #include "bench/body_region.hpp"
 #include "recon/geometry/sample_surface.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 
 using namespace bodyscan;
 

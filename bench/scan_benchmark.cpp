@@ -21,7 +21,7 @@
 #include "recon/geometry/sample_surface.hpp"
 #include "recon/spatial/knn_index.hpp"
 #include "server/pipeline/scan.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 
 using namespace bodyscan;
 using Clock = std::chrono::steady_clock;

@@ -23,6 +23,8 @@ packages=(
   libsodium-dev        # checksums of archived files; password hashing (server)
   libboost1.81-dev     # Beast HTTP + WebSocket (server); 1.74 lacks message_generator
   libssl-dev openssl   # TLS for `bodyscan serve`; the tests make a certificate with openssl
+  libaravis-dev aravis-tools  # GenICam cameras (hw/aravis); the tests run arv-fake-gv-camera-0.8
+  libusb-1.0-0-dev     # the TMCL controller board over USB (hw/usb)
   libgtest-dev libgmock-dev libbenchmark-dev
   poppler-utils        # pdftotext: the tests read the PDF sheets back
 )

@@ -13,7 +13,7 @@
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/scan_job.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 
 namespace bodyscan::cli {
 
@@ -128,7 +128,7 @@ int run_scan(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan scan: --customer and --new-customer go with --archive\n");
     return 2;
   }
-  auto sim = pipeline::open_simulated_rig(rig_arg, body);
+  auto sim = pipeline::open_rig(rig_arg, body);
   if (!sim.ok()) {
     std::fprintf(stderr, "bodyscan scan: %s\n", sim.status().message().c_str());
     return 1;

@@ -10,7 +10,7 @@
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/png_image.hpp"
 #include "server/pipeline/acquire.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 
 namespace bodyscan::cli {
 

@@ -3,6 +3,8 @@
 #include <cstring>
 #include <string>
 
+#include "hw/safety.hpp"
+
 namespace bodyscan::cli {
 int run_reconstruct(int argc, char** argv);
 int run_sim(int argc, char** argv);
@@ -12,6 +14,7 @@ int run_sheet(int argc, char** argv);
 int run_reprocess(int argc, char** argv);
 int run_archive(int argc, char** argv);
 int run_serve(int argc, char** argv);
+int run_devices(int argc, char** argv);
 }
 
 namespace {
@@ -28,6 +31,7 @@ void print_usage(FILE* out) {
       "  reprocess SCAN_DIR --out DIR    a scan again from its raw record\n"
       "  archive DIR list|show|verify|export|erase|reprocess|sheet ...  the scan archive\n"
       "  serve [--port 8080] [--data DIR]  the workstation: rig, archive, API and browser UI\n"
+      "  devices [--json]                the cameras and controller boards this machine reaches\n"
       "\n"
       "Run 'bodyscan <command> --help' for a command's options.\n",
       out);
@@ -44,6 +48,9 @@ int main(int argc, char** argv) {
     print_usage(stdout);
     return 0;
   }
+  // Lasers off on a crash, and on Ctrl-C or kill in every command but `serve`, which
+  // takes SIGINT and SIGTERM itself and stops in order.
+  bodyscan::hw::install_laser_safety_handlers(cmd != "serve");
   if (cmd == "reconstruct") return bodyscan::cli::run_reconstruct(argc - 1, argv + 1);
   if (cmd == "scan") return bodyscan::cli::run_scan(argc - 1, argv + 1);
   if (cmd == "sim") return bodyscan::cli::run_sim(argc - 1, argv + 1);
@@ -52,6 +59,7 @@ int main(int argc, char** argv) {
   if (cmd == "reprocess") return bodyscan::cli::run_reprocess(argc - 1, argv + 1);
   if (cmd == "archive") return bodyscan::cli::run_archive(argc - 1, argv + 1);
   if (cmd == "serve") return bodyscan::cli::run_serve(argc - 1, argv + 1);
+  if (cmd == "devices") return bodyscan::cli::run_devices(argc - 1, argv + 1);
   std::fprintf(stderr, "bodyscan: unknown command '%s'\n", cmd.c_str());
   print_usage(stderr);
   return 2;

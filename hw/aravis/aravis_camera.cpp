@@ -138,18 +138,24 @@ StatusOr<std::unique_ptr<AravisCamera>> AravisCamera::open(const CameraDescripti
                                "needs a monochrome camera");
   }
 
-  // The whole sensor.
+  // The description's image size, from the sensor's top-left corner.
   gint sx = 0, sy = 0;
   arv_camera_get_sensor_size(impl->camera, &sx, &sy, err.out());
-  if (!err && sx > 0 && sy > 0) arv_camera_set_region(impl->camera, 0, 0, sx, sy, err.out());
+  if (err) return io_error("cannot read the sensor size of " + impl->name + ": " + err.text());
+  if (desc.width > sx || desc.height > sy) {
+    return failed_precondition(impl->name + " has a " + std::to_string(sx) + " x " + std::to_string(sy) +
+                               " pixel sensor, smaller than the rig description's " + std::to_string(desc.width) + " x " +
+                               std::to_string(desc.height) + ": correct the description");
+  }
+  arv_camera_set_region(impl->camera, 0, 0, desc.width, desc.height, err.out());
   gint x = 0, y = 0, w = 0, h = 0;
   arv_camera_get_region(impl->camera, &x, &y, &w, &h, err.out());
-  if (err) return io_error("cannot read the image size of " + impl->name + ": " + err.text());
+  if (err) return io_error("cannot set the image size of " + impl->name + ": " + err.text());
   info.width = w;
   info.height = h;
   if (w != desc.width || h != desc.height) {
     return failed_precondition(impl->name + " delivers " + std::to_string(w) + " x " + std::to_string(h) +
-                               " pixels, but the rig description says " + std::to_string(desc.width) + " x " +
+                               " pixels, not the rig description's " + std::to_string(desc.width) + " x " +
                                std::to_string(desc.height) + ": correct the description");
   }
 
@@ -273,7 +279,8 @@ StatusOr<Frame> AravisCamera::grab(std::chrono::milliseconds timeout) {
       arv_camera_software_trigger(m.camera, err.out());
       if (err) {
         if (m.lost) return m.unplugged();
-        return unavailable("cannot trigger " + m.name + ": " + err.text());
+        return unavailable(m.name + " does not answer its trigger (" + err.text() +
+                           "): is it unplugged, powered off, or its network link down?");
       }
     }
     ArvBuffer* buf = arv_stream_timeout_pop_buffer(m.stream, static_cast<guint64>(wait.count()) * 1000u);

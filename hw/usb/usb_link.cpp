@@ -124,7 +124,9 @@ StatusOr<std::unique_ptr<UsbLink>> UsbLink::open(uint16_t vendor, uint16_t produ
   for (uint8_t i = 0; i < cfg->bNumInterfaces; ++i) {
     const libusb_interface_descriptor& alt = cfg->interface[i].altsetting[0];
     if (alt.bInterfaceClass == LIBUSB_CLASS_COMM && link->comm_interface_ < 0) link->comm_interface_ = alt.bInterfaceNumber;
-    if (alt.bInterfaceClass != LIBUSB_CLASS_DATA && alt.bInterfaceClass != LIBUSB_CLASS_VENDOR_SPEC) continue;
+    // CDC-ACM only: vendor bridges (FTDI, CP210x) frame their data differently and
+    // are driven through their kernel serial driver ("port" in the description).
+    if (alt.bInterfaceClass != LIBUSB_CLASS_DATA) continue;
     uint8_t in = 0, out = 0;
     int in_size = 64;
     for (uint8_t e = 0; e < alt.bNumEndpoints; ++e) {
@@ -141,7 +143,7 @@ StatusOr<std::unique_ptr<UsbLink>> UsbLink::open(uint16_t vendor, uint16_t produ
     }
   }
   libusb_free_config_descriptor(cfg);
-  if (link->data_interface_ < 0) return io_error(link->name_ + " has no bulk data interface: it is not a serial-over-USB board");
+  if (link->data_interface_ < 0) return io_error(link->name_ + " is not a USB CDC-ACM board; give its serial port (\"port\": \"/dev/ttyUSB0\") in the rig description instead");
   libusb_set_auto_detach_kernel_driver(link->handle_, 1);  // cdc_acm lets go of it
   for (int iface : {link->comm_interface_, link->data_interface_}) {
     if (iface < 0) continue;

@@ -21,7 +21,7 @@
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/scan_recording.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 #include "server/workstation/preview.hpp"
 #include "storage/archive/ids.hpp"
 
@@ -96,7 +96,7 @@ struct Workstation::Impl {
   WorkstationOptions options;
   std::unique_ptr<storage::Archive> archive;
   std::unique_ptr<AuthStore> auth;
-  std::unique_ptr<hw::sim::SimulatedRig> sim;
+  std::unique_ptr<hw::DeviceRig> devices;
   pipeline::Rig rig;
   nlohmann::json rig_json;  // the description, as the archive records it
 
@@ -292,9 +292,9 @@ StatusOr<std::unique_ptr<Workstation>> Workstation::open(const WorkstationOption
   if (ec) return io_error(options.data_dir + ": cannot create the data folder: " + ec.message());
   ASSIGN_OR_RETURN(impl->archive, storage::Archive::open(options.data_dir));
   ASSIGN_OR_RETURN(impl->auth, AuthStore::open(options.data_dir + "/accounts.db", options.auth));
-  ASSIGN_OR_RETURN(impl->sim, pipeline::open_simulated_rig(options.rig, options.body));
-  impl->rig = pipeline::rig_handle(*impl->sim);
-  impl->rig_json = nlohmann::json::parse(hw::to_json(impl->sim->description()), nullptr, false);
+  ASSIGN_OR_RETURN(impl->devices, pipeline::open_rig(options.rig, options.body));
+  impl->rig = pipeline::rig_handle(*impl->devices);
+  impl->rig_json = nlohmann::json::parse(hw::to_json(impl->devices->description()), nullptr, false);
   // Whatever state the rig was left in, no laser shines until a scan asks.
   RETURN_IF_ERROR(impl->rig.controller->all_lasers_off());
   impl->load_calibration();
@@ -305,7 +305,7 @@ StatusOr<std::unique_ptr<Workstation>> Workstation::open(const WorkstationOption
 storage::Archive& Workstation::archive() { return *impl_->archive; }
 AuthStore& Workstation::auth() { return *impl_->auth; }
 const WorkstationOptions& Workstation::options() const { return impl_->options; }
-hw::sim::SimulatedRig* Workstation::simulated_rig() { return impl_->sim.get(); }
+hw::sim::SimulatedRig* Workstation::simulated_rig() { return impl_->devices->simulation(); }
 
 nlohmann::json Workstation::Impl::status_json() const {
   const Impl& s = *this;
@@ -330,7 +330,7 @@ nlohmann::json Workstation::Impl::status_json() const {
     lasers.push_back(l);
   }
   nlohmann::json out = {{"rig", desc.name},
-                        {"simulated", s.sim != nullptr},
+                        {"simulated", !s.devices->description().has_real_devices()},
                         {"cameras", cams},
                         {"lasers", lasers},
                         {"calibration", s.calibration_json()},

@@ -176,5 +176,46 @@ TEST(RigDescription, LasersWhosePlanesCrossInsideTheFrameCannotRunTogether) {
   EXPECT_EQ(r->laser_groups.size(), 3u) << e;
 }
 
+TEST(RigDescription, RealDevicesExampleLoadsAndRoundTrips) {
+  const std::string path = std::string(BODYSCAN_SOURCE_DIR) + "/hw/rigs/examples/shop-example.json";
+  auto rig = load_rig_description(path);
+  ASSERT_TRUE(rig.ok()) << rig.status().message();
+  EXPECT_TRUE(rig->has_real_devices());
+  EXPECT_EQ(rig->cameras[0].device.backend, "aravis");
+  EXPECT_EQ(rig->cameras[0].device.packet_size, 8192);
+  EXPECT_EQ(rig->controller.backend, "tmcl");
+  EXPECT_EQ(rig->controller.usb_vendor, 0x2a3c);
+  ASSERT_EQ(rig->controller.lasers.size(), 4u);
+  EXPECT_EQ(rig->controller.lasers[2].output, 2);
+  EXPECT_EQ(rig->controller.lasers[2].microsteps_per_step, 16);
+  auto again = parse_rig_description(to_json(*rig), "again");
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_EQ(to_json(*again), to_json(*rig));
+  EXPECT_FALSE(load_shipped("thesis").has_real_devices());
+}
+
+TEST(RigDescription, ControllerWiringMistakesAreNamed) {
+  nlohmann::json j = thesis_json();
+  j["controller"] = {{"backend", "tmcl"}, {"lasers", {{"front-left", {{"output", 0}, {"axis", 0}}}}}};
+  EXPECT_NE(parse_error(j).find("laser 'front-right' is not wired"), std::string::npos) << parse_error(j);
+  j["controller"]["lasers"] = {{"front-left", {{"output", 0}, {"axis", 0}}},
+                               {"front-right", {{"output", 0}, {"axis", 1}}},
+                               {"back-left", {{"output", 2}, {"axis", 2}}},
+                               {"back-right", {{"output", 3}, {"axis", 3}}}};
+  EXPECT_NE(parse_error(j).find("output 0 is wired twice"), std::string::npos) << parse_error(j);
+  j["controller"]["lasers"]["front-right"]["output"] = 1;
+  j["controller"]["lasers"]["back-right"]["axis"] = 0;
+  EXPECT_NE(parse_error(j).find("axis 0 turns two lasers"), std::string::npos) << parse_error(j);
+  j["controller"]["lasers"]["back-right"]["axis"] = 3;
+  j["controller"]["usb"] = {{"vendor", "xyz"}};
+  EXPECT_NE(parse_error(j).find("4 hex digits"), std::string::npos) << parse_error(j);
+  j["controller"].erase("usb");
+  j["controller"]["backend"] = "simstep";
+  EXPECT_NE(parse_error(j).find("'sim' or 'tmcl'"), std::string::npos);
+  j = thesis_json();
+  j["cameras"][0]["device"] = {{"backend", "aravis"}};
+  EXPECT_NE(parse_error(j).find("needs its 'id'"), std::string::npos) << parse_error(j);
+}
+
 }  // namespace
 }  // namespace bodyscan::hw

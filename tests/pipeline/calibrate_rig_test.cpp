@@ -4,7 +4,7 @@
 
 #include "hw/sim/sim_rig.hpp"
 #include "server/pipeline/calibrate.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 
 namespace bodyscan::pipeline {
 namespace {

@@ -7,7 +7,7 @@
 #include "hw/sim/sim_rig.hpp"
 #include "recon/geometry/mesh_distance.hpp"
 #include "server/pipeline/scan_job.hpp"
-#include "server/pipeline/sim_backend.hpp"
+#include "server/pipeline/rig_backend.hpp"
 
 namespace bodyscan::pipeline {
 namespace {

@@ -31,16 +31,19 @@ enum class Death { kSegfault, kAbort, kTerminate, kSigterm, kSigint, kSigkill };
 // laser 0.
 int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoard& board, int laser_output,
               bool* was_on) {
-  int ready[2];
-  if (pipe(ready) != 0) return -1;
+  int ready[2], go[2];
+  if (pipe(ready) != 0 || pipe(go) != 0) return -1;
   const pid_t pid = fork();
   if (pid == 0) {
     close(ready[0]);
+    close(go[1]);
     install_laser_safety_handlers(true);
     auto c = TmclController::open(testing::tmcl_rig(port, watchdog_ms));
     if (!c.ok() || !(*c)->set_laser(0, true).ok()) _exit(3);
     const char one = 1;
     (void)!write(ready[1], &one, 1);
+    char wait_for_parent = 0;
+    (void)!read(go[0], &wait_for_parent, 1);  // until the parent has seen the laser on
     switch (death) {
       case Death::kSegfault: raise(SIGSEGV); break;
       case Death::kAbort: std::abort();
@@ -50,10 +53,13 @@ int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoar
     for (;;) pause();  // the parent signals it
   }
   close(ready[1]);
+  close(go[0]);
   char byte = 0;
   const bool started = read(ready[0], &byte, 1) == 1;
   close(ready[0]);
   *was_on = started && board.output(laser_output);
+  (void)!write(go[1], &byte, 1);
+  close(go[1]);
   if (death == Death::kSigterm) kill(pid, SIGTERM);
   if (death == Death::kSigint) kill(pid, SIGINT);
   if (death == Death::kSigkill) kill(pid, SIGKILL);
@@ -70,6 +76,11 @@ double off_within(SimTmclBoard& board, int output, std::chrono::milliseconds lim
     std::this_thread::sleep_for(1ms);
   }
   return -1;
+}
+
+std::string death_name(const ::testing::TestParamInfo<std::pair<Death, int>>& p) {
+  static const char* const names[] = {"Segfault", "Abort", "Terminate", "Sigterm", "Sigint", "Sigkill"};
+  return names[static_cast<int>(p.param.first)];
 }
 
 class LaserSafety : public ::testing::TestWithParam<std::pair<Death, int>> {};
@@ -101,7 +112,8 @@ TEST_P(LaserSafety, LaserGoesOffWhenTheProcessDies) {
 INSTANTIATE_TEST_SUITE_P(EveryDeath, LaserSafety,
                          ::testing::Values(std::pair{Death::kSegfault, SIGSEGV}, std::pair{Death::kAbort, SIGABRT},
                                            std::pair{Death::kTerminate, SIGABRT}, std::pair{Death::kSigterm, SIGTERM},
-                                           std::pair{Death::kSigint, SIGINT}, std::pair{Death::kSigkill, SIGKILL}));
+                                           std::pair{Death::kSigint, SIGINT}, std::pair{Death::kSigkill, SIGKILL}),
+                         death_name);
 
 TEST(LaserSafetyInProcess, ExceptionUnwindingThroughLasersOff) {
   SimTmclBoard board;
