@@ -182,14 +182,15 @@ TEST(TmclController, StoresAndRunsTheWatchdog) {
   SimTmclBoard board;
   auto pty = PtyBoard::start(board);
   ASSERT_TRUE(pty.ok());
-  const RigDescription rig = testing::tmcl_rig((*pty)->path(), 200);
+  // A period well above any scheduling delay on a loaded test machine.
+  const RigDescription rig = testing::tmcl_rig((*pty)->path(), 1000);
   {
     auto c = TmclController::open(rig);
     ASSERT_TRUE(c.ok()) << c.status().message();
     EXPECT_TRUE(board.application_running());
     ASSERT_TRUE((*c)->set_laser(0, true).ok());
     // Fed by the controller, the watchdog leaves the laser on.
-    std::this_thread::sleep_for(700ms);
+    std::this_thread::sleep_for(2500ms);
     EXPECT_TRUE(board.output(rig.controller.lasers[0].output));
     EXPECT_EQ(board.watchdog_trips(), 0);
   }
