@@ -1,5 +1,5 @@
-// `bodyscan scan`: calibrate the simulated rig, scan the body, build the surface, and
-// write the results - the very pipeline the server runs.
+// `bodyscan scan`: calibrate the rig, scan the body, build the surface, and write
+// the results - the very pipeline the server runs.
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -48,7 +48,13 @@ void usage(FILE* out) {
       "  --customer ID    the archived scan's customer (default: a new one)\n"
       "  --new-customer NAME  a new customer with this name\n"
       "  --operator NAME  who runs the scan (the archive's audit log)\n"
-      "  -q, --quiet      print only errors\n",
+      "  --operator-dot-grid  ask on the terminal for the lens board before the\n"
+      "                   simulated cameras too, as for real ones (a line on\n"
+      "                   standard input answers each request)\n"
+      "  -q, --quiet      print only errors\n"
+      "\n"
+      "Before each real camera a person holds the lens dot-grid board: the request\n"
+      "is printed, and Enter (a line on standard input) answers it.\n",
       out);
 }
 
@@ -57,7 +63,7 @@ void usage(FILE* out) {
 int run_scan(int argc, char** argv) {
   std::string rig_arg, body, out, archive_dir, customer_id, new_customer, operator_name = "cli";
   pipeline::ScanJobOptions options;
-  bool quiet = false;
+  bool quiet = false, operator_dot_grid = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> const char* {
@@ -113,6 +119,8 @@ int run_scan(int argc, char** argv) {
       options.reconstruct = false;
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
+    } else if (a == "--operator-dot-grid") {
+      operator_dot_grid = true;
     } else {
       std::fprintf(stderr, "bodyscan scan: unknown option '%s'\n", a.c_str());
       usage(stderr);
@@ -181,7 +189,20 @@ int run_scan(int argc, char** argv) {
       return true;
     };
   }
-  auto result = pipeline::run_scan_job(pipeline::rig_handle(**sim), options);
+  // The person at the rig answers on the terminal.
+  auto ask = [&](const pipeline::OperatorRequest& r) -> Status {
+    if (!last_stage.empty()) std::fprintf(stderr, "\n");
+    if (!r.why.empty()) std::fprintf(stderr, "The last picture could not be used: %s\n", r.why.c_str());
+    std::fprintf(stderr, "%s\n  [Enter when done] ", r.text().c_str());
+    std::fflush(stderr);
+    for (int c = std::getchar();; c = std::getchar()) {
+      if (c == EOF) return cancelled("nobody answered on standard input to hold the dot-grid board");
+      if (c == '\n') break;
+    }
+    last_percent = -1;
+    return Status::Ok();
+  };
+  auto result = pipeline::run_scan_job(pipeline::rig_handle(**sim, ask, operator_dot_grid), options);
   if (!quiet && !last_stage.empty()) std::fprintf(stderr, "\n");
   if (!result.ok()) {
     fail_archived(result.status().message());

@@ -34,6 +34,10 @@ void usage(FILE* out) {
       "  --body BODY.ply    the simulated subject (mm, Y up)\n"
       "  --every N          scans use every Nth laser step unless asked otherwise\n"
       "                     (default 1)\n"
+      "  --operator-dot-grid\n"
+      "                     calibration asks a person to hold the lens board before\n"
+      "                     the simulated cameras too, as it does before real ones\n"
+      "                     (staff training)\n"
       "  --web DIR          the browser UI's files (default: the UI this build made, BUILD/web)\n"
       "  --tls-cert PEM --tls-key PEM\n"
       "                     serve HTTPS (session cookies become Secure)\n"
@@ -72,6 +76,10 @@ int run_serve(int argc, char** argv) {
     }
     if (a == "--behind-tls-proxy") {
       ao.secure_cookies = true;
+      continue;
+    }
+    if (a == "--operator-dot-grid") {
+      wo.operator_dot_grid = true;
       continue;
     }
     if (i + 1 >= argc) {

@@ -41,41 +41,35 @@ bool checksum_ok(const Frame& f) { return checksum(f.data()) == f[8]; }
 Request decode_request(const Frame& f) { return {f[0], f[1], f[2], f[3], value_of(f)}; }
 Reply decode_reply(const Frame& f) { return {f[0], f[1], f[2], f[3], value_of(f)}; }
 
-StatusOr<Reply> Client::exchange(const Request& r) {
-  const Frame out = encode(r);
+StatusOr<Frame> Client::transact(const Frame& out, const std::function<Status(const Frame&)>& check) {
   Status last;
   for (int attempt = 0; attempt < attempts_; ++attempt) {
     if (attempt > 0) link_.discard_input();
     Status st = link_.write(out.data(), out.size(), timeout_);
-    if (!st.ok()) {
-      if (st.code() == StatusCode::kUnavailable) return st;
-      last = st;
-      continue;
-    }
     Frame in{};
-    st = link_.read(in.data(), in.size(), timeout_);
-    if (!st.ok()) {
-      if (st.code() == StatusCode::kUnavailable) return st;
-      last = st;
-      continue;
-    }
-    if (!checksum_ok(in)) {
-      last = internal_error("the controller on " + link_.name() + " sent a reply with a bad checksum");
-      continue;
-    }
-    const Reply rep = decode_reply(in);
-    if (rep.address != address_ || (rep.command != r.command && r.command != kGetFirmwareVersion)) {
-      last = internal_error("the controller on " + link_.name() + " answered another request (command " +
-                            std::to_string(rep.command) + " from module " + std::to_string(rep.address) + ")");
-      continue;
-    }
-    if (rep.status == kWrongChecksum) {  // our frame was damaged on the way
-      last = internal_error("the controller on " + link_.name() + " received a damaged command");
-      continue;
-    }
-    return rep;
+    if (st.ok()) st = link_.read(in.data(), in.size(), timeout_);
+    if (st.ok()) st = check(in);
+    if (st.ok()) return in;
+    if (st.code() == StatusCode::kUnavailable) return st;
+    last = st;
   }
   return Status(last.code(), last.message() + " (" + std::to_string(attempts_) + " tries)");
+}
+
+StatusOr<Reply> Client::exchange(const Request& r) {
+  ASSIGN_OR_RETURN(const Frame in, transact(encode(r), [&](const Frame& f) -> Status {
+    if (!checksum_ok(f)) return internal_error("the controller on " + link_.name() + " sent a reply with a bad checksum");
+    const Reply rep = decode_reply(f);
+    if (rep.address != address_ || rep.command != r.command) {
+      return internal_error("the controller on " + link_.name() + " answered another request (command " +
+                            std::to_string(rep.command) + " from module " + std::to_string(rep.address) + ")");
+    }
+    if (rep.status == kWrongChecksum) {  // our frame was damaged on the way
+      return internal_error("the controller on " + link_.name() + " received a damaged command");
+    }
+    return Status::Ok();
+  }));
+  return decode_reply(in);
 }
 
 StatusOr<int32_t> Client::call(uint8_t command, uint8_t type, uint8_t bank, int32_t value) {
@@ -100,26 +94,15 @@ Status Client::store(uint8_t command, uint8_t type, uint8_t bank, int32_t value)
 StatusOr<std::string> Client::firmware_version() {
   // Type 0 answers with the host address and then eight ASCII characters in place of
   // the rest of the reply (no checksum).
-  const Frame out = encode(Request{address_, kGetFirmwareVersion, 0, 0, 0});
-  Status last;
-  for (int attempt = 0; attempt < attempts_; ++attempt) {
-    if (attempt > 0) link_.discard_input();
-    Status st = link_.write(out.data(), out.size(), timeout_);
-    if (st.ok()) {
-      Frame in{};
-      st = link_.read(in.data(), in.size(), timeout_);
-      if (st.ok()) {
-        std::string v(reinterpret_cast<const char*>(in.data()) + 1, 8);
-        bool printable = true;
-        for (char c : v) printable = printable && c >= 0x20 && c < 0x7f;
-        if (printable) return v;
-        st = internal_error("the controller on " + link_.name() + " answered the version request with binary data");
-      }
-    }
-    if (st.code() == StatusCode::kUnavailable) return st;
-    last = st;
-  }
-  return last;
+  ASSIGN_OR_RETURN(const Frame in, transact(encode(Request{address_, kGetFirmwareVersion, 0, 0, 0}),
+                                            [&](const Frame& f) -> Status {
+                                              for (size_t i = 1; i < 9; ++i)
+                                                if (f[i] < 0x20 || f[i] >= 0x7f)
+                                                  return internal_error("the controller on " + link_.name() +
+                                                                        " answered the version request with binary data");
+                                              return Status::Ok();
+                                            }));
+  return std::string(reinterpret_cast<const char*>(in.data()) + 1, 8);
 }
 
 }  // namespace bodyscan::hw::usb::tmcl

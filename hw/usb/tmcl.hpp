@@ -13,6 +13,7 @@
 
 #include <array>
 #include <chrono>
+#include <functional>
 #include <cstdint>
 #include <string>
 
@@ -89,6 +90,9 @@ class Client {
 
  private:
   StatusOr<Reply> exchange(const Request& r);
+  // Writes `out` and reads the 9-byte answer, retrying (input discarded) on a
+  // link timeout or an answer `check` rejects; unavailable at once.
+  StatusOr<Frame> transact(const Frame& out, const std::function<Status(const Frame&)>& check);
   ByteLink& link_;
   uint8_t address_;
   std::chrono::milliseconds timeout_;

@@ -1,5 +1,6 @@
-// The rig: its status, calibrating it, starting a scan, following and cancelling
-// the job. One job at a time: a second gets 409 with what the rig is busy with.
+// The rig: its status, calibrating it, starting a scan, following the job,
+// answering its prompts and cancelling it. One job at a time: a second gets 409
+// with what the rig is busy with.
 #include "server/api/api.hpp"
 
 namespace bodyscan::server {
@@ -63,6 +64,18 @@ void add_rig_routes(std::vector<Api::Route>* routes) {
                        auto j = ws.job(call.params.at("id"));
                        if (!j) return error_response(404, "no job " + call.params.at("id"));
                        return json_response(200, {{"job", to_json(*j)}});
+                     }});
+  // The person has done what the job's prompt asked (held the dot-grid board ...).
+  routes->push_back({"POST", "/api/jobs/{id}/prompt", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
+                       HttpResponse error;
+                       auto body = json_body(call, &error);
+                       if (!body) return error;
+                       if (!body->contains("prompt") || !(*body)["prompt"].is_string())
+                         return error_response(400, "give the prompt answered: {\"prompt\": \"p1\"}");
+                       const Status s = ws.answer_prompt(call.params.at("id"), (*body)["prompt"].get<std::string>());
+                       if (!s.ok()) return error_response(s);
+                       auto j = ws.job(call.params.at("id"));
+                       return json_response(202, {{"job", j ? to_json(*j) : nlohmann::json()}});
                      }});
   routes->push_back({"POST", "/api/jobs/{id}/cancel", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
                        const Status s = ws.cancel(call.params.at("id"), call.actor());

@@ -70,10 +70,30 @@ Status calibration_sequence(const Rig& rig, const ShotSink& sink, const Progress
       return cancelled("calibration cancelled");
     }
     if (!rig.hold_dot_grid) return failed_precondition("no way to hold the dot grid before the cameras");
-    RETURN_IF_ERROR(rig.hold_dot_grid(c, true));
-    const Status s = grab(rig, c, shot(ShotKind::kDotGrid), sink);
-    RETURN_IF_ERROR(rig.hold_dot_grid(c, false));
-    RETURN_IF_ERROR(s);
+    const bool person = rig.person_holds_dot_grid && rig.person_holds_dot_grid(c);
+    // A simulated board leaves the view whatever happens; a person is not asked
+    // to take it away from a sequence that failed.
+    auto fail = [&](Status st) {
+      if (!person) (void)rig.hold_dot_grid(c, false, {});
+      return st;
+    };
+    std::string why;
+    for (;;) {
+      if (Status st = rig.hold_dot_grid(c, true, why); !st.ok()) return fail(st);
+      StatusOr<hw::Frame> frame = rig.cameras[c]->grab();
+      if (!frame.ok()) return fail(frame.status());
+      Shot s = shot(ShotKind::kDotGrid);
+      s.camera = c;
+      s.frame = std::move(*frame);
+      const Status used = sink(std::move(s));
+      if (used.ok()) break;
+      if (!person || used.code() != StatusCode::kFailedPrecondition) return fail(used);
+      why = used.message();
+      if (!report(progress, "calibration: lens", static_cast<double>(c) / rig.cameras.size())) {
+        return cancelled("calibration cancelled");
+      }
+    }
+    RETURN_IF_ERROR(rig.hold_dot_grid(c, false, {}));
   }
   RETURN_IF_ERROR(grab_all(rig, shot(ShotKind::kRoom), sink));
   if (!report(progress, "calibration: frame lights", 0)) return cancelled("calibration cancelled");

@@ -25,9 +25,15 @@ struct Rig {
   const hw::RigDescription* description = nullptr;
   hw::Controller* controller = nullptr;
   std::vector<hw::Camera*> cameras;
-  // Asks the operator to hold the dot-grid board before camera i (held = true) or
-  // take it away; returns when done. The simulated rig does it itself.
-  std::function<Status(size_t camera, bool held)> hold_dot_grid;
+  // Puts the lens dot-grid board before camera i (held) or takes it away, and
+  // returns when that is done: the simulation places it itself; before a real
+  // camera a person holds it, asked by whoever runs the sequence (the station's
+  // prompt, a terminal; rig_backend.hpp). `why` is not empty when the last picture
+  // of the board could not be used: the person is asked again, told why.
+  std::function<Status(size_t camera, bool held, const std::string& why)> hold_dot_grid;
+  // Whether a person holds the board before camera i (and so can be asked again);
+  // null: nobody does.
+  std::function<bool(size_t camera)> person_holds_dot_grid;
 };
 
 enum class ShotKind {
@@ -62,6 +68,11 @@ using ShotSink = std::function<Status(Shot&&)>;
 // Calibration: the dot grid before each camera; lights off, all frame lights on,
 // the front circuit alone; then each laser alone at both ends and the middle (step
 // 0) of its sweep after a base frame, seen by every camera.
+//
+// When a person holds the dot grid and the sink rejects its picture
+// (failed_precondition: no dots found, a black image ...), the person is asked to
+// hold it again with the sink's reason, until a picture is usable or `progress`
+// cancels; a simulated board's rejected picture is an error at once.
 Status acquire_calibration(const Rig& rig, const ShotSink& sink, const ProgressFn& progress = {});
 
 // A scan: per laser group, a base frame (lasers off), then the group's lasers

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 
 namespace bodyscan::pipeline {
 
@@ -61,6 +62,30 @@ void plan_sweeps(RigCalibration& cal, const hw::RigDescription& rig) {
   }
 }
 
+// The lens correction from camera `id`'s picture of the dot grid, or why that
+// picture cannot give one (failed_precondition: a person can hold the board again).
+StatusOr<LensCorrection> lens_from_dot_grid(const std::string& id, const hw::Frame& frame, const LensOptions& options) {
+  if (frame.pixels.empty()) return failed_precondition("camera '" + id + "': the dot-grid frame is empty");
+  // A black picture (a capped lens, a dead light) would only find noise.
+  std::vector<uint16_t> sorted(frame.pixels);
+  const size_t p99 = sorted.size() * 99 / 100;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(p99), sorted.end());
+  if (sorted[p99] < frame.max_value() / 10) {
+    return failed_precondition("camera '" + id + "': the dot-grid image is black (99 % of its pixels at or below " +
+                               std::to_string(sorted[p99]) + " of " + std::to_string(frame.max_value()) +
+                               "): is the lens capped, the exposure too short, or the room light off?");
+  }
+  auto lens = calibrate_lens(view(frame), options);
+  if (!lens.ok()) {
+    // Whatever the fit found wrong, the remedy is another picture of the board.
+    std::string why = lens.status().message();
+    for (const char* prefix : {"lens calibration: ", "lens correction: "})
+      if (why.rfind(prefix, 0) == 0) why.erase(0, std::strlen(prefix));
+    return failed_precondition("camera '" + id + "': lens calibration from the dot grid: " + why);
+  }
+  return lens;
+}
+
 }  // namespace
 
 CalibrationBuilder::CalibrationBuilder(const hw::RigDescription& rig, const CalibrateOptions& options)
@@ -70,7 +95,14 @@ Status CalibrationBuilder::consume(Shot&& shot) {
   if (shot.camera >= cameras_.size()) return invalid_argument("calibration: a frame from an unknown camera");
   PerCamera& c = cameras_[shot.camera];
   switch (shot.kind) {
-    case ShotKind::kDotGrid: c.dot_grid = std::move(shot.frame); break;
+    case ShotKind::kDotGrid: {
+      const auto t0 = std::chrono::steady_clock::now();
+      StatusOr<LensCorrection> lens = lens_from_dot_grid(rig_.cameras[shot.camera].id, shot.frame, options_.lens);
+      lens_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      RETURN_IF_ERROR(lens.status());
+      c.lens = std::move(*lens);
+      break;
+    }
     case ShotKind::kLightsOff: c.lights_off = std::move(shot.frame); break;
     case ShotKind::kFrameLights: c.frame_lights = std::move(shot.frame); break;
     case ShotKind::kFrontLights: c.front_lights = std::move(shot.frame); break;
@@ -95,25 +127,12 @@ StatusOr<RigCalibration> CalibrationBuilder::finish() {
   for (size_t i = 0; i < cameras_.size(); ++i) {
     const PerCamera& c = cameras_[i];
     const std::string& id = rig_.cameras[i].id;
-    for (const hw::Frame* f : {&c.dot_grid, &c.lights_off, &c.frame_lights, &c.front_lights}) {
+    for (const hw::Frame* f : {&c.lights_off, &c.frame_lights, &c.front_lights}) {
       if (f->pixels.empty()) return failed_precondition("camera '" + id + "': a calibration frame is missing");
     }
-    // A black picture (a capped lens, a dead light) would only find noise.
-    std::vector<uint16_t> sorted(c.dot_grid.pixels);
-    const size_t p99 = sorted.size() * 99 / 100;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(p99), sorted.end());
-    if (sorted[p99] < c.dot_grid.max_value() / 10) {
-      return failed_precondition("camera '" + id + "': the dot-grid image is black (99 % of its pixels at or below " +
-                                 std::to_string(sorted[p99]) + " of " + std::to_string(c.dot_grid.max_value()) +
-                                 "): is the lens capped, the exposure too short, or the room light off?");
-    }
-    auto lens = calibrate_lens(view(c.dot_grid), options_.lens);
-    if (!lens.ok()) {
-      return Status(lens.status().code(), "camera '" + id + "': lens calibration from the dot grid: " +
-                                              lens.status().message());
-    }
+    if (!c.lens) return failed_precondition("camera '" + id + "': the dot-grid frame is missing");
     ASSIGN_OR_RETURN(CameraCalibration cal,
-                     calibrate_camera(id, *lens, {view(c.lights_off), view(c.frame_lights), view(c.front_lights)},
+                     calibrate_camera(id, *c.lens, {view(c.lights_off), view(c.frame_lights), view(c.front_lights)},
                                       out.frame, options_.markers));
     out.cameras.push_back(std::move(cal));
   }
@@ -153,7 +172,8 @@ StatusOr<RigCalibration> CalibrationBuilder::finish() {
     }
   }
   plan_sweeps(out, rig_);
-  out.processing_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.processing_seconds =
+      lens_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 

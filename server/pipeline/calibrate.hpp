@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,10 @@ struct CalibrateOptions {
 // The calibration frames (acquire_calibration) to a calibration. Errors name the
 // camera or laser and what went wrong: a black dot-grid image, a frame light that
 // stayed off, a laser no camera sees on the poles.
+//
+// A dot-grid picture is turned into its lens correction as it comes: consume()
+// rejects one that cannot be used (failed_precondition, saying why), so that the
+// person holding the board can be asked again at once (acquire.hpp).
 class CalibrationBuilder {
  public:
   explicit CalibrationBuilder(const hw::RigDescription& rig, const CalibrateOptions& options = {});
@@ -62,8 +67,10 @@ class CalibrationBuilder {
     std::shared_ptr<const hw::Frame> base;
     hw::Frame frame;
   };
+  double lens_seconds_ = 0;  // spent in consume() on the dot grids
   struct PerCamera {
-    hw::Frame dot_grid, lights_off, frame_lights, front_lights;
+    std::optional<LensCorrection> lens;  // from the dot grid
+    hw::Frame lights_off, frame_lights, front_lights;
     std::shared_ptr<const hw::Frame> laser_base;
     std::vector<Identify> identify;
   };

@@ -3,6 +3,7 @@
 // description says - and the Rig handle the sequences drive.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -21,8 +22,28 @@ StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> open_simulated_rig(const std::s
 // subject when not empty.
 StatusOr<std::unique_ptr<hw::DeviceRig>> open_rig(const std::string& rig, const std::string& body);
 
+// What a person is asked to do during a calibration: hold the lens dot-grid
+// board before a camera (again, when `why` says the last picture could not be
+// used), or, after the last camera, take it out of the rig.
+struct OperatorRequest {
+  enum class Kind { kHoldDotGrid, kRemoveDotGrid };
+  Kind kind = Kind::kHoldDotGrid;
+  size_t camera = 0;
+  std::string camera_id;
+  std::string why;
+  std::string text() const;  // the instruction, in words for the shop's staff (`why` apart)
+};
+const char* to_string(OperatorRequest::Kind k);
+// Returns when the person has done it; an error (kCancelled: nobody will) stops
+// the calibration.
+using AskOperator = std::function<Status(const OperatorRequest&)>;
+
 // The handle the sequences drive; valid while `sim` (or `devices`) lives.
 Rig rig_handle(hw::sim::SimulatedRig& sim);
-Rig rig_handle(hw::DeviceRig& devices);
+// A person holds the dot grid before every real camera, asked through `ask`;
+// with `ask_for_simulated` before the simulated ones too (staff training: the
+// simulation places the board when the person says it is in place). Without
+// `ask`, a real camera's dot grid is a failed_precondition saying what to do.
+Rig rig_handle(hw::DeviceRig& devices, AskOperator ask = {}, bool ask_for_simulated = false);
 
 }  // namespace bodyscan::pipeline

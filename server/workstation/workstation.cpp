@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <ctime>
 #include <filesystem>
@@ -55,6 +56,14 @@ nlohmann::json to_json(const JobInfo& j) {
   if (!j.error.empty()) out["error"] = j.error;
   if (!j.finished_at.empty()) out["finished_at"] = j.finished_at;
   if (j.version > 0) out["version"] = j.version;
+  if (j.prompt) {
+    const JobPrompt& p = *j.prompt;
+    out["prompt"] = {{"id", p.id}, {"kind", p.kind}, {"text", p.text}, {"asked_at", p.asked_at}};
+    if (!p.camera.empty()) out["prompt"]["camera"] = p.camera;
+    if (!p.why.empty()) out["prompt"]["why"] = p.why;
+  } else {
+    out["prompt"] = nullptr;
+  }
   return out;
 }
 
@@ -112,6 +121,8 @@ struct Workstation::Impl {
   std::thread worker;
   std::vector<std::thread> retired;  // finished jobs' threads, joined at shutdown
   bool stopped = false;
+  std::condition_variable prompt_cv;  // a prompt answered, a job cancelled
+  int prompt_seq = 0;
   std::map<int, EventSink> sinks;
   int next_sink = 1;
   std::string last_camera_error;
@@ -275,6 +286,7 @@ struct Workstation::Impl {
   nlohmann::json status_json() const;  // takes the mutex
   void publish_rig() { publish({{"type", "rig"}, {"rig", status_json()}}); }
   void run(JobInfo j, std::function<Status()> work);
+  Status ask_operator(const pipeline::OperatorRequest& request);
   Status do_calibrate();
   Status do_scan(int every);
   Status do_reprocess(const std::string& scan_id, const std::string& actor);
@@ -293,7 +305,10 @@ StatusOr<std::unique_ptr<Workstation>> Workstation::open(const WorkstationOption
   ASSIGN_OR_RETURN(impl->archive, storage::Archive::open(options.data_dir));
   ASSIGN_OR_RETURN(impl->auth, AuthStore::open(options.data_dir + "/accounts.db", options.auth));
   ASSIGN_OR_RETURN(impl->devices, pipeline::open_rig(options.rig, options.body));
-  impl->rig = pipeline::rig_handle(*impl->devices);
+  Impl* ip = impl.get();
+  impl->rig = pipeline::rig_handle(
+      *impl->devices, [ip](const pipeline::OperatorRequest& r) { return ip->ask_operator(r); },
+      options.operator_dot_grid);
   impl->rig_json = nlohmann::json::parse(hw::to_json(impl->devices->description()), nullptr, false);
   // Whatever state the rig was left in, no laser shines until a scan asks.
   RETURN_IF_ERROR(impl->rig.controller->all_lasers_off());
@@ -385,6 +400,46 @@ void Workstation::Impl::run(JobInfo j, std::function<Status()> work) {
     publish_rig();
     idle_cv.notify_all();
   });
+}
+
+// On the job's thread: shows the request as the job's prompt and waits for the
+// answer, a cancel or the timeout.
+Status Workstation::Impl::ask_operator(const pipeline::OperatorRequest& request) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                                std::chrono::duration<double>(options.operator_timeout_s));
+  std::string id;
+  {
+    std::lock_guard lock(mutex);
+    if (!job || !running) return failed_precondition("no job to ask the operator for");
+    JobPrompt p;
+    p.id = "p" + std::to_string(++prompt_seq);
+    p.kind = pipeline::to_string(request.kind);
+    if (request.kind == pipeline::OperatorRequest::Kind::kHoldDotGrid) p.camera = request.camera_id;
+    p.text = request.text();
+    p.why = request.why;
+    p.asked_at = storage::iso8601_utc(unix_now());
+    id = p.id;
+    job->prompt = std::move(p);
+  }
+  publish_job();
+  bool answered = false;
+  {
+    std::unique_lock lock(mutex);
+    prompt_cv.wait_until(lock, deadline, [&] { return !job->prompt || job->prompt->id != id || cancel; });
+    answered = !job->prompt || job->prompt->id != id;
+    job->prompt.reset();
+  }
+  publish_job();
+  if (cancel) return cancelled("calibration cancelled");
+  if (!answered) {
+    const double t = options.operator_timeout_s;
+    const std::string waited = t < 120 ? std::to_string(static_cast<int>(std::lround(t))) + " s"
+                                       : std::to_string(static_cast<int>(std::lround(t / 60))) + " minutes";
+    // Not a device's fault (deadline_exceeded would be reported as one).
+    return failed_precondition("nobody confirmed the dot-grid board in " + waited +
+                             "; calibrate again when someone can hold it");
+  }
+  return Status::Ok();
 }
 
 Status Workstation::Impl::do_calibrate() {
@@ -522,6 +577,24 @@ Status Workstation::cancel(const std::string& job_id, const std::string& actor) 
   if (!s.running) return failed_precondition("job " + job_id + " has already ended (" + to_string(s.job->state) + ")");
   s.cancel_reason = "cancelled by " + actor;
   s.cancel = true;
+  s.prompt_cv.notify_all();
+  return Status::Ok();
+}
+
+Status Workstation::answer_prompt(const std::string& job_id, const std::string& prompt_id) {
+  Impl& s = *impl_;
+  {
+    std::lock_guard lock(s.mutex);
+    if (!s.job || s.job->id != job_id) return not_found("no job " + job_id);
+    if (!s.running) return failed_precondition("job " + job_id + " has already ended (" + to_string(s.job->state) + ")");
+    if (!s.job->prompt) return failed_precondition("job " + job_id + " is not waiting for anyone");
+    if (s.job->prompt->id != prompt_id) {
+      return failed_precondition("job " + job_id + " now asks " + s.job->prompt->id + " (\"" + s.job->prompt->text +
+                                 "\"), not " + prompt_id);
+    }
+    s.job->prompt.reset();
+  }
+  s.prompt_cv.notify_all();
   return Status::Ok();
 }
 
@@ -612,6 +685,7 @@ void Workstation::shutdown(const std::string& reason) {
       s.cancel = true;
     }
   }
+  s.prompt_cv.notify_all();
   std::vector<std::thread> threads;
   {
     std::lock_guard lock(s.mutex);

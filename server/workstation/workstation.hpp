@@ -34,12 +34,29 @@ struct WorkstationOptions {
   // Live camera previews during a scan: at most one per camera this often, this wide.
   double preview_interval_s = 1.0;
   int preview_width = 160;
+  // Calibration asks a person to hold the lens dot-grid board before every real
+  // camera (JobInfo::prompt). With this, before the simulated ones too: staff
+  // training on the simulated rig (and the tests of the prompt).
+  bool operator_dot_grid = false;
+  // A prompt nobody answers in this long stops the calibration.
+  double operator_timeout_s = 900;
 };
 
 enum class JobKind { kCalibrate, kScan, kReprocess };
 enum class JobState { kRunning, kComplete, kFailed, kCancelled };
 const char* to_string(JobKind k);
 const char* to_string(JobState s);
+
+// What a job waits for a person to do (a calibration's dot grid): answered with
+// Workstation::answer_prompt, naming its id.
+struct JobPrompt {
+  std::string id;         // "p" + a number, new for every question
+  std::string kind;       // hold_dot_grid | remove_dot_grid
+  std::string camera;     // the camera's id (hold_dot_grid)
+  std::string text;       // the instruction, for the station to show
+  std::string why;        // why the last picture of the board could not be used
+  std::string asked_at;   // ISO 8601 UTC
+};
 
 struct JobInfo {
   std::string id;  // "j_" + 16 hex digits
@@ -52,6 +69,7 @@ struct JobInfo {
   std::string error;       // why it failed or was cancelled
   std::string started_at, finished_at;  // ISO 8601 UTC
   int version = 0;         // a reprocess's new version
+  std::optional<JobPrompt> prompt;  // what the job waits for a person to do
 };
 nlohmann::json to_json(const JobInfo& job);
 
@@ -85,6 +103,9 @@ class Workstation {
   StatusOr<JobInfo> start_reprocess(const std::string& scan_id, const std::string& actor);
   // Asks the job to stop (it stops at the next frame or stage, lasers off).
   Status cancel(const std::string& job_id, const std::string& actor);
+  // The person has done what the job's prompt asked: not_found for another job,
+  // failed_precondition when the job asks nothing or asks something newer.
+  Status answer_prompt(const std::string& job_id, const std::string& prompt_id);
   std::optional<JobInfo> job(const std::string& id) const;  // the current or the last job
   std::optional<JobInfo> current_job() const;               // running
   // Waits until no job runs (tests, shutdown); false on timeout.

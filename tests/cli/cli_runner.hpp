@@ -34,10 +34,13 @@ inline std::string quote(const std::string& s) {
   return q + "'";
 }
 
-// Runs `bodyscan <args>` with stdout and stderr captured in files under `dir`.
-inline CliResult bodyscan(const std::string& args, const std::string& dir) {
-  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
-  const std::string cmd = quote(BODYSCAN_BIN) + " " + args + " >" + quote(out) + " 2>" + quote(err) + " </dev/null";
+// Runs `bodyscan <args>` with stdout and stderr captured in files under `dir`,
+// and `input` on its standard input (nothing: /dev/null).
+inline CliResult bodyscan(const std::string& args, const std::string& dir, const std::string& input = "") {
+  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt", in = dir + "/stdin.txt";
+  if (!input.empty()) std::ofstream(in, std::ios::binary) << input;
+  const std::string cmd = quote(BODYSCAN_BIN) + " " + args + " >" + quote(out) + " 2>" + quote(err) + " <" +
+                          (input.empty() ? std::string("/dev/null") : quote(in));
   const int status = std::system(cmd.c_str());
   CliResult r;
   if (status != -1 && WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);

@@ -48,6 +48,31 @@ TEST(ScanCli, CalibratesScansAndWritesTheCloudAndFigures) {
   EXPECT_EQ(facing, viewed->size());
 }
 
+// The person holding the dot grid answers on the terminal: a request per camera
+// and one to clear the rig, each answered by a line; nobody there (standard
+// input closed) stops the scan before anything is written.
+TEST(ScanCli, AsksOnTheTerminalForTheDotGrid) {
+  const std::string dir = testing::temp_dir();
+  const CliResult r = bodyscan("scan --rig sim --out " + quote(dir + "/scan") +
+                                   " --every 24 --no-surface --operator-dot-grid",
+                               dir, "\n\n\n\n");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  size_t holds = 0;
+  for (size_t at = r.err.find("Hold the dot-grid board"); at != std::string::npos;
+       at = r.err.find("Hold the dot-grid board", at + 1))
+    ++holds;
+  EXPECT_EQ(holds, 3u) << r.err;
+  for (const char* camera : {"'front-left'", "'front-right'", "'back'"}) EXPECT_NE(r.err.find(camera), std::string::npos);
+  EXPECT_NE(r.err.find("Take the dot-grid board out of the rig"), std::string::npos) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/scan/points.ply"));
+
+  const CliResult nobody =
+      bodyscan("scan --rig sim --out " + quote(dir + "/none") + " --every 24 --no-surface --operator-dot-grid", dir);
+  EXPECT_EQ(nobody.exit_code, 1);
+  EXPECT_NE(nobody.err.find("nobody answered"), std::string::npos) << nobody.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/none/points.ply"));
+}
+
 TEST(ScanCli, BadArgumentsAreClearErrors) {
   const std::string dir = testing::temp_dir();
   CliResult r = bodyscan("scan --rig sim --out x --every 0", dir);

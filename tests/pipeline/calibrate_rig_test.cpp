@@ -2,6 +2,9 @@
 // simulator's ground truth, and its errors when the rig is broken.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
+#include "hw/device_rig.hpp"
 #include "hw/sim/sim_rig.hpp"
 #include "server/pipeline/calibrate.hpp"
 #include "server/pipeline/rig_backend.hpp"
@@ -114,6 +117,93 @@ TEST(CalibrateRig, ABlackCameraIsAClearError) {
   EXPECT_NE(cal.status().message().find("camera '" + desc.cameras[2].id + "'"), std::string::npos)
       << cal.status().message();
   EXPECT_NE(cal.status().message().find("black"), std::string::npos) << cal.status().message();
+}
+
+// Before a real camera a person holds the dot grid: asked for each camera in turn,
+// asked again with the reason when the picture cannot be used (here: the board
+// held out of view the first time before camera 1), and asked to clear the rig
+// after the last. Training mode asks for the simulated cameras the same way.
+TEST(CalibrateRig, APersonHoldingTheDotGridIsAskedAgainWhenThePictureIsUnusable) {
+  const hw::RigDescription desc = half_resolution();
+  auto devices = hw::DeviceRig::open(desc);
+  ASSERT_TRUE(devices.ok()) << devices.status().message();
+  std::vector<OperatorRequest> asked;
+  Rig rig = rig_handle(
+      **devices,
+      [&](const OperatorRequest& r) {
+        asked.push_back(r);
+        return Status::Ok();
+      },
+      true);
+  ASSERT_TRUE(rig.person_holds_dot_grid);
+  for (size_t c = 0; c < desc.cameras.size(); ++c) EXPECT_TRUE(rig.person_holds_dot_grid(c));
+  bool fumbled = false;
+  auto hold = rig.hold_dot_grid;
+  rig.hold_dot_grid = [&](size_t c, bool held, const std::string& why) {
+    Status st = hold(c, held, why);
+    if (c == 1 && held && !fumbled) {  // said "holding it", but out of the camera's view
+      fumbled = true;
+      (*devices)->simulation()->hold_dot_grid(c, false);
+    }
+    return st;
+  };
+  auto cal = calibrate_rig(rig);
+  ASSERT_TRUE(cal.ok()) << cal.status().message();
+  expect_matches_truth(desc, *cal);
+  ASSERT_EQ(asked.size(), desc.cameras.size() + 2);
+  const std::vector<size_t> cameras = {0, 1, 1, 2};
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    EXPECT_EQ(asked[i].kind, OperatorRequest::Kind::kHoldDotGrid) << i;
+    EXPECT_EQ(asked[i].camera, cameras[i]) << i;
+    EXPECT_EQ(asked[i].camera_id, desc.cameras[cameras[i]].id) << i;
+    EXPECT_NE(asked[i].text().find(desc.cameras[cameras[i]].id), std::string::npos) << asked[i].text();
+  }
+  EXPECT_TRUE(asked[0].why.empty());
+  EXPECT_TRUE(asked[1].why.empty());
+  EXPECT_NE(asked[2].why.find("camera '" + desc.cameras[1].id + "'"), std::string::npos) << asked[2].why;
+  EXPECT_NE(asked[2].why.find("dots"), std::string::npos) << asked[2].why;
+  EXPECT_TRUE(asked[3].why.empty());
+  std::printf("asked again before camera %s: %s\n", asked[2].camera_id.c_str(), asked[2].why.c_str());
+  EXPECT_EQ(asked.back().kind, OperatorRequest::Kind::kRemoveDotGrid);
+  for (int i = 0; i < (*devices)->controller().num_lasers(); ++i) EXPECT_FALSE((*devices)->controller().laser_on(i));
+}
+
+// Nobody to hold the board (the operator cancels, standard input closes): the
+// calibration stops with that, every laser off, no board left before a camera.
+TEST(CalibrateRig, NobodyToHoldTheDotGridStopsTheCalibration) {
+  const hw::RigDescription desc = half_resolution();
+  auto devices = hw::DeviceRig::open(desc);
+  ASSERT_TRUE(devices.ok()) << devices.status().message();
+  int asked = 0;
+  const Rig rig = rig_handle(
+      **devices,
+      [&](const OperatorRequest& r) {
+        return ++asked == 2 ? cancelled("nobody answered about camera '" + r.camera_id + "'") : Status::Ok();
+      },
+      true);
+  auto cal = calibrate_rig(rig);
+  ASSERT_FALSE(cal.ok());
+  EXPECT_EQ(cal.status().code(), StatusCode::kCancelled);
+  EXPECT_NE(cal.status().message().find(desc.cameras[1].id), std::string::npos) << cal.status().message();
+  EXPECT_EQ(asked, 2);
+  for (int i = 0; i < (*devices)->controller().num_lasers(); ++i) EXPECT_FALSE((*devices)->controller().laser_on(i));
+}
+
+// A simulated board is placed exactly: its unusable picture is an error at once,
+// nobody is asked again.
+TEST(CalibrateRig, ASimulatedBoardIsNotRetried) {
+  hw::RigDescription desc = half_resolution();
+  desc.cameras[0].exposure_us = 1;
+  auto devices = hw::DeviceRig::open(desc);
+  ASSERT_TRUE(devices.ok()) << devices.status().message();
+  int asked = 0;
+  const Rig rig = rig_handle(**devices, [&](const OperatorRequest&) { return ++asked, Status::Ok(); });
+  EXPECT_FALSE(rig.person_holds_dot_grid(0));
+  auto cal = calibrate_rig(rig);
+  ASSERT_FALSE(cal.ok());
+  EXPECT_EQ(cal.status().code(), StatusCode::kFailedPrecondition);
+  EXPECT_NE(cal.status().message().find("black"), std::string::npos) << cal.status().message();
+  EXPECT_EQ(asked, 0);
 }
 
 }  // namespace

@@ -198,6 +198,70 @@ TEST(ApiScan, CancelStopsTheScanAndTurnsTheLasersOff) {
   EXPECT_EQ(op.post("/api/jobs/j_unknown/cancel").status, 404);
 }
 
+// Calibration asking the person at the rig to hold the dot grid (training mode on
+// the simulated rig, as for real cameras): the job and its events carry the
+// prompt, an operator answers it by id; a tailor may not, a stale id is refused.
+TEST(ApiScan, AnOperatorAnswersTheCalibrationsPrompts) {
+  ServerUnderTest s(12, {}, [](server::WorkstationOptions& o) { o.operator_dot_grid = true; });
+  Client op = s.as("op");
+  HttpReply refused;
+  auto events = EventStream::open(s.port, op.cookie, &refused);
+  ASSERT_TRUE(events) << refused.status << " " << refused.body;
+  const HttpReply cal = op.post("/api/rig/calibrate");
+  ASSERT_EQ(cal.status, 202) << cal.body;
+  const std::string job = parse(cal)["job"]["id"];
+  EXPECT_TRUE(parse(cal)["job"]["prompt"].is_null());
+  std::vector<nlohmann::json> prompts;
+  const auto until = std::chrono::steady_clock::now() + 240s;
+  for (;;) {
+    const nlohmann::json j = parse(op.get("/api/jobs/" + job))["job"];
+    if (j["state"] != "running") {
+      EXPECT_EQ(j["state"], "complete") << j.dump();
+      break;
+    }
+    ASSERT_LT(std::chrono::steady_clock::now(), until);
+    if (j["prompt"].is_null() || (!prompts.empty() && prompts.back()["id"] == j["prompt"]["id"])) {
+      std::this_thread::sleep_for(20ms);
+      continue;
+    }
+    const nlohmann::json p = j["prompt"];
+    const std::string answer = "{\"prompt\": \"" + p["id"].get<std::string>() + "\"}";
+    if (prompts.empty()) {
+      EXPECT_EQ(anonymous(s.port).post("/api/jobs/" + job + "/prompt", answer).status, 401);
+      EXPECT_EQ(s.as("tailor").post("/api/jobs/" + job + "/prompt", answer).status, 403);
+      EXPECT_EQ(op.post("/api/jobs/" + job + "/prompt", "{}").status, 400);
+      EXPECT_EQ(op.post("/api/jobs/" + job + "/prompt", "{\"prompt\": 1}").status, 400);
+      EXPECT_EQ(op.post("/api/jobs/j_unknown/prompt", answer).status, 404);
+      const HttpReply stale = op.post("/api/jobs/" + job + "/prompt", "{\"prompt\": \"p999\"}");
+      EXPECT_EQ(stale.status, 409);
+      EXPECT_NE(stale.body.find(p["id"].get<std::string>()), std::string::npos) << "names the prompt asked: " << stale.body;
+    }
+    prompts.push_back(p);
+    const HttpReply answered = op.post("/api/jobs/" + job + "/prompt", answer);
+    ASSERT_EQ(answered.status, 202) << answered.body;
+    EXPECT_TRUE(parse(answered)["job"]["prompt"].is_null() ||
+                parse(answered)["job"]["prompt"]["id"] != p["id"]) << answered.body;
+  }
+  const nlohmann::json rig = parse(op.get("/api/rig"));
+  ASSERT_EQ(prompts.size(), rig["cameras"].size() + 1);
+  for (size_t i = 0; i + 1 < prompts.size(); ++i) {
+    EXPECT_EQ(prompts[i]["kind"], "hold_dot_grid");
+    EXPECT_EQ(prompts[i]["camera"], rig["cameras"][i]["id"]);
+  }
+  EXPECT_EQ(prompts.back()["kind"], "remove_dot_grid");
+  EXPECT_TRUE(rig["calibration"].is_object()) << rig.dump();
+  // The WebSocket told the station every prompt as it came.
+  std::vector<std::string> seen;
+  while (auto text = events->next(1s)) {
+    const nlohmann::json e = nlohmann::json::parse(*text);
+    if (e["type"] == "job" && e["job"]["prompt"].is_object() &&
+        (seen.empty() || seen.back() != e["job"]["prompt"]["id"]))
+      seen.push_back(e["job"]["prompt"]["id"]);
+  }
+  ASSERT_EQ(seen.size(), prompts.size());
+  for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], prompts[i]["id"]);
+}
+
 // A camera that stops answering mid-scan: the job fails naming it, the scan is
 // marked failed with the reason, nothing else in the archive changes, the lasers
 // are off and the rig status shows the device error.

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <sodium.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -32,8 +33,10 @@ struct ServerUnderTest {
   std::string scan_id, customer_id;  // the finished demo scan
   TriangleMesh body;                 // its surface (the true body)
 
-  // `every`: the scans the tests run use every Nth laser step (fast).
-  explicit ServerUnderTest(int every = 12, server::NetOptions net = {}) {
+  // `every`: the scans the tests run use every Nth laser step (fast). `tweak`
+  // changes the workstation's options before it opens.
+  explicit ServerUnderTest(int every = 12, server::NetOptions net = {},
+                           const std::function<void(server::WorkstationOptions&)>& tweak = {}) {
     data = temp_dir();
     web = temp_dir();
     server::WorkstationOptions wo;
@@ -42,6 +45,7 @@ struct ServerUnderTest {
     wo.auth.opslimit = crypto_pwhash_OPSLIMIT_MIN;
     wo.auth.memlimit = crypto_pwhash_MEMLIMIT_MIN;
     wo.preview_interval_s = 0.2;
+    if (tweak) tweak(wo);
     auto opened = server::Workstation::open(wo);
     if (!opened.ok()) throw std::runtime_error(opened.status().message());
     ws = std::move(*opened);

@@ -76,6 +76,33 @@ TEST(AravisCamera, FakeCameraFramesArriveWhole) {
   EXPECT_EQ((*cam)->grab(2000ms)->exposure_us, (*cam)->exposure_us());
 }
 
+// A hardware trigger: the camera set to Line0 sends no frame of its own accord
+// and no software trigger is sent; the fake camera pulses that line itself (a
+// frame every ~20 ms here), so each grab gets the frame of the next pulse. A line
+// the camera does not have is refused when opening, naming it.
+TEST(AravisCamera, LineTriggerTakesFramesFromTheLine) {
+  CameraDescription d = fake_description("Fake_1");
+  d.device.trigger = "Line0";
+  auto cam = AravisCamera::open(d);
+  ASSERT_TRUE(cam.ok()) << cam.status().message();
+  uint64_t last = 0;
+  for (int i = 0; i < 5; ++i) {
+    auto f = (*cam)->grab(2000ms);
+    ASSERT_TRUE(f.ok()) << f.status().message();
+    EXPECT_EQ(f->pixels.size(), 512u * 512u);
+    EXPECT_LE(off_diagonal(*f), 60);
+    if (i > 0) {
+      EXPECT_GT(f->frame_id, last);
+    }
+    last = f->frame_id;
+  }
+  d.device.trigger = "Line7";
+  auto wrong = AravisCamera::open(d);
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_EQ(wrong.status().code(), StatusCode::kFailedPrecondition);
+  EXPECT_NE(wrong.status().message().find("'Line7'"), std::string::npos) << wrong.status().message();
+}
+
 TEST(AravisCamera, DescriptionThatDoesNotMatchTheCameraIsRefused) {
   auto cam = AravisCamera::open(fake_description("Fake_1", 4096));
   ASSERT_FALSE(cam.ok());

@@ -11,6 +11,7 @@
 #include "hw/usb/serial_link.hpp"
 #include "hw/usb/sim_tmcl_board.hpp"
 #include "hw/usb/tmcl_controller.hpp"
+#include "hw/usb/usb_link.hpp"
 #include "tests/hw/usb/tmcl_rig.hpp"
 
 namespace bodyscan::hw::usb {
@@ -114,6 +115,23 @@ TEST(Tmcl, MissingPortSaysWhatToCheck) {
   auto link = SerialLink::open("/dev/does-not-exist-ttyACM9");
   ASSERT_FALSE(link.ok());
   EXPECT_NE(link.status().message().find("plugged in"), std::string::npos) << link.status().message();
+}
+
+// No board on the USB bus (there is none on a test machine; a shop's unplugged
+// cable): unavailable, naming the ids and what to check - whether or not the
+// machine has USB at all.
+TEST(Tmcl, MissingUsbBoardSaysWhatToCheck) {
+  auto link = UsbLink::open(0x2a3c, 0x0100, "NO-SUCH-SERIAL");
+  ASSERT_FALSE(link.ok());
+  EXPECT_EQ(link.status().code(), StatusCode::kUnavailable) << link.status().message();
+  const std::string& m = link.status().message();
+  EXPECT_TRUE(m.find("2a3c:0100") != std::string::npos || m.find("libusb") != std::string::npos) << m;
+  auto listed = list_usb_devices();
+  if (listed.ok()) {
+    for (const UsbDeviceInfo& d : *listed) EXPECT_FALSE(d.serial == "NO-SUCH-SERIAL");
+  } else {
+    EXPECT_EQ(listed.status().code(), StatusCode::kUnavailable) << listed.status().message();
+  }
 }
 
 TEST(TmclController, DrivesTheRigOverAPseudoTerminal) {

@@ -1,6 +1,7 @@
 // The operator's page: the rig at a glance, calibration, a scan for a new or
 // returning customer, its progress live over the WebSocket (stage, progress,
-// the cameras' previews), cancel, and the result opening by itself when done.
+// the cameras' previews, what the job asks the operator to do), cancel, and the
+// result opening by itself when done.
 import { enc, get, post, query } from '../api.js';
 import { overallFraction, stageText } from '../progress.js';
 import { ago, clear, errorText, h, toast, when } from '../ui/dom.js';
@@ -69,7 +70,7 @@ export async function mount(container, _params, ctx) {
     try {
       const { job } = await post('/api/rig/calibrate', {});
       state.myJob = job.id;
-      setJob(job);
+      startedJob(job);
     } catch (e) {
       toast(errorText(e), 'error');
     }
@@ -173,7 +174,7 @@ export async function mount(container, _params, ctx) {
           try {
             const { job } = await post('/api/scans', body);
             state.myJob = job.id;
-            setJob(job);
+            startedJob(job);
             name.value = '';
             contact.value = '';
           } catch (err) {
@@ -200,6 +201,12 @@ export async function mount(container, _params, ctx) {
 
   // ---- the job
   const previewGrid = h('div', { class: 'previews' });
+  // The answer to starting a job is older than any event about it that came
+  // first (a prompt asked at once): it only shows a job not heard of yet.
+  function startedJob(job) {
+    if (!state.job || state.job.id !== job.id) setJob(job);
+  }
+
   function setJob(job) {
     if (!state.job || state.job.id !== job.id) {
       state.lastFraction = 0;
@@ -223,6 +230,7 @@ export async function mount(container, _params, ctx) {
     // A stage the bar does not know keeps the last position rather than jumping.
     if (overall !== null) state.lastFraction = running ? Math.max(state.lastFraction || 0, overall) : overall;
     const pct = j.state === 'complete' ? 100 : Math.round((state.lastFraction || 0) * 100);
+    let prompt = null;
     clear(
       jobBox,
       h('h2', {}, j.kind === 'calibrate' ? 'Calibration' : j.kind === 'reprocess' ? 'Reprocessing' : 'Scan'),
@@ -230,10 +238,41 @@ export async function mount(container, _params, ctx) {
       h('progress', { max: 100, value: pct, 'aria-label': 'Progress' }),
       h('p', { class: 'muted small' }, `${pct} %${j.frames ? ` · ${j.frames} frames` : ''}`),
       j.error ? h('p', { class: 'form-error' }, j.error) : null,
+      running && j.prompt ? (prompt = promptBox(j)) : null,
       j.kind === 'scan' ? previewGrid : null,
       running ? h('button', { type: 'button', class: 'danger', onclick: () => cancel(j) }, 'Cancel') : null,
       !running && j.scan_id && j.state === 'complete' ? h('a', { class: 'button primary', href: `/scans/${enc(j.scan_id)}` }, 'Open the result') : null,
     );
+    // A new request to the person at the rig comes into view, wherever the page was.
+    if (prompt && state.shownPrompt !== j.prompt.id) prompt.scrollIntoView({ block: 'center', behavior: 'smooth' });
+    state.shownPrompt = prompt ? j.prompt.id : null;
+  }
+
+  // What the job waits for a person to do: hold the lens board before a camera,
+  // or take it out of the rig. Confirming answers that very prompt; a newer one
+  // (the picture could not be used) replaces it with the reason.
+  function promptBox(j) {
+    const p = j.prompt;
+    const title = p.kind === 'remove_dot_grid' ? 'Clear the rig' : `Lens board before camera ${p.camera}`;
+    const done = h('button', { type: 'button', class: 'primary', dataset: { prompt: p.id }, onclick: () => answer(j, p, done) }, p.kind === 'remove_dot_grid' ? 'The rig is clear' : 'Holding it: take the picture');
+    return h(
+      'div',
+      { class: 'prompt', role: 'alertdialog', 'aria-label': title, dataset: { kind: p.kind, camera: p.camera || '' } },
+      h('h3', {}, title),
+      p.why ? h('p', { class: 'form-error prompt-why' }, `The last picture could not be used: ${p.why}`) : null,
+      h('p', {}, p.text),
+      done,
+    );
+  }
+
+  async function answer(j, p, button) {
+    button.disabled = true;
+    try {
+      await post(`/api/jobs/${enc(j.id)}/prompt`, { prompt: p.id });
+    } catch (e) {
+      button.disabled = false;
+      toast(errorText(e), 'error');
+    }
   }
 
   async function cancel(j) {
