@@ -39,10 +39,8 @@ hw::RigDescription shop_rig(const std::string& port, int watchdog_ms) {
   return *rig;
 }
 
-// One request and its reply (GIO: read an output), to the board in process.
-void BM_TmclRequestInProcess(benchmark::State& state) {
-  SimTmclBoard board;
-  SimBoardLink link(board);
+// Requests and their replies (GIO: read an output) over `link`.
+void time_requests(benchmark::State& state, ByteLink& link) {
   tmcl::Client client(link);
   for (auto _ : state) {
     auto v = client.call(tmcl::kGIO, 0, tmcl::kBankOutputs, 0);
@@ -50,6 +48,13 @@ void BM_TmclRequestInProcess(benchmark::State& state) {
     benchmark::DoNotOptimize(v);
   }
   state.SetItemsProcessed(state.iterations());
+}
+
+// To the board in process.
+void BM_TmclRequestInProcess(benchmark::State& state) {
+  SimTmclBoard board;
+  SimBoardLink link(board);
+  time_requests(state, link);
 }
 BENCHMARK(BM_TmclRequestInProcess)->UseRealTime();
 
@@ -61,13 +66,7 @@ void BM_TmclRequestPty(benchmark::State& state) {
   if (!pty.ok()) return state.SkipWithError(pty.status().message().c_str());
   auto link = SerialLink::open((*pty)->path());
   if (!link.ok()) return state.SkipWithError(link.status().message().c_str());
-  tmcl::Client client(**link);
-  for (auto _ : state) {
-    auto v = client.call(tmcl::kGIO, 0, tmcl::kBankOutputs, 0);
-    if (!v.ok()) state.SkipWithError(v.status().message().c_str());
-    benchmark::DoNotOptimize(v);
-  }
-  state.SetItemsProcessed(state.iterations());
+  time_requests(state, **link);
 }
 BENCHMARK(BM_TmclRequestPty)->UseRealTime();
 

@@ -8,23 +8,13 @@
 #include "hw/sim/sim_rig.hpp"
 #include "server/pipeline/calibrate.hpp"
 #include "server/pipeline/rig_backend.hpp"
+#include "tests/half_resolution.hpp"
 
 namespace bodyscan::pipeline {
 namespace {
 
-// The shipped thesis rig at half resolution (the same lenses on pixels twice the
-// size), so that a calibration renders in a few seconds.
-hw::RigDescription half_resolution(const std::string& name = "thesis") {
-  auto desc = hw::load_rig_description(*hw::shipped_rig_path(name));
-  EXPECT_TRUE(desc.ok()) << desc.status().message();
-  for (hw::CameraDescription& c : desc->cameras) {
-    c.width /= 2;
-    c.height /= 2;
-    c.pixel_size_um *= 2;
-    c.blur_px /= 2;
-  }
-  return *desc;
-}
+using testing::half_resolution_rig;
+hw::RigDescription half_resolution() { return half_resolution_rig(); }
 
 std::unique_ptr<hw::sim::SimulatedRig> make(const hw::RigDescription& desc) {
   auto rig = hw::sim::SimulatedRig::create(desc);

@@ -8,20 +8,13 @@
 #include "recon/geometry/mesh_distance.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/rig_backend.hpp"
+#include "tests/half_resolution.hpp"
 
 namespace bodyscan::pipeline {
 namespace {
 
 std::unique_ptr<hw::sim::SimulatedRig> half_resolution_rig(const std::string& name = "thesis") {
-  auto desc = hw::load_rig_description(*hw::shipped_rig_path(name));
-  EXPECT_TRUE(desc.ok());
-  for (hw::CameraDescription& c : desc->cameras) {
-    c.width /= 2;
-    c.height /= 2;
-    c.pixel_size_um *= 2;
-    c.blur_px /= 2;
-  }
-  auto rig = hw::sim::SimulatedRig::create(*desc);
+  auto rig = hw::sim::SimulatedRig::create(testing::half_resolution_rig(name));
   EXPECT_TRUE(rig.ok()) << rig.status().message();
   return rig.ok() ? std::move(rig).value() : nullptr;
 }

@@ -12,6 +12,7 @@
 #include "recon/geometry/mesh_distance.hpp"
 #include "server/pipeline/rig_backend.hpp"
 #include "server/pipeline/scan_job.hpp"
+#include "tests/half_resolution.hpp"
 #include "tests/hw/usb/tmcl_rig.hpp"
 
 namespace bodyscan::pipeline {
@@ -23,12 +24,7 @@ TEST(TmclBoardRig, CalibratesAndScansThroughTheBoard) {
   auto pty = hw::usb::PtyBoard::start(board);
   ASSERT_TRUE(pty.ok());
   hw::RigDescription desc = hw::testing::tmcl_rig((*pty)->path(), 500);
-  for (hw::CameraDescription& c : desc.cameras) {  // half resolution, as scan_job_test
-    c.width /= 2;
-    c.height /= 2;
-    c.pixel_size_um *= 2;
-    c.blur_px /= 2;
-  }
+  testing::halve_resolution(desc);
   ASSERT_TRUE(desc.has_real_devices());
   auto devices = hw::DeviceRig::open(desc);
   ASSERT_TRUE(devices.ok()) << devices.status().message();

@@ -10,6 +10,7 @@
 
 #include "hw/rig_description.hpp"
 #include "server/workstation/workstation.hpp"
+#include "tests/half_resolution.hpp"
 #include "tests/test_data.hpp"
 
 namespace bodyscan::testing {
@@ -52,16 +53,8 @@ TEST(Workstation, StartsWithTheCalibrationOfTheNewestArchivedScanOnThisRig) {
 
 // The thesis rig at half resolution (a calibration in seconds), as a file.
 std::string half_resolution_rig_file() {
-  auto desc = hw::load_rig_description(*hw::shipped_rig_path("thesis"));
-  EXPECT_TRUE(desc.ok()) << desc.status().message();
-  for (hw::CameraDescription& c : desc->cameras) {
-    c.width /= 2;
-    c.height /= 2;
-    c.pixel_size_um *= 2;
-    c.blur_px /= 2;
-  }
   const std::string path = temp_dir() + "/half-thesis.json";
-  std::ofstream(path) << hw::to_json(*desc);
+  std::ofstream(path) << hw::to_json(half_resolution_rig());
   return path;
 }
 

@@ -4,12 +4,11 @@
 // it does before real ones). Screenshots go to the artefacts folder.
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
-import { ADMIN_PASSWORD, launchBrowser, login, newPage, shot, startServer } from './harness.mjs';
+import { ADMIN_PASSWORD, closeSuite, login, openSuite, shot } from './harness.mjs';
 
 let server;
-let browser;
 let page;
-const errors = [];
+const suite = { errors: [] };
 
 // The prompt on screen once it is one other than `last`: { id, kind, camera, title }.
 async function nextPrompt(last) {
@@ -30,20 +29,11 @@ async function nextPrompt(last) {
 
 describe('the dot-grid prompt at the station', { timeout: 600_000 }, () => {
   before(async () => {
-    server = await startServer({ extraArgs: ['--operator-dot-grid'] });
-    browser = await launchBrowser();
-    const context = await browser.newContext({ viewport: { width: 1024, height: 768 }, hasTouch: true });
-    page = await newPage(context, errors);
+    await openSuite(suite, { serverOptions: { extraArgs: ['--operator-dot-grid'] }, contextOptions: { viewport: { width: 1024, height: 768 }, hasTouch: true } });
+    ({ server, page } = suite);
   });
 
-  after(async () => {
-    if (browser) await browser.close();
-    if (server) {
-      const code = await server.stop();
-      assert.equal(code, 0, `bodyscan serve did not stop cleanly:\n${server.log()}`);
-    }
-    assert.deepEqual(errors, [], 'the pages threw or logged errors');
-  });
+  after(() => closeSuite(suite, assert));
 
   it('asks for the board before each camera, then to clear the rig, and calibrates', async () => {
     await login(page, server.url, 'admin', ADMIN_PASSWORD);

@@ -88,6 +88,27 @@ export async function startServer({ every = 6, extraArgs = [], seed = null } = {
   };
 }
 
+// A suite's server, browser and page, set on `suite` ({ errors: [] } to start
+// with: the page's errors collect there) as each comes up, so that closeSuite
+// stops whatever started.
+export async function openSuite(suite, { serverOptions = {}, contextOptions = {} } = {}) {
+  suite.server = await startServer(serverOptions);
+  suite.browser = await launchBrowser();
+  suite.context = await suite.browser.newContext(contextOptions);
+  suite.page = await newPage(suite.context, suite.errors);
+}
+
+// Closes the browser, stops the server (which must exit 0 on SIGTERM), and
+// fails on any error a page threw or logged.
+export async function closeSuite(suite, assert) {
+  if (suite.browser) await suite.browser.close();
+  if (suite.server) {
+    const code = await suite.server.stop();
+    assert.equal(code, 0, `bodyscan serve did not stop cleanly:\n${suite.server.log()}`);
+  }
+  assert.deepEqual(suite.errors, [], 'the pages threw or logged errors');
+}
+
 export async function launchBrowser() {
   return chromium.launch({
     executablePath: CHROMIUM(),

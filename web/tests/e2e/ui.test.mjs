@@ -8,7 +8,7 @@
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { after, before, describe, it } from 'node:test';
-import { ADMIN_PASSWORD, ARTEFACTS, coverage, demoBodyBounds, launchBrowser, login, logout, newPage, shot, startServer } from './harness.mjs';
+import { ADMIN_PASSWORD, ARTEFACTS, closeSuite, coverage, demoBodyBounds, login, logout, newPage, openSuite, shot } from './harness.mjs';
 
 const SCAN_TIMEOUT = 420_000;
 const OPERATOR = ['olivia', 'operator pass 1'];
@@ -19,6 +19,7 @@ let browser;
 let context;
 let page;
 const errors = [];
+const suite = { errors };
 const state = {};
 
 async function addAccount(name, role, password) {
@@ -97,20 +98,11 @@ function nextMeasure() {
 
 describe('the browser UI', { timeout: 1_800_000 }, () => {
   before(async () => {
-    server = await startServer();
-    browser = await launchBrowser();
-    context = await browser.newContext({ viewport: { width: 1366, height: 1024 }, acceptDownloads: true, hasTouch: true });
-    page = await newPage(context, errors);
+    await openSuite(suite, { contextOptions: { viewport: { width: 1366, height: 1024 }, acceptDownloads: true, hasTouch: true } });
+    ({ server, browser, context, page } = suite);
   });
 
-  after(async () => {
-    if (browser) await browser.close();
-    if (server) {
-      const code = await server.stop();
-      assert.equal(code, 0, `bodyscan serve did not stop cleanly:\n${server.log()}`);
-    }
-    assert.deepEqual(errors, [], 'the pages threw or logged errors');
-  });
+  after(() => closeSuite(suite, assert));
 
   it('refuses a wrong password and lets the admin in, who adds an operator and a tailor', async () => {
     await page.goto(`${server.url}/archive`);
