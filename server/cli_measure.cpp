@@ -11,7 +11,7 @@
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_measurements.hpp"
 #include "recon/measure/girth.hpp"
-#include "recon/measure/surface_path.hpp"
+#include "server/pipeline/evaluate_measurement.hpp"
 #include "server/pipeline/measurements_json.hpp"
 
 namespace bodyscan::cli {
@@ -143,15 +143,40 @@ int run_measure(int argc, char** argv) {
     return 2;
   }
   nlohmann::json out = pipeline::measurements_document(file, "mesh");
-  if (from) {
-    out.erase("kind");  // the file is not read
-    out["measurements"].push_back({{"name", "distance"},
-                                   {"kind", "point_to_point"},
-                                   {"value_mm", (*to - *from).norm()},
-                                   {"from", point_json(*from)},
-                                   {"to", point_json(*to)}});
+  auto fail = [&](const Status& st) {
+    std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), st.message().c_str());
+    return 1;
+  };
+  auto print = [&](nlohmann::json m, const std::string& name) {
+    m["name"] = name;
+    out["measurements"].push_back(std::move(m));
     std::printf("%s\n", out.dump(2).c_str());
     return 0;
+  };
+  // Everything but a point cloud's girth is the very evaluation the server runs
+  // for the browser (server/pipeline/evaluate_measurement.hpp), so the two agree.
+  const Plane cut = plane ? *plane : Plane{Eigen::Vector3d(0, girth_y.value_or(0), 0), Eigen::Vector3d::UnitY()};
+  nlohmann::json request;
+  std::string name;
+  if (from) {
+    request = {{"kind", "distance"}, {"from", point_json(*from)}, {"to", point_json(*to)}};
+    name = "distance";
+  } else if (surface_from) {
+    request = {{"kind", "surface"}, {"from", point_json(*surface_from)}, {"to", point_json(*to)}};
+    name = "surface length";
+  } else if (arc_from) {
+    request = {{"kind", "arc"}, {"plane", plane_json(cut)}, {"from", point_json(*arc_from)}, {"to", point_json(*to)}};
+    name = "arc";
+  } else if (!automatic) {
+    request = {{"kind", "girth"}, {"plane", plane_json(cut)}};
+    if (near) request["near"] = point_json(*near);
+    name = girth_y ? "girth at y " + std::to_string(static_cast<long>(std::lround(*girth_y))) : "girth";
+  }
+  if (from) {
+    out.erase("kind");  // the file is not read
+    auto m = pipeline::evaluate_measurement(TriangleMesh{}, request);
+    if (!m.ok()) return fail(m.status());
+    return print(*m, name);
   }
   auto ply = read_ply(file);
   if (!ply.ok()) {
@@ -159,95 +184,43 @@ int run_measure(int argc, char** argv) {
     return 1;
   }
   const bool is_mesh = !ply->triangles.empty();
-  if ((surface_from || automatic) && !is_mesh) {
-    std::fprintf(stderr, "bodyscan measure: %s needs a mesh (%s is a point cloud)\n",
-                 automatic ? "--auto" : "--surface", file.c_str());
-    return 1;
-  }
-  if (surface_from || automatic) {
-    TriangleMesh mesh;
-    mesh.vertices = ply->cloud.positions;
-    mesh.triangles = ply->triangles;
-    if (ply->cloud.confidence.size() == mesh.vertices.size()) mesh.confidence = ply->cloud.confidence;
-    if (surface_from) {
-      const StatusOr<SurfacePath> p = mesh_surface_path(mesh, *surface_from, *to);
-      if (!p.ok()) {
-        std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), p.status().message().c_str());
-        return 1;
-      }
-      out["measurements"].push_back(pipeline::to_json(*p, "surface length"));
-    } else {
-      BodyMeasureOptions options;
-      options.floor_y = floor_y;
-      const StatusOr<BodyMeasurements> body = measure_body(mesh, options);
-      if (!body.ok()) {
-        std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), body.status().message().c_str());
-        return 1;
-      }
-      pipeline::add_body_measurements(*body, &out);
+  if (!is_mesh) {
+    if (surface_from || automatic || arc_from) {
+      std::fprintf(stderr, "bodyscan measure: %s needs a mesh (%s is a point cloud)\n",
+                   automatic ? "--auto" : surface_from ? "--surface" : "--arc", file.c_str());
+      return 1;
     }
+    // The thesis's girth on a cloud: the points within a slab of the plane.
+    const StatusOr<Girth> g = cloud_girth(ply->cloud, cut, near);
+    if (!g.ok()) return fail(g.status());
+    out["kind"] = "points";
+    nlohmann::json m = {{"kind", "girth"},
+                        {"value_mm", g->value_mm},
+                        {"plane", plane_json(g->plane)},
+                        {"path", polyline_json(g->tape)},
+                        {"closed", true},
+                        {"tape", polyline_json(g->tape)},
+                        {"loops_cut", g->loops_cut},
+                        {"algorithm", kGirthAlgorithm}};
+    if (near) m["near"] = point_json(*near);
+    return print(m, name);
+  }
+  TriangleMesh mesh;
+  mesh.vertices = ply->cloud.positions;
+  mesh.triangles = ply->triangles;
+  if (ply->cloud.confidence.size() == mesh.vertices.size()) mesh.confidence = ply->cloud.confidence;
+  if (automatic) {
+    BodyMeasureOptions options;
+    options.floor_y = floor_y;
+    const StatusOr<BodyMeasurements> body = measure_body(mesh, options);
+    if (!body.ok()) return fail(body.status());
+    pipeline::add_body_measurements(*body, &out);
     std::printf("%s\n", out.dump(2).c_str());
     return 0;
   }
-  const Plane cut = plane ? *plane : Plane{Eigen::Vector3d(0, *girth_y, 0), Eigen::Vector3d::UnitY()};
-  if (arc_from) {
-    if (!is_mesh) {
-      std::fprintf(stderr, "bodyscan measure: --arc needs a mesh (%s is a point cloud)\n", file.c_str());
-      return 1;
-    }
-    TriangleMesh mesh;
-    mesh.vertices = ply->cloud.positions;
-    mesh.triangles = ply->triangles;
-    const StatusOr<Arc> arc = mesh_arc(mesh, cut, *arc_from, *to);
-    if (!arc.ok()) {
-      std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), arc.status().message().c_str());
-      return 1;
-    }
-    out["kind"] = "mesh";
-    out["measurements"].push_back({{"name", "arc"},
-                                   {"kind", "arc"},
-                                   {"value_mm", arc->value_mm},
-                                   {"other_way_mm", arc->other_way_mm},
-                                   {"from", point_json(*arc_from)},
-                                   {"to", point_json(*to)},
-                                   {"path", polyline_json(arc->path)},
-                                   {"plane", plane_json(cut)},
-                                   {"girth_mm", arc->girth.value_mm},
-                                   {"algorithm", kGirthAlgorithm}});
-    std::printf("%s\n", out.dump(2).c_str());
-    return 0;
-  }
-  const auto measure = [&]() -> StatusOr<Girth> {
-    if (!is_mesh) return cloud_girth(ply->cloud, cut, near);
-    TriangleMesh mesh;
-    mesh.vertices = ply->cloud.positions;
-    mesh.triangles = ply->triangles;
-    if (ply->cloud.confidence.size() == mesh.vertices.size()) mesh.confidence = ply->cloud.confidence;
-    return mesh_girth(mesh, cut, near);
-  };
-  const StatusOr<Girth> g = measure();
-  if (!g.ok()) {
-    std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), g.status().message().c_str());
-    return 1;
-  }
-  out["kind"] = is_mesh ? "mesh" : "points";
-  nlohmann::json m = {{"name", girth_y ? "girth at y " + std::to_string(static_cast<long>(std::lround(*girth_y))) : "girth"},
-                      {"kind", "girth"},
-                      {"value_mm", g->value_mm},
-                      {"plane", plane_json(g->plane)},
-                      {"tape", polyline_json(g->tape)},
-                      {"loops_cut", g->loops_cut},
-                      {"algorithm", kGirthAlgorithm}};
-  if (near) m["near"] = point_json(*near);
-  if (is_mesh) {
-    m["loop"] = polyline_json(g->loop);
-    m["loop_length_mm"] = g->loop_length_mm;
-    m["min_confidence"] = g->min_confidence;
-    m["crosses_filled_hole"] = g->min_confidence < 0.5f;
-  }
-  out["measurements"].push_back(m);
-  std::printf("%s\n", out.dump(2).c_str());
-  return 0;
+  auto m = pipeline::evaluate_measurement(mesh, request);
+  if (!m.ok()) return fail(m.status());
+  return print(*m, name);
 }
 
 }  // namespace bodyscan::cli

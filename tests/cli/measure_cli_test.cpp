@@ -37,6 +37,9 @@ TEST(MeasureCli, GirthsOnAMeshAndAPointCloud) {
   EXPECT_EQ(m["loop"].size(), 1440u);  // each quad's side and diagonal
   EXPECT_NEAR(m["loop"][0][1].get<double>(), 310, 1e-4);
   EXPECT_FALSE(m["algorithm"].get<std::string>().empty());
+  EXPECT_EQ(m["name"], "girth at y 310");
+  EXPECT_EQ(m["path"], m["tape"]);  // what the viewer draws, as the server's evaluation gives it
+  EXPECT_EQ(m["closed"], true);
 
   r = bodyscan("measure " + quote(mesh) + " --girth-y 310 --near 230,310,40", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -66,7 +69,10 @@ TEST(MeasureCli, GirthsOnAMeshAndAPointCloud) {
 
   r = bodyscan("measure --distance 0,0,0 --to 30,40,0 " + quote(mesh), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NEAR(nlohmann::json::parse(r.out)["measurements"][0]["value_mm"].get<double>(), 50.0, 1e-12);
+  j = nlohmann::json::parse(r.out)["measurements"][0];
+  EXPECT_NEAR(j["value_mm"].get<double>(), 50.0, 1e-12);
+  EXPECT_EQ(j["kind"], "distance");
+  EXPECT_EQ(j["path"].size(), 2u);
 }
 
 TEST(MeasureCli, SurfaceLengthsAndTheAutomaticSet) {
