@@ -13,8 +13,8 @@
 
 #include <array>
 #include <chrono>
-#include <functional>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "hw/usb/byte_link.hpp"
