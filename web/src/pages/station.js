@@ -254,7 +254,8 @@ export async function mount(container, _params, ctx) {
   function promptBox(j) {
     const p = j.prompt;
     const title = p.kind === 'remove_dot_grid' ? 'Clear the rig' : `Lens board before camera ${p.camera}`;
-    const done = h('button', { type: 'button', class: 'primary', dataset: { prompt: p.id }, onclick: () => answer(j, p, done) }, p.kind === 'remove_dot_grid' ? 'The rig is clear' : 'Holding it: take the picture');
+    // Disabled once answered, even when another event redraws the card before the job moves on.
+    const done = h('button', { type: 'button', class: 'primary', disabled: state.answered === `${j.id}/${p.id}`, dataset: { prompt: p.id }, onclick: () => answer(j, p, done) }, p.kind === 'remove_dot_grid' ? 'The rig is clear' : 'Holding it: take the picture');
     return h(
       'div',
       { class: 'prompt', role: 'alertdialog', 'aria-label': title, dataset: { kind: p.kind, camera: p.camera || '' } },
@@ -267,9 +268,11 @@ export async function mount(container, _params, ctx) {
 
   async function answer(j, p, button) {
     button.disabled = true;
+    state.answered = `${j.id}/${p.id}`;
     try {
       await post(`/api/jobs/${enc(j.id)}/prompt`, { prompt: p.id });
     } catch (e) {
+      state.answered = null;
       button.disabled = false;
       toast(errorText(e), 'error');
     }
