@@ -143,8 +143,17 @@ int run_measure(int argc, char** argv) {
     return 2;
   }
   nlohmann::json out = pipeline::measurements_document(file, "mesh");
+  // The evaluation names the request's fields ('near' ...): say the options instead.
+  const std::string start_option = from ? "--distance" : surface_from ? "--surface" : "--arc";
   auto fail = [&](const Status& st) {
-    std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), st.message().c_str());
+    std::string m = st.message();
+    for (const auto& [field, option] : {std::pair<std::string, std::string>{"'near'", "--near"},
+                                        {"'from'", start_option},
+                                        {"'to'", "--to"}}) {
+      for (size_t at = m.find(field); at != std::string::npos; at = m.find(field, at + option.size()))
+        m.replace(at, field.size(), option);
+    }
+    std::fprintf(stderr, "bodyscan measure: %s: %s\n", file.c_str(), m.c_str());
     return 1;
   };
   auto print = [&](nlohmann::json m, const std::string& name) {

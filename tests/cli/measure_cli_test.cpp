@@ -156,6 +156,13 @@ TEST(MeasureCli, BadInputIsAClearError) {
   EXPECT_EQ(r.exit_code, 2);
   r = bodyscan("measure " + quote(mesh) + " --girth-y 300 --arc 0,300,150", dir);  // no --to
   EXPECT_EQ(r.exit_code, 2);
+  // A point in metres or garbage, 10 km off: refused, naming the option.
+  r = bodyscan("measure " + quote(mesh) + " --girth-y 300 --near 0,300,1e7", dir);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--near is outside the scan volume"), std::string::npos) << r.err;
+  r = bodyscan("measure " + quote(mesh) + " --surface 0,150,-150 --to 0,350,-1e7", dir);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--to is outside the scan volume"), std::string::npos) << r.err;
   std::ofstream(dir + "/broken.ply") << "ply\nformat ascii 1.0\nelement vertex 3\n";
   r = bodyscan("measure " + quote(dir + "/broken.ply") + " --girth-y 300", dir);
   EXPECT_EQ(r.exit_code, 1);
