@@ -11,13 +11,9 @@ class DeviceRig::Mirror : public Controller {
  public:
   Mirror(Controller& real, Controller& sim) : real_(real), sim_(sim) {}
   int num_lasers() const override { return real_.num_lasers(); }
-  Status set_room_lights(bool on) override {
-    RETURN_IF_ERROR(real_.set_room_lights(on));
-    return sim_.set_room_lights(on);
-  }
+  Status set_room_lights(bool on) override { return both(&Controller::set_room_lights, on); }
   Status set_frame_light_circuits(bool f, bool b) override {
-    RETURN_IF_ERROR(real_.set_frame_light_circuits(f, b));
-    return sim_.set_frame_light_circuits(f, b);
+    return both(&Controller::set_frame_light_circuits, f, b);
   }
   Status set_laser(int laser, bool on) override {
     Status st = real_.set_laser(laser, on);
@@ -29,17 +25,17 @@ class DeviceRig::Mirror : public Controller {
     return real_.all_lasers_off();
   }
   bool laser_on(int laser) const override { return real_.laser_on(laser); }
-  Status home(int motor) override {
-    RETURN_IF_ERROR(real_.home(motor));
-    return sim_.home(motor);
-  }
-  Status move_to(int motor, int step) override {
-    RETURN_IF_ERROR(real_.move_to(motor, step));
-    return sim_.move_to(motor, step);
-  }
+  Status home(int motor) override { return both(&Controller::home, motor); }
+  Status move_to(int motor, int step) override { return both(&Controller::move_to, motor, step); }
   StatusOr<int> current_step(int motor) const override { return real_.current_step(motor); }
 
  private:
+  // The real board first; the simulation follows only what the board did.
+  template <class... Params, class... Args>
+  Status both(Status (Controller::*f)(Params...), Args... args) {
+    RETURN_IF_ERROR((real_.*f)(args...));
+    return (sim_.*f)(args...);
+  }
   Controller& real_;
   Controller& sim_;
 };
