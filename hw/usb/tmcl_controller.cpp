@@ -208,19 +208,10 @@ Status TmclController::home(int motor) {
   const std::string who = "the motor of laser '" + lasers_[static_cast<size_t>(motor)].id + "'";
   const auto axis = static_cast<uint8_t>(w.axis);
   RETURN_IF_ERROR(call_or_lasers_off(kRFS, kRfsStart, axis, 0, nullptr).with_context(who));
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(wiring_.home_timeout_ms);
-  for (;;) {
-    int32_t busy = 0;
-    RETURN_IF_ERROR(call_or_lasers_off(kRFS, kRfsStatus, axis, 0, &busy).with_context(who));
-    if (busy == 0) break;
-    if (std::chrono::steady_clock::now() > deadline) {
-      (void)call_or_lasers_off(kRFS, kRfsStop, axis, 0, nullptr);
-      (void)all_lasers_off();
-      return deadline_exceeded(who + " did not find its reference switch within " +
-                               std::to_string(wiring_.home_timeout_ms) + " ms: check the switch and its wiring");
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  RETURN_IF_ERROR(wait_for_axis(axis, kRFS, kRfsStatus, /*not busy*/ 0, kRFS, kRfsStop, wiring_.home_timeout_ms,
+                                std::chrono::milliseconds(10), who,
+                                "did not find its reference switch within " + std::to_string(wiring_.home_timeout_ms) +
+                                    " ms: check the switch and its wiring"));
   homed_[static_cast<size_t>(motor)] = true;
   return move_to(motor, 0);
 }
@@ -238,20 +229,28 @@ Status TmclController::move_to(int motor, int step) {
   const std::string who = "the motor of laser '" + l.id + "'";
   const int32_t target = w.home_offset + step * w.microsteps_per_step;
   RETURN_IF_ERROR(call_or_lasers_off(kMVP, kMvpAbsolute, axis, target, nullptr).with_context(who));
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(wiring_.move_timeout_ms);
+  return wait_for_axis(axis, kGAP, kApPositionReached, /*reached*/ 1, kMST, 0, wiring_.move_timeout_ms,
+                       std::chrono::milliseconds(1), who,
+                       "did not reach step " + std::to_string(step) + " within " +
+                           std::to_string(wiring_.move_timeout_ms) + " ms: is it stalled?");
+}
+
+Status TmclController::wait_for_axis(uint8_t axis, uint8_t command, uint8_t type, int32_t done_when,
+                                     uint8_t stop_command, uint8_t stop_type, int timeout_ms,
+                                     std::chrono::milliseconds every, const std::string& who,
+                                     const std::string& late) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
   for (;;) {
-    int32_t reached = 0;
-    RETURN_IF_ERROR(call_or_lasers_off(kGAP, kApPositionReached, axis, 0, &reached).with_context(who));
-    if (reached) break;
+    int32_t answer = 0;
+    RETURN_IF_ERROR(call_or_lasers_off(command, type, axis, 0, &answer).with_context(who));
+    if (answer == done_when) return Status::Ok();
     if (std::chrono::steady_clock::now() > deadline) {
-      (void)call_or_lasers_off(kMST, 0, axis, 0, nullptr);
+      (void)call_or_lasers_off(stop_command, stop_type, axis, 0, nullptr);
       (void)all_lasers_off();
-      return deadline_exceeded(who + " did not reach step " + std::to_string(step) + " within " +
-                               std::to_string(wiring_.move_timeout_ms) + " ms: is it stalled?");
+      return deadline_exceeded(who + " " + late);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(every);
   }
-  return Status::Ok();
 }
 
 StatusOr<int> TmclController::current_step(int motor) const {

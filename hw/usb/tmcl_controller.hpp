@@ -61,6 +61,12 @@ class TmclController : public Controller {
   Status check_laser(int i) const;
   Status output(int port, bool on);           // under mutex_
   Status call_or_lasers_off(uint8_t command, uint8_t type, uint8_t bank, int32_t value, int32_t* result);
+  // Asks (command, type) of `axis` every `every` until the answer is `done_when`;
+  // past `timeout_ms` it sends `stop_command` (with `stop_type`), switches the
+  // lasers off and returns deadline_exceeded(who + " " + late).
+  Status wait_for_axis(uint8_t axis, uint8_t command, uint8_t type, int32_t done_when, uint8_t stop_command,
+                       uint8_t stop_type, int timeout_ms, std::chrono::milliseconds every, const std::string& who,
+                       const std::string& late);
   void feed_loop();
   static void emergency_stop(void* self) noexcept;
 

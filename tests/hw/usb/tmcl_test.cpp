@@ -196,6 +196,36 @@ TEST(TmclController, BoardFallingSilentMidMoveIsAnErrorNotAHang) {
   EXPECT_NE(st.message().find("front-left"), std::string::npos) << st.message();
 }
 
+// A stalled motor or a switch that never closes: the wait ends at the
+// description's timeout with what to check, the axis stopped and every laser off.
+TEST(TmclController, StalledMotorAndMissingSwitchTimeOut) {
+  SimTmclBoard board(1, {400000, 0, 0, 0, 0, 0});  // axis 0's switch far away
+  auto pty = PtyBoard::start(board);
+  ASSERT_TRUE(pty.ok());
+  RigDescription rig = testing::tmcl_rig((*pty)->path(), 0);
+  rig.controller.home_timeout_ms = 300;
+  rig.controller.move_timeout_ms = 300;
+  auto c = TmclController::open(rig);
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  ASSERT_TRUE((*c)->set_laser(1, true).ok());
+  Status st = (*c)->home(0);
+  EXPECT_EQ(st.code(), StatusCode::kDeadlineExceeded) << st.message();
+  EXPECT_NE(st.message().find("reference switch within 300 ms"), std::string::npos) << st.message();
+  EXPECT_FALSE(board.output(rig.controller.lasers[1].output));
+  EXPECT_FALSE((*c)->laser_on(1));
+  const int32_t stopped_at = board.position(0);
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(board.position(0), stopped_at) << "the search was stopped";
+
+  ASSERT_TRUE((*c)->home(1).ok());  // axis 1's switch is at its power-on position
+  board.set_speed(10);              // microsteps per second: a stall
+  ASSERT_TRUE((*c)->set_laser(1, true).ok());
+  st = (*c)->move_to(1, rig.lasers[1].max_step);
+  EXPECT_EQ(st.code(), StatusCode::kDeadlineExceeded) << st.message();
+  EXPECT_NE(st.message().find("did not reach step"), std::string::npos) << st.message();
+  EXPECT_FALSE(board.output(rig.controller.lasers[1].output));
+}
+
 TEST(TmclController, StoresAndRunsTheWatchdog) {
   SimTmclBoard board;
   auto pty = PtyBoard::start(board);
