@@ -403,21 +403,28 @@ class HolePatch {
       int m = -1;
       Vec3f normal = Vec3f::Zero();  // of the triangle (i, m, j)
     };
-    std::vector<Cell> w(n * n);
+    // Row-major for the left cells (i, m), and a column-major copy for the right
+    // cells (m, j): the innermost loop walks m, and both stay contiguous in memory
+    // (a stride of n cells missed the cache on every step of long loops).
+    std::vector<Cell> w(n * n), w_by_column(n * n);
     auto at = [&](size_t i, size_t j) -> Cell& { return w[i * n + j]; };
-    for (size_t i = 0; i + 1 < n; ++i) at(i, i + 1).min_cos = 1.f;
+    std::vector<Vec3f> p(n);
+    for (size_t k = 0; k < n; ++k) p[k] = pos(poly[k]);
+    for (size_t i = 0; i + 1 < n; ++i) at(i, i + 1).min_cos = w_by_column[(i + 1) * n + i].min_cos = 1.f;
     for (size_t len = 2; len < n; ++len) {
       for (size_t i = 0; i + len < n; ++i) {
         const size_t j = i + len;
         if (len < n - 1 && edge_taken(poly[i], poly[j])) continue;
         Cell best;
-        const Vec3f& pi = pos(poly[i]);
-        const Vec3f& pj = pos(poly[j]);
+        const Vec3f& pi = p[i];
+        const Vec3f pij = p[j] - pi;
+        const Cell* row = &w[i * n];
+        const Cell* column = &w_by_column[j * n];
         for (size_t m = i + 1; m < j; ++m) {
-          const Cell& left = at(i, m);
-          const Cell& right = at(m, j);
+          const Cell& left = row[m];
+          const Cell& right = column[m];
           if (left.min_cos < -1.5f || right.min_cos < -1.5f) continue;
-          const Vec3f nrm = (pos(poly[m]) - pi).cross(pj - pi);
+          const Vec3f nrm = (p[m] - pi).cross(pij);
           const float twice_area = nrm.norm();
           const Vec3f u = twice_area > 0.f ? Vec3f(nrm / twice_area) : Vec3f::Zero();
           float c = std::min(left.min_cos, right.min_cos);
@@ -435,7 +442,7 @@ class HolePatch {
             best.normal = u;
           }
         }
-        at(i, j) = best;
+        at(i, j) = w_by_column[j * n + i] = best;
       }
     }
     if (at(0, n - 1).m < 0) return false;
