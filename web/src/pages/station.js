@@ -234,7 +234,7 @@ export async function mount(container, _params, ctx) {
     clear(
       jobBox,
       h('h2', {}, j.kind === 'calibrate' ? 'Calibration' : j.kind === 'reprocess' ? 'Reprocessing' : 'Scan'),
-      h('p', { class: `job-state ${j.state}`, dataset: { state: j.state, stage: j.stage || '' } }, running ? `${stageText(j.stage)}…` : { complete: 'Done', failed: 'Failed', cancelled: 'Cancelled' }[j.state] || j.state),
+      h('p', { class: `job-state ${j.state}`, dataset: { state: j.state, stage: j.stage || '', job: j.id } }, running ? `${stageText(j.stage)}…` : { complete: 'Done', failed: 'Failed', cancelled: 'Cancelled' }[j.state] || j.state),
       h('progress', { max: 100, value: pct, 'aria-label': 'Progress' }),
       h('p', { class: 'muted small' }, `${pct} %${j.frames ? ` · ${j.frames} frames` : ''}`),
       j.error ? h('p', { class: 'form-error' }, j.error) : null,

@@ -10,18 +10,21 @@ let server;
 let page;
 const suite = { errors: [] };
 
-// The prompt on screen once it is one other than `last`: { id, kind, camera, title }.
-async function nextPrompt(last) {
+// The prompt on screen once it is one other than `last`: { id, kind, camera, title },
+// or { ended } once the job ends. The card of `oldJob`, a job that ended before
+// this one was started, is not this job's end: it stays until the new job shows.
+async function nextPrompt(last, oldJob = null) {
   const handle = await page.waitForFunction(
-    (old) => {
+    ([old, oldJobId]) => {
       const done = document.querySelector('#job .job-state');
+      if (done && done.dataset.job === oldJobId) return null;
       if (done && done.dataset.state !== 'running') return { ended: done.dataset.state };
       const b = document.querySelector('#job .prompt button[data-prompt]');
       if (!b || b.disabled || b.dataset.prompt === old) return null;
       const box = b.closest('.prompt');
       return { id: b.dataset.prompt, kind: box.dataset.kind, camera: box.dataset.camera, title: box.querySelector('h3').textContent };
     },
-    last,
+    [last, oldJob],
     { timeout: 120000, polling: 50 },
   );
   return handle.jsonValue();
@@ -63,8 +66,11 @@ describe('the dot-grid prompt at the station', { timeout: 600_000 }, () => {
   });
 
   it('cancels a calibration that waits for the board, lasers off', async () => {
+    // The finished calibration's card is still on screen when the new one starts.
+    const previous = await page.locator('#job .job-state').getAttribute('data-job');
+    assert.ok(previous, 'the first calibration is shown');
     await page.click('#rig-status button:has-text("Calibrate")');
-    const p = await nextPrompt(null);
+    const p = await nextPrompt(null, previous);
     assert.equal(p.kind, 'hold_dot_grid');
     await page.click('#job button:has-text("Cancel")');
     await page.locator('#job .job-state[data-state=cancelled]').waitFor({ timeout: 30000 });
