@@ -14,6 +14,7 @@ packages=(
   libeigen3-dev        # linear algebra (recon)
   libnanoflann-dev     # k-nearest-neighbour search (recon)
   libtbb-dev           # parallel loops (recon)
+  robin-map-dev        # open-addressing hash map, header-only (recon/geometry/fill_holes)
   nlohmann-json3-dev   # rig descriptions, API documents (hw, server)
   libembree-dev        # ray casting for the simulated rig (hw/sim)
   libpng-dev           # camera images (recon/io)

@@ -12,6 +12,11 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include <tsl/robin_map.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 #include "recon/geometry/mesh_components.hpp"
 
 namespace bodyscan {
@@ -20,6 +25,15 @@ namespace {
 
 uint64_t key(uint32_t a, uint32_t b) { return (static_cast<uint64_t>(a) << 32) | b; }
 uint64_t undirected_key(uint32_t a, uint32_t b) { return a < b ? key(a, b) : key(b, a); }
+// The keys' both halves mixed into the low bits an open-addressing table indexes by.
+struct EdgeHash {
+  size_t operator()(uint64_t k) const {
+    k ^= k >> 33;
+    k *= 0xff51afd7ed558ccdull;
+    k ^= k >> 33;
+    return static_cast<size_t>(k);
+  }
+};
 
 // Every triangle's half-edges filed under their start vertex (compressed rows).
 struct HalfEdges {
@@ -138,6 +152,30 @@ std::vector<std::vector<uint32_t>> boundary_loops(const std::vector<BoundaryEdge
   return loops;
 }
 
+// The edges earlier patches added, findable by key and from either end.
+struct AddedEdges {
+  std::unordered_set<uint64_t> keys;
+  std::unordered_map<uint32_t, std::vector<uint32_t>> neighbours;
+  void insert(uint32_t a, uint32_t b) {
+    if (!keys.insert(undirected_key(a, b)).second) return;
+    neighbours[a].push_back(b);
+    neighbours[b].push_back(a);
+  }
+  bool contains(uint32_t a, uint32_t b) const { return keys.count(undirected_key(a, b)) > 0; }
+};
+
+// Whether min(a[k], b[k]) < t for all four k (false for a NaN).
+inline bool all_below(const float* a, const float* b, float t) {
+#ifdef __SSE2__
+  const __m128 bound = _mm_min_ps(_mm_loadu_ps(a), _mm_loadu_ps(b));
+  return _mm_movemask_ps(_mm_cmplt_ps(bound, _mm_set1_ps(t))) == 0xf;
+#else
+  for (int k = 0; k < 4; ++k)
+    if (!(std::min(a[k], b[k]) < t)) return false;
+  return true;
+#endif
+}
+
 Vec3f unit_normal(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
   const Vec3f n = (b - a).cross(c - a);
   const float len = n.norm();
@@ -148,7 +186,7 @@ Vec3f unit_normal(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
 // about the mesh around them.
 class HolePatch {
  public:
-  HolePatch(TriangleMesh& mesh, const HalfEdges& he, std::unordered_set<uint64_t>& added_edges)
+  HolePatch(TriangleMesh& mesh, const HalfEdges& he, const AddedEdges& added_edges)
       : mesh_(mesh), he_(he), added_(added_edges), first_new_vertex_(static_cast<uint32_t>(mesh.vertices.size())) {}
 
   // Triangulates the polygon (fill winding: consecutive vertices are the new
@@ -171,7 +209,7 @@ class HolePatch {
         std::vector<Vec3f> nb(edge_normal.begin() + static_cast<long>(sj), edge_normal.end());
         nb.insert(nb.end(), edge_normal.begin(), edge_normal.begin() + static_cast<long>(si));
         nb.push_back(Vec3f::Zero());
-        added_.insert(undirected_key(poly[si], poly[sj]));
+        diagonals_.insert(undirected_key(poly[si], poly[sj]));
         triangulate(a, na, max_dp);
         triangulate(b, nb, max_dp);
         return;
@@ -291,6 +329,7 @@ class HolePatch {
   void discard() {
     tris_.clear();
     edges_.clear();
+    diagonals_.clear();
     mesh_.vertices.resize(first_new_vertex_);
   }
 
@@ -301,7 +340,43 @@ class HolePatch {
   // in this one.
   bool edge_taken(uint32_t a, uint32_t b) const {
     return (a < first_new_vertex_ && b < first_new_vertex_ && he_.connected(a, b)) ||
-           added_.count(undirected_key(a, b)) > 0 || edges_.count(key(a, b)) > 0 || edges_.count(key(b, a)) > 0;
+           added_.contains(a, b) || diagonals_.count(undirected_key(a, b)) > 0 || edges_.count(key(a, b)) > 0 ||
+           edges_.count(key(b, a)) > 0;
+  }
+
+  // edge_taken for every pair of the polygon's vertices (n x n, symmetric), found
+  // from the vertices' own edges - the mesh's, earlier patches', this patch's -
+  // rather than by n^2 / 2 lookups.
+  std::vector<uint8_t> taken_pairs(const std::vector<uint32_t>& poly) const {
+    const size_t n = poly.size();
+    std::vector<uint8_t> taken(n * n, 0);
+    std::unordered_map<uint32_t, uint32_t> slot;
+    slot.reserve(2 * n);
+    for (size_t k = 0; k < n; ++k) slot.emplace(poly[k], static_cast<uint32_t>(k));
+    auto mark = [&](size_t i, uint32_t b) {
+      auto it = slot.find(b);
+      if (it == slot.end()) return;
+      taken[i * n + it->second] = taken[it->second * n + i] = 1;
+    };
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t a = poly[i];
+      if (a < first_new_vertex_ && a + 1 < he_.start.size())
+        for (size_t s = he_.start[a]; s < he_.start[a + 1]; ++s)
+          if (he_.to[s] < first_new_vertex_) mark(i, he_.to[s]);
+      auto it = added_.neighbours.find(a);
+      if (it != added_.neighbours.end())
+        for (uint32_t b : it->second) mark(i, b);
+    }
+    for (const Triangle& t : tris_)
+      for (int k = 0; k < 3; ++k) {
+        auto it = slot.find(t[k]);
+        if (it != slot.end()) mark(it->second, t[(k + 1) % 3]);
+      }
+    for (uint64_t d : diagonals_) {
+      auto it = slot.find(static_cast<uint32_t>(d >> 32));
+      if (it != slot.end()) mark(it->second, static_cast<uint32_t>(d));
+    }
+    return taken;
   }
 
   float scale_of(uint32_t v) {
@@ -368,7 +443,7 @@ class HolePatch {
   // either end (along the surrounding triangles' normals) spans a gap outside the
   // body rather than the hole - between the inner thighs below the crotch, the
   // shortest of all - and is taken only when nothing else is left.
-  bool find_split(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal, size_t* si,
+  __attribute__((noinline)) bool find_split(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal, size_t* si,
                   size_t* sj) const {
     const size_t n = poly.size();
     const size_t min_part = std::max<size_t>(3, n / 4);
@@ -395,62 +470,88 @@ class HolePatch {
     return best < std::numeric_limits<double>::max();
   }
 
-  bool minimum_dihedral_triangulation(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal) {
+  __attribute__((noinline)) bool minimum_dihedral_triangulation(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal) {
     const size_t n = poly.size();
-    struct Cell {
-      float min_cos = -2.f;  // < -1: no triangulation
-      float area = 0.f;
-      int m = -1;
-      Vec3f normal = Vec3f::Zero();  // of the triangle (i, m, j)
-    };
-    // Row-major for the left cells (i, m), and a column-major copy for the right
-    // cells (m, j): the innermost loop walks m, and both stay contiguous in memory
-    // (a stride of n cells missed the cache on every step of long loops).
-    std::vector<Cell> w(n * n), w_by_column(n * n);
-    auto at = [&](size_t i, size_t j) -> Cell& { return w[i * n + j]; };
+    // Cell (i, j): the best triangulation of the polygon i..j - its worst dihedral
+    // angle's cosine (< -1: none), its area, the apex m of the triangle on i-j and
+    // that triangle's normal. Kept as separate tables so the bound test below
+    // reads only the cosines. Row-major tables serve the left cells (i, m) and
+    // column-major copies the right cells (m, j): the innermost loop walks m and
+    // every table it reads stays contiguous (a stride of n cells missed the cache
+    // on every step of long loops).
+    std::vector<float> cos_row(n * n, -2.f), cos_column(n * n, -2.f);
+    std::vector<float> area_row(n * n, 0.f), area_column(n * n, 0.f);
+    std::vector<Vec3f> normal_row(n * n, Vec3f::Zero()), normal_column(n * n, Vec3f::Zero());
+    std::vector<int> apex(n * n, -1);
     std::vector<Vec3f> p(n);
     for (size_t k = 0; k < n; ++k) p[k] = pos(poly[k]);
-    for (size_t i = 0; i + 1 < n; ++i) at(i, i + 1).min_cos = w_by_column[(i + 1) * n + i].min_cos = 1.f;
-    for (size_t len = 2; len < n; ++len) {
-      for (size_t i = 0; i + len < n; ++i) {
-        const size_t j = i + len;
-        if (len < n - 1 && edge_taken(poly[i], poly[j])) continue;
-        Cell best;
-        const Vec3f& pi = p[i];
-        const Vec3f pij = p[j] - pi;
-        const Cell* row = &w[i * n];
-        const Cell* column = &w_by_column[j * n];
-        for (size_t m = i + 1; m < j; ++m) {
-          const Cell& left = row[m];
-          const Cell& right = column[m];
-          if (left.min_cos < -1.5f || right.min_cos < -1.5f) continue;
-          const Vec3f nrm = (p[m] - pi).cross(pij);
-          const float twice_area = nrm.norm();
-          const Vec3f u = twice_area > 0.f ? Vec3f(nrm / twice_area) : Vec3f::Zero();
-          float c = std::min(left.min_cos, right.min_cos);
-          if (twice_area <= 0.f) c = -1.f;  // degenerate: the worst angle
-          const Vec3f& n_left = m == i + 1 ? edge_normal[i] : left.normal;
-          const Vec3f& n_right = j == m + 1 ? edge_normal[m] : right.normal;
-          if (!n_left.isZero()) c = std::min(c, u.dot(n_left));
-          if (!n_right.isZero()) c = std::min(c, u.dot(n_right));
-          if (len == n - 1 && !edge_normal[n - 1].isZero()) c = std::min(c, u.dot(edge_normal[n - 1]));
-          const float area = left.area + right.area + 0.5f * twice_area;
-          if (c > best.min_cos + 1e-6f || (c >= best.min_cos - 1e-6f && area < best.area)) {
-            best.min_cos = c;
-            best.area = area;
-            best.m = static_cast<int>(m);
-            best.normal = u;
-          }
+    const std::vector<uint8_t> taken = taken_pairs(poly);
+    for (size_t i = 0; i + 1 < n; ++i) cos_row[i * n + i + 1] = cos_column[(i + 1) * n + i] = 1.f;
+    // Cell (i, i + len) needs only shorter cells: each length's cells are solved
+    // in parallel once the previous lengths are done.
+    auto solve = [&](size_t i, size_t len) {
+      const size_t j = i + len;
+      if (len < n - 1 && taken[i * n + j]) return;
+      float best_cos = -2.f, best_area = 0.f;
+      int best_m = -1;
+      Vec3f best_normal = Vec3f::Zero();
+      const Vec3f& pi = p[i];
+      const Vec3f pij = p[j] - pi;
+      const float* left_cos = &cos_row[i * n];
+      const float* right_cos = &cos_column[j * n];
+      auto consider = [&](size_t m) __attribute__((always_inline)) {
+        // The candidate's worst angle is no better than its two parts': when
+        // that bound already loses to the best so far, the triangle's geometry
+        // cannot change the outcome (an exact pruning: the same triangulation).
+        const float bound = std::min(left_cos[m], right_cos[m]);
+        if (bound < -1.5f || bound < best_cos - 1e-6f) return;
+        const Vec3f nrm = (p[m] - pi).cross(pij);
+        const float twice_area = nrm.norm();
+        const Vec3f u = twice_area > 0.f ? Vec3f(nrm / twice_area) : Vec3f::Zero();
+        float c = twice_area > 0.f ? bound : -1.f;  // degenerate: the worst angle
+        const Vec3f& n_left = m == i + 1 ? edge_normal[i] : normal_row[i * n + m];
+        const Vec3f& n_right = j == m + 1 ? edge_normal[m] : normal_column[j * n + m];
+        if (!n_left.isZero()) c = std::min(c, u.dot(n_left));
+        if (!n_right.isZero()) c = std::min(c, u.dot(n_right));
+        if (len == n - 1 && !edge_normal[n - 1].isZero()) c = std::min(c, u.dot(edge_normal[n - 1]));
+        const float area = area_row[i * n + m] + area_column[j * n + m] + 0.5f * twice_area;
+        if (c > best_cos + 1e-6f || (c >= best_cos - 1e-6f && area < best_area)) {
+          best_cos = c;
+          best_area = area;
+          best_m = static_cast<int>(m);
+          best_normal = u;
         }
-        at(i, j) = w_by_column[j * n + i] = best;
+      };
+      // Four candidates at a time are passed over together when none of their
+      // bounds reaches the best so far - most of them, once a good one is found.
+      size_t m = i + 1;
+      for (; m + 4 <= j; m += 4) {
+        if (all_below(left_cos + m, right_cos + m, std::max(-1.5f, best_cos - 1e-6f))) continue;
+        for (size_t k = m; k < m + 4; ++k) consider(k);
+      }
+      for (; m < j; ++m) consider(m);
+      cos_row[i * n + j] = cos_column[j * n + i] = best_cos;
+      area_row[i * n + j] = area_column[j * n + i] = best_area;
+      normal_row[i * n + j] = normal_column[j * n + i] = best_normal;
+      apex[i * n + j] = best_m;
+    };
+    for (size_t len = 2; len < n; ++len) {
+      const size_t cells = n - len;
+      if (cells * len < 1u << 14) {
+        for (size_t i = 0; i < cells; ++i) solve(i, len);
+      } else {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, cells, 16), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t i = r.begin(); i != r.end(); ++i) solve(i, len);
+        });
       }
     }
-    if (at(0, n - 1).m < 0) return false;
+    auto at = [&](size_t i, size_t j) { return apex[i * n + j]; };
+    if (at(0, n - 1) < 0) return false;
     std::vector<std::pair<size_t, size_t>> stack{{0, n - 1}};
     while (!stack.empty()) {
       const auto [i, j] = stack.back();
       stack.pop_back();
-      const size_t m = static_cast<size_t>(at(i, j).m);
+      const size_t m = static_cast<size_t>(at(i, j));
       add({poly[i], poly[m], poly[j]});
       if (m - i >= 2) stack.emplace_back(i, m);
       if (j - m >= 2) stack.emplace_back(m, j);
@@ -470,10 +571,11 @@ class HolePatch {
 
   TriangleMesh& mesh_;
   const HalfEdges& he_;
-  std::unordered_set<uint64_t>& added_;
+  const AddedEdges& added_;
   const uint32_t first_new_vertex_;
   std::vector<Triangle> tris_;
-  std::unordered_map<uint64_t, uint32_t> edges_;  // directed patch edge -> patch triangle
+  tsl::robin_map<uint64_t, uint32_t, EdgeHash> edges_;  // directed patch edge -> patch triangle
+  std::unordered_set<uint64_t> diagonals_;        // the splits' diagonals (undirected)
   std::unordered_map<uint32_t, float> scale_;     // local edge length per vertex
 };
 
@@ -488,7 +590,7 @@ HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
   stats.holes = loops.size();
   if (loops.empty()) return stats;
   std::vector<Triangle> added_triangles;
-  std::unordered_set<uint64_t> added_edges;
+  AddedEdges added_edges;
   for (const std::vector<uint32_t>& loop : loops) {
     stats.largest_hole_edges = std::max(stats.largest_hole_edges, loop.size());
     if (options.max_hole_edges && loop.size() > options.max_hole_edges) continue;
@@ -515,7 +617,7 @@ HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
     stats.area_added += patch.area();
     for (const Triangle& t : patch.triangles()) {
       added_triangles.push_back(t);
-      for (int k = 0; k < 3; ++k) added_edges.insert(undirected_key(t[k], t[(k + 1) % 3]));
+      for (int k = 0; k < 3; ++k) added_edges.insert(t[k], t[(k + 1) % 3]);
     }
     ++stats.holes_filled;
   }

@@ -40,7 +40,7 @@ struct HoleFillOptions {
   // limit): an opening that big is the surface's real edge, not a hole.
   double max_hole_area = 0.0;
   // Longer loops are split by diagonals before the cubic dynamic programme.
-  size_t max_dp_edges = 400;
+  size_t max_dp_edges = 1000;
   bool refine = true;
   HoleFairing fairing = HoleFairing::kMembrane;
 };

@@ -141,6 +141,37 @@ TEST(FillHoles, LongLoopsAreSplitAndStillClose) {
   }
 }
 
+TEST(FillHoles, ALoopOfSeveralHundredEdgesIsTakenWholeAlikeEveryTime) {
+  // A cap cut from a fine sphere leaves a loop of about 600 edges: under the
+  // default limit, so the programme takes it whole, solving each length's cells in
+  // parallel. The thin plate continues the sphere (as far as the umbrella
+  // operator's does: 0.1 at most here), and a second fill of the same mesh is the
+  // same to the bit.
+  const TriangleMesh sphere = icosphere(7, 1.0);
+  const auto in_cap = [](const Vec3f& p) { return p.y() > 0.6f; };
+  TriangleMesh first;
+  for (int run = 0; run < 2; ++run) {
+    TriangleMesh m = without(sphere, in_cap);
+    HoleFillOptions o;
+    o.fairing = HoleFairing::kThinPlate;
+    const HoleFillStats s = fill_holes(m, o);
+    ASSERT_EQ(s.holes_filled, 1u);
+    EXPECT_GT(s.largest_hole_edges, 500u);
+    EXPECT_LT(s.largest_hole_edges, o.max_dp_edges);
+    expect_closed(m, "fine sphere");
+    float worst = 0.f;
+    for (size_t v = 0; v < m.vertices.size(); ++v)
+      if (m.confidence[v] == 0.f) worst = std::max(worst, std::abs(m.vertices[v].norm() - 1.f));
+    EXPECT_LT(worst, 0.12f);  // the flat span the loop bounds is 0.4 below the pole
+    if (run == 0) {
+      first = std::move(m);
+    } else {
+      EXPECT_TRUE(m.triangles == first.triangles);
+      EXPECT_TRUE(m.vertices == first.vertices);
+    }
+  }
+}
+
 TEST(FillHoles, HolesMeetingAtAVertexAndSeveralHolesAllClose) {
   // Two triangles of a cube removed at opposite faces, and on an icosphere two
   // fans that share only their centre's neighbour: loops through one vertex twice

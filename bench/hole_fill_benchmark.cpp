@@ -1,0 +1,148 @@
+// Hole filling on a real open surface (issue 5: the square rig's feet).
+//
+//   hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R]
+//                       [--save-open OPEN.ply] [--out FILLED.ply]
+//
+// IN.ply is either a scan's point cloud, e.g. from
+//   bodyscan scan --rig square --body male_average.ply --out S --no-surface
+// which is surfaced as a scan's is (the body options) up to the holes: the field's
+// zero set with its flaps trimmed back to the data, saved with --save-open; or
+// such an open mesh (a PLY with faces), filled directly.
+// For each --max-dp limit (the longest loop the minimum-dihedral programme takes
+// whole; several may be given, compared in one run) it fills a fresh copy of the
+// mesh R times and prints the best wall time, the loops, what was added, and a
+// checksum of the result (equal checksums: the same triangulation), so a faster
+// programme can be shown to fill exactly as before.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "recon/geometry/fill_holes.hpp"
+#include "recon/io/ply.hpp"
+#include "recon/spatial/knn_index.hpp"
+#include "recon/surface/reconstruct.hpp"
+#include "server/pipeline/scan_job.hpp"
+
+using namespace bodyscan;
+
+namespace {
+
+// FNV-1a over the triangles and the vertex positions' bits.
+uint64_t checksum(const TriangleMesh& mesh) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* data, size_t bytes) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  };
+  mix(mesh.triangles.data(), mesh.triangles.size() * sizeof(Triangle));
+  mix(mesh.vertices.data(), mesh.vertices.size() * sizeof(Vec3f));
+  return h;
+}
+
+// The scan's surface before fill_holes: reconstruct_surface with the body options,
+// holes kept, then the flaps trimmed as reconstruct_surface trims them.
+StatusOr<TriangleMesh> open_surface(const PointCloud& cloud) {
+  ReconstructOptions ro = pipeline::body_surface_options();
+  ro.close_holes = false;
+  ro.min_component_fraction = 0.0;  // after the filling, as in the pipeline
+  if (cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
+  ASSIGN_OR_RETURN(ReconstructResult r, reconstruct_surface(cloud, ro));
+  std::vector<Vec3f> used;
+  for (size_t i = 0; i < cloud.size(); ++i)
+    if (!cloud.has_confidence() || cloud.confidence[i] > 0.f) used.push_back(cloud.positions[i]);
+  const KnnIndex index(used);
+  const float reach = r.stats.median_density_sigma + 3.f * r.stats.noise_sigma;
+  const size_t trimmed = trim_boundary_flaps(r.mesh, [&](uint32_t v) {
+    uint32_t nearest = 0;
+    float d2 = 0.f;
+    return index.knn(r.mesh.vertices[v], 1, &nearest, &d2) == 0 || d2 > reach * reach;
+  });
+  std::printf("surfaced %zu points at %.2f voxels in %.1f s; %zu flap triangles trimmed\n", cloud.size(),
+              r.stats.voxel_size, r.stats.total_seconds(), trimmed);
+  return std::move(r.mesh);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string in, out, save_open;
+  std::vector<size_t> limits;
+  int repeat = 1;
+  HoleFillOptions options;
+  options.fairing = pipeline::body_surface_options().hole_fairing;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "hole_fill_benchmark: %s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--max-dp") limits.push_back(std::strtoull(next(), nullptr, 10));
+    else if (a == "--repeat") repeat = std::max(1, std::atoi(next()));
+    else if (a == "--membrane") options.fairing = HoleFairing::kMembrane;
+    else if (a == "--out") out = next();
+    else if (a == "--save-open") save_open = next();
+    else if (!a.empty() && a[0] != '-' && in.empty()) in = a;
+    else {
+      std::fprintf(stderr, "usage: hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R] [--save-open OPEN.ply] [--out FILLED.ply]\n");
+      return 2;
+    }
+  }
+  if (in.empty()) {
+    std::fprintf(stderr, "hole_fill_benchmark: no input mesh\n");
+    return 2;
+  }
+  if (limits.empty()) limits.push_back(HoleFillOptions{}.max_dp_edges);
+  auto loaded = read_ply(in);
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "hole_fill_benchmark: %s\n", loaded.status().message().c_str());
+    return 1;
+  }
+  TriangleMesh open;
+  if (loaded->triangles.empty()) {
+    auto surfaced = open_surface(loaded->cloud);
+    if (!surfaced.ok()) {
+      std::fprintf(stderr, "hole_fill_benchmark: %s\n", surfaced.status().message().c_str());
+      return 1;
+    }
+    open = std::move(surfaced).value();
+    if (!save_open.empty()) {
+      const Status s = write_ply(save_open, open);
+      if (!s.ok()) std::fprintf(stderr, "hole_fill_benchmark: %s\n", s.message().c_str());
+    }
+  } else {
+    open.vertices = std::move(loaded->cloud.positions);
+    open.triangles = std::move(loaded->triangles);
+  }
+  std::printf("%s: %zu vertices, %zu triangles\n", in.c_str(), open.num_vertices(), open.num_triangles());
+  for (size_t limit : limits) {
+    options.max_dp_edges = limit;
+    double best = 1e300;
+    TriangleMesh filled;
+    HoleFillStats stats;
+    for (int r = 0; r < repeat; ++r) {
+      filled = open;
+      const auto t0 = std::chrono::steady_clock::now();
+      stats = fill_holes(filled, options);
+      best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    std::printf("max_dp %5zu: %8.3f s  loops %zu filled %zu longest %zu  +%zu triangles +%zu vertices  "
+                "area %.0f  checksum %016llx\n",
+                limit, best, stats.holes, stats.holes_filled, stats.largest_hole_edges, stats.triangles_added,
+                stats.vertices_added, stats.area_added, static_cast<unsigned long long>(checksum(filled)));
+    if (!out.empty() && limit == limits.back()) {
+      const Status s = write_ply(out, filled);
+      if (!s.ok()) {
+        std::fprintf(stderr, "hole_fill_benchmark: %s\n", s.message().c_str());
+        return 1;
+      }
+    }
+  }
+  return 0;
+}
