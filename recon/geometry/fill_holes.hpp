@@ -41,10 +41,12 @@ struct HoleFillOptions {
   double max_hole_area = 0.0;
   // Longer loops are split by diagonals before the cubic dynamic programme. The
   // shortest diagonal can run across the body rather than the hole - the square
-  // rig's feet, 70 mm up (docs/benchmarks.md §7) - so loops are taken whole as far
-  // as time allows: that scan's 296 loops fill in 7.2 s at 1000, 5.3 s at 400
-  // (bench/hole_fill_benchmark, two cores).
-  size_t max_dp_edges = 1000;
+  // rig's feet, 70 mm up - and 1000 takes those loops whole (the fill then takes
+  // 7.2 s instead of 5.3 on that scan, bench/hole_fill_benchmark). But on the
+  // thesis rig the whole programme spans the unseen shoulder tops worse than the
+  // split parts do (male_muscular: 22 of 34 measurements within the ISO allowance
+  // at 400, 19 at 1000; docs/benchmarks.md §7), so the default stays at 400.
+  size_t max_dp_edges = 400;
   bool refine = true;
   HoleFairing fairing = HoleFairing::kMembrane;
 };
