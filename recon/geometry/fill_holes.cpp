@@ -443,7 +443,7 @@ class HolePatch {
   // either end (along the surrounding triangles' normals) spans a gap outside the
   // body rather than the hole - between the inner thighs below the crotch, the
   // shortest of all - and is taken only when nothing else is left.
-  __attribute__((noinline)) bool find_split(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal, size_t* si,
+  bool find_split(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal, size_t* si,
                   size_t* sj) const {
     const size_t n = poly.size();
     const size_t min_part = std::max<size_t>(3, n / 4);
@@ -470,7 +470,7 @@ class HolePatch {
     return best < std::numeric_limits<double>::max();
   }
 
-  __attribute__((noinline)) bool minimum_dihedral_triangulation(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal) {
+  bool minimum_dihedral_triangulation(const std::vector<uint32_t>& poly, const std::vector<Vec3f>& edge_normal) {
     const size_t n = poly.size();
     // Cell (i, j): the best triangulation of the polygon i..j - its worst dihedral
     // angle's cosine (< -1: none), its area, the apex m of the triangle on i-j and
