@@ -1,12 +1,13 @@
 // Hole filling on a real open surface (issue 5: the square rig's feet).
 //
 //   hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R]
-//                       [--save-open OPEN.ply] [--out FILLED.ply]
+//                       [--save-open OPEN.ply] [--out FILLED.ply] [--min-weight W]
 //
 // IN.ply is either a scan's point cloud, e.g. from
 //   bodyscan scan --rig square --body male_average.ply --out S --no-surface
 // which is surfaced as a scan's is (the body options) up to the holes: the field's
-// zero set with its flaps trimmed back to the data, saved with --save-open; or
+// zero set with its flaps trimmed back to the data, saved with --save-open (W:
+// ReconstructOptions::min_relative_weight, to see what the weight cut opens); or
 // such an open mesh (a PLY with faces), filled directly.
 // For each --max-dp limit (the longest loop the minimum-dihedral programme takes
 // whole; several may be given, compared in one run) it fills a fresh copy of the
@@ -45,8 +46,9 @@ uint64_t checksum(const TriangleMesh& mesh) {
 
 // The scan's surface before fill_holes: reconstruct_surface with the body options,
 // holes kept, then the flaps trimmed as reconstruct_surface trims them.
-StatusOr<TriangleMesh> open_surface(const PointCloud& cloud) {
+StatusOr<TriangleMesh> open_surface(const PointCloud& cloud, float min_relative_weight) {
   ReconstructOptions ro = pipeline::body_surface_options();
+  if (min_relative_weight >= 0.f) ro.min_relative_weight = min_relative_weight;
   ro.close_holes = false;
   ro.min_component_fraction = 0.0;  // after the filling, as in the pipeline
   if (cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
@@ -72,6 +74,7 @@ int main(int argc, char** argv) {
   std::string in, out, save_open;
   std::vector<size_t> limits;
   int repeat = 1;
+  float min_weight = -1.f;  // the body options' own
   HoleFillOptions options;
   options.fairing = pipeline::body_surface_options().hole_fairing;
   for (int i = 1; i < argc; ++i) {
@@ -88,9 +91,10 @@ int main(int argc, char** argv) {
     else if (a == "--membrane") options.fairing = HoleFairing::kMembrane;
     else if (a == "--out") out = next();
     else if (a == "--save-open") save_open = next();
+    else if (a == "--min-weight") min_weight = std::strtof(next(), nullptr);
     else if (!a.empty() && a[0] != '-' && in.empty()) in = a;
     else {
-      std::fprintf(stderr, "usage: hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R] [--save-open OPEN.ply] [--out FILLED.ply]\n");
+      std::fprintf(stderr, "usage: hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R] [--save-open OPEN.ply] [--out FILLED.ply] [--min-weight W]\n");
       return 2;
     }
   }
@@ -106,7 +110,7 @@ int main(int argc, char** argv) {
   }
   TriangleMesh open;
   if (loaded->triangles.empty()) {
-    auto surfaced = open_surface(loaded->cloud);
+    auto surfaced = open_surface(loaded->cloud, min_weight);
     if (!surfaced.ok()) {
       std::fprintf(stderr, "hole_fill_benchmark: %s\n", surfaced.status().message().c_str());
       return 1;

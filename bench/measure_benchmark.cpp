@@ -5,9 +5,10 @@
 //
 //   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR]
-//                     [--seed N]
+//                     [--seed N] [--min-weight W]
 //
 // --save writes each scan's surface and the posed true body as PLY into DIR.
+// --min-weight sets the surface's ReconstructOptions::min_relative_weight.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
 // 9 mm off on large girths, 4 mm on small girths and heights, 5 mm on lengths. The
@@ -57,6 +58,7 @@ struct Scan {
 };
 
 HoleFairing g_fairing = pipeline::body_surface_options().hole_fairing;
+float g_min_weight = pipeline::body_surface_options().min_relative_weight;
 std::string g_save;
 uint64_t g_seed = 1;
 
@@ -77,6 +79,7 @@ StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64
   pipeline::ScanJobOptions o;
   o.every = every;
   o.surface.hole_fairing = g_fairing;
+  o.surface.min_relative_weight = g_min_weight;
   ASSIGN_OR_RETURN(pipeline::ScanJobResult r, pipeline::run_scan_job(pipeline::rig_handle(*sim), o));
   if (!r.surface_error.empty()) return internal_error("surface: " + r.surface_error);
   Scan s;
@@ -121,6 +124,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
     // The same scan surfaced on a coarser grid, about 500k triangles.
     ReconstructOptions ro = pipeline::body_surface_options();
     ro.hole_fairing = g_fairing;
+    ro.min_relative_weight = g_min_weight;
     ro.voxel_size = a->voxel * 1.77f;
     ro.normal_source = NormalSource::kCameras;
     auto coarse = reconstruct_surface(a->cloud, ro);
@@ -232,12 +236,13 @@ int main(int argc, char** argv) {
     else if (a == "--every" && i + 1 < argc) every = std::atoi(argv[++i]);
     else if (a == "--save" && i + 1 < argc) g_save = argv[++i];
     else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (a == "--min-weight" && i + 1 < argc) g_min_weight = std::strtof(argv[++i], nullptr);
     else if (a == "--fairing" && i + 1 < argc) {
       const std::string f = argv[++i];
       g_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
     }
     else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
-                        "[--fairing membrane|thin]\n"), 2;
+                        "[--fairing membrane|thin] [--save DIR] [--seed N] [--min-weight W]\n"), 2;
   }
   if (rigs.empty()) rigs = {"thesis"};
   if (bodies.empty()) bodies = {""};
