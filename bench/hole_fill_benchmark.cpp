@@ -24,7 +24,6 @@
 
 #include "recon/geometry/fill_holes.hpp"
 #include "recon/io/ply.hpp"
-#include "recon/spatial/knn_index.hpp"
 #include "recon/surface/reconstruct.hpp"
 #include "server/pipeline/scan_job.hpp"
 
@@ -45,26 +44,16 @@ uint64_t checksum(const TriangleMesh& mesh) {
 }
 
 // The scan's surface before fill_holes: reconstruct_surface with the body options,
-// holes kept, then the flaps trimmed as reconstruct_surface trims them.
+// its flaps trimmed and its holes left open.
 StatusOr<TriangleMesh> open_surface(const PointCloud& cloud, float min_relative_weight) {
   ReconstructOptions ro = pipeline::body_surface_options();
   if (min_relative_weight >= 0.f) ro.min_relative_weight = min_relative_weight;
-  ro.close_holes = false;
+  ro.leave_trimmed_holes_open = true;
   ro.min_component_fraction = 0.0;  // after the filling, as in the pipeline
   if (cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
   ASSIGN_OR_RETURN(ReconstructResult r, reconstruct_surface(cloud, ro));
-  std::vector<Vec3f> used;
-  for (size_t i = 0; i < cloud.size(); ++i)
-    if (!cloud.has_confidence() || cloud.confidence[i] > 0.f) used.push_back(cloud.positions[i]);
-  const KnnIndex index(used);
-  const float reach = r.stats.median_density_sigma + 3.f * r.stats.noise_sigma;
-  const size_t trimmed = trim_boundary_flaps(r.mesh, [&](uint32_t v) {
-    uint32_t nearest = 0;
-    float d2 = 0.f;
-    return index.knn(r.mesh.vertices[v], 1, &nearest, &d2) == 0 || d2 > reach * reach;
-  });
   std::printf("surfaced %zu points at %.2f voxels in %.1f s; %zu flap triangles trimmed\n", cloud.size(),
-              r.stats.voxel_size, r.stats.total_seconds(), trimmed);
+              r.stats.voxel_size, r.stats.total_seconds(), r.stats.flap_triangles_trimmed);
   return std::move(r.mesh);
 }
 

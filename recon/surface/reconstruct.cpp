@@ -242,12 +242,14 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
       float d2 = 0.f;
       return index.knn(result.mesh.vertices[v], 1, &nearest, &d2) == 0 || d2 > reach2;
     });
-    HoleFillOptions fill;
-    fill.max_hole_area = options.max_hole_area_fraction * surface_area(result.mesh);
-    fill.fairing = options.hole_fairing;
-    const HoleFillStats holes = fill_holes(result.mesh, fill);
-    st.holes_filled = holes.holes_filled;
-    st.hole_area = holes.area_added;
+    if (!options.leave_trimmed_holes_open) {
+      HoleFillOptions fill;
+      fill.max_hole_area = options.max_hole_area_fraction * surface_area(result.mesh);
+      fill.fairing = options.hole_fairing;
+      const HoleFillStats holes = fill_holes(result.mesh, fill);
+      st.holes_filled = holes.holes_filled;
+      st.hole_area = holes.area_added;
+    }
   }
   // After the trimming, which may cut islands off a flap.
   if (options.min_component_fraction > 0.0) {

@@ -60,6 +60,9 @@ struct ReconstructOptions {
   // noise sigmas), then fill every hole up to max_hole_area_fraction. Off = the
   // field's zero set as is.
   bool close_holes = true;
+  // With close_holes: stop after the trimming, holes left open (to study or time
+  // the filling on exactly what it would get: bench/hole_fill_benchmark).
+  bool leave_trimmed_holes_open = false;
   float hole_trim_distance = 0.f;
   // Openings whose fill would exceed this fraction of the surface's area are taken
   // as the surface's real edge and stay open (a scanned patch, a tube's ends); a
