@@ -7,6 +7,10 @@
 // the smallest clearance, in mm around the light's centre, that every camera has.
 //
 //   rig_coverage [--rig thesis|square|FILE]... [--body BODY.ply] [--min-angle DEG]
+//                [--max-view DEG] [--cross]
+//
+// --max-view counts a camera only within DEG of the surface's normal (default 90:
+// any camera in front of it; the scan drops views beyond the rig's max_view_deg).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,15 +26,16 @@ using namespace bodyscan;
 int main(int argc, char** argv) {
   std::vector<std::string> rigs;
   std::string body;
-  double min_angle = 8, min_incidence = 0.1;
+  double min_angle = 8, min_incidence = 0.1, max_view = 90;
   bool cross = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
     else if (a == "--body" && i + 1 < argc) body = argv[++i];
     else if (a == "--min-angle" && i + 1 < argc) min_angle = std::atof(argv[++i]);
+    else if (a == "--max-view" && i + 1 < argc) max_view = std::atof(argv[++i]);
     else if (a == "--cross") cross = true;
-    else return std::fprintf(stderr, "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG]\n"), 2;
+    else return std::fprintf(stderr, "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG] [--max-view DEG] [--cross]\n"), 2;
   }
   if (rigs.empty()) rigs = {"thesis", "square"};
   for (const std::string& name : rigs) {
@@ -42,6 +47,20 @@ int main(int argc, char** argv) {
     for (const auto& c : desc.cameras) cams.push_back(c.model());
     const PointCloud s = sample_mesh_uniform(scene.subject(), 60000, 3, true);
     size_t covered = 0, seen = 0, lit = 0;
+    // Where the tailor's measurements hang from an unseen surface (docs/measurements.md):
+    // the crotch, the shoulders' tops, the forearms held out from the sides.
+    float floor_y = 1e9f, top_y = -1e9f;
+    for (const Vec3f& p : s.positions) floor_y = std::min(floor_y, p.y()), top_y = std::max(top_y, p.y());
+    const float height = top_y - floor_y;
+    const auto zone = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& n) -> int {
+      const double h = (p.y() - floor_y) / height;
+      if (h > 0.40 && h < 0.50 && std::abs(p.x()) < 100 && n.y() < -0.3) return 0;
+      if (h > 0.78 && h < 0.86 && std::abs(p.x()) > 60 && n.y() > 0.5) return 1;
+      if (h > 0.45 && h < 0.65 && std::abs(p.x()) > 300) return 2;
+      return -1;
+    };
+    const char* zone_names[3] = {"crotch", "shoulder tops", "forearms"};
+    size_t zone_total[3] = {0, 0, 0}, zone_covered[3] = {0, 0, 0};
     std::map<std::string, size_t> holes;
     for (size_t i = 0; i < s.size(); ++i) {
       const Eigen::Vector3d p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
@@ -49,7 +68,7 @@ int main(int argc, char** argv) {
       bool any_seen = false, any_lit = false, ok = false;
       for (size_t c = 0; c < cams.size() && !ok; ++c) {
         const Eigen::Vector3d to_cam = cams[c].centre() - p;
-        if (n.dot(to_cam) <= 0) continue;
+        if (n.dot(to_cam) <= std::cos(max_view * M_PI / 180) * to_cam.norm()) continue;
         const auto px = cams[c].project(p);
         if (!px || !cams[c].in_image(*px) || scene.occluded(q, to_cam.normalized(), to_cam.norm())) continue;
         any_seen = true;
@@ -74,6 +93,7 @@ int main(int argc, char** argv) {
       seen += any_seen;
       lit += any_lit;
       covered += ok;
+      if (const int z = zone(p, n); z >= 0) zone_total[z]++, zone_covered[z] += ok;
       if (!ok) {
         holes[bench::body_region(p, n) + (any_seen ? (any_lit ? " (angle)" : " (unlit)") : " (unseen)")]++;
       }
@@ -113,6 +133,10 @@ int main(int argc, char** argv) {
     std::sort(by.rbegin(), by.rend());
     for (size_t k = 0; k < std::min<size_t>(8, by.size()); ++k)
       std::printf("%s %s %.1f %%", k ? "," : "", by[k].second.c_str(), 100.0 * by[k].first / s.size());
+    std::printf("\n  zones:");
+    for (int z = 0; z < 3; ++z)
+      std::printf(" %s %.1f %% of %.0f cm2%s", zone_names[z], zone_total[z] ? 100.0 * zone_covered[z] / zone_total[z] : 0.0,
+                  zone_total[z] * surface_area(scene.subject()) / s.size() / 100.0, z < 2 ? "," : "");
     std::printf("\n");
   }
 }

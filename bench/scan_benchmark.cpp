@@ -248,6 +248,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
     // stripe's peak towards the side that faces the camera more.
     {
       std::vector<double> err, signed_err, confidence, view;
+      std::vector<double> camera_bias(cal->cameras.size(), 0.0);
+      std::vector<size_t> camera_n(cal->cameras.size(), 0);
       for (size_t i = 0; i < dd.size(); ++i) {
         if (dd[i] > 5) continue;
         const ClosestPoint cp = distance.closest_point(cloud.positions[i]);
@@ -260,6 +262,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
             (desc.cameras[static_cast<size_t>(cloud.camera[i])].position - cloud.positions[i].cast<double>()).normalized();
         err.push_back(dd[i]);
         signed_err.push_back(cp.signed_distance);
+        camera_bias[static_cast<size_t>(cloud.camera[i])] += cp.signed_distance;
+        camera_n[static_cast<size_t>(cloud.camera[i])]++;
         confidence.push_back(cloud.confidence[i]);
         view.push_back(std::acos(std::min(1.0, std::abs(n.dot(to_cam)))) * 180 / M_PI);
       }
@@ -277,6 +281,11 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       };
       report("confidence", {0.0, 0.1, 0.25, 0.5, 0.75, 1.0 + 1e-6}, confidence);
       report("view (deg)", {0, 60, 70, 75, 80, 85, 90.01}, view);
+      std::printf("    signed mean within 5 mm by camera:");
+      for (size_t c = 0; c < camera_n.size(); ++c)
+        std::printf(" %s %+.3f", cal->cameras[c].camera_id.c_str(),
+                    camera_bias[c] / static_cast<double>(std::max<size_t>(camera_n[c], 1)));
+      std::printf("\n");
     }
     // Coverage: the share of the body's area within 5 mm of a point, and where the rest is.
     const PointCloud samples = sample_mesh_uniform(truth, 400000, 7, true);

@@ -592,13 +592,20 @@ std::string to_json(const RigDescription& rig) {
   return j.dump(2);
 }
 
+const std::vector<std::string>& shipped_rig_names() {
+  static const std::vector<std::string> names = {"thesis", "square", "tiered"};
+  return names;
+}
+
 StatusOr<std::string> shipped_rig_path(const std::string& name) {
   const char* env = std::getenv("BODYSCAN_DATA_DIR");
   const std::filesystem::path root = env && *env ? env : BODYSCAN_DATA_DIR;
-  for (const char* known : {"thesis", "square"}) {
+  std::string list;
+  for (const std::string& known : shipped_rig_names()) {
     if (name == known) return (root / "hw" / "rigs" / (name + ".json")).string();
+    list += (list.empty() ? "" : ", ") + known;
   }
-  return not_found("no shipped rig named '" + name + "' (shipped: thesis, square; or give a description file)");
+  return not_found("no shipped rig named '" + name + "' (shipped: " + list + "; or give a description file)");
 }
 
 }  // namespace bodyscan::hw

@@ -170,9 +170,12 @@ StatusOr<RigDescription> load_rig_description(const std::string& path);
 std::string to_json(const RigDescription& rig);
 
 // The shipped layouts: "thesis" (thesis fig. 2.2: 3 cameras, 4 lasers, run one at a
-// time - docs/rig-description.md says why) and "square" (thesis fig. 6.1: 4 cameras,
-// 4 lasers). Their files live in hw/rigs/; this returns the path for a name, or an
-// error listing the names.
+// time - docs/rig-description.md says why), "square" (thesis fig. 6.1: 4 cameras,
+// 4 lasers) and "tiered" (the square's four columns, each with a camera and a laser
+// low and high, so the crotch, the shoulders' tops and the forearms are seen). Their
+// files live in hw/rigs/; this returns the path for a name, or an error listing the
+// names.
+const std::vector<std::string>& shipped_rig_names();
 StatusOr<std::string> shipped_rig_path(const std::string& name);
 
 }  // namespace bodyscan::hw

@@ -7,6 +7,7 @@
 
 #include "recon/io/ply.hpp"
 #include "recon/surface/reconstruct.hpp"
+#include "server/pipeline/scan_job.hpp"
 #include "storage/formats/draco_files.hpp"
 #include "storage/formats/mesh_files.hpp"
 
@@ -35,6 +36,9 @@ void usage(FILE* out) {
       "  --normal-k K           neighbours per PCA normal (default: from the noise)\n"
       "  --keep-fragments       keep small disconnected pieces (default: drop those under\n"
       "                         1% of the largest)\n"
+      "  --body                 a body scan: the scan job's settings (every hole filled\n"
+      "                         with a thin plate, the field kept down to 2 % of its\n"
+      "                         median weight); the other options still apply\n"
       "  --keep-holes           leave the field's zero set open where it is (default: trim\n"
       "                         flaps past the data and fill every hole; filled vertices\n"
       "                         get confidence 0 in the output)\n"
@@ -60,6 +64,10 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 int run_reconstruct(int argc, char** argv) {
   std::string in, out;
   ReconstructOptions opt;
+  // --body sets the base the other options change, wherever it stands.
+  bool body = false;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--body") opt = pipeline::body_surface_options(), body = true;
   bool ascii = false, quiet = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -109,6 +117,8 @@ int run_reconstruct(int argc, char** argv) {
       }
     } else if (a == "--keep-fragments") {
       opt.min_component_fraction = 0.0;
+    } else if (a == "--body") {
+      // applied before the loop
     } else if (a == "--keep-holes") {
       opt.close_holes = false;
     } else if (a == "--ascii") {
@@ -164,6 +174,9 @@ int run_reconstruct(int argc, char** argv) {
       return true;
     };
   }
+  // As the scan job does: a scan's own normals are the stripes', too noisy for the
+  // kernels; the surface estimates its own and turns them to the cameras.
+  if (body && opt.normal_source == NormalSource::kAuto && cloud.has_cameras()) opt.normal_source = NormalSource::kCameras;
   auto rec = reconstruct_surface(cloud, opt);
   if (!rec.ok()) {
     std::fprintf(stderr, "bodyscan reconstruct: %s: %s\n", in.c_str(), rec.status().message().c_str());

@@ -30,7 +30,7 @@ void usage(FILE* out) {
       "DIR/calibration.json, DIR/scan.json and DIR/raw/ (the raw record that\n"
       "`bodyscan reprocess` makes the scan again from).\n"
       "\n"
-      "  --rig RIG        sim (the thesis rig and the demo body), thesis, square,\n"
+      "  --rig RIG        sim (the thesis rig and the demo body), thesis, square, tiered,\n"
       "                   or a rig description file (JSON)\n"
       "  --body BODY.ply  the subject (mm, Y up; default: the rig description's)\n"
       "  --out DIR        output folder (created)\n"

@@ -30,7 +30,7 @@ void usage(FILE* out) {
       "  --address A        the address to listen on (default 0.0.0.0)\n"
       "  --port N           (default 8080; 0 picks a free port)\n"
       "  --data DIR         the archive and accounts (default ./bodyscan-data)\n"
-      "  --rig RIG          sim (default), thesis, square or a rig description file\n"
+      "  --rig RIG          sim (default), thesis, square, tiered or a rig description file\n"
       "  --body BODY.ply    the simulated subject (mm, Y up)\n"
       "  --every N          scans use every Nth laser step unless asked otherwise\n"
       "                     (default 1)\n"

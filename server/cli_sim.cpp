@@ -26,7 +26,7 @@ void usage(FILE* out) {
       "with the lasers off, then every step with the group's lasers on), as PNG\n"
       "images in DIR with DIR/index.json listing them.\n"
       "\n"
-      "  --rig RIG        thesis, square, or a rig description file (JSON)\n"
+      "  --rig RIG        thesis, square, tiered, or a rig description file (JSON)\n"
       "  --body BODY.ply  the subject (default: the rig description's)\n"
       "  --out DIR        output folder (created)\n"
       "  --every N        render every Nth laser step only (default 1)\n"

@@ -100,6 +100,34 @@ TEST_F(ReconstructCli, QuietAsciiAndOptions) {
   EXPECT_TRUE(analyze_topology(*mesh).closed());
 }
 
+TEST_F(ReconstructCli, BodyTakesTheScanJobsSettings) {
+  // A sphere with its top quarter unseen (y > 0.5: 25 % of the area). The library's
+  // default takes an opening that large for the surface's real edge and leaves it;
+  // --body, like the scan job, fills every hole.
+  PointCloud full = fibonacci_sphere(4000, 100.0);
+  PointCloud cloud;
+  for (size_t i = 0; i < full.size(); ++i) {
+    if (full.positions[i].y() > 50.f) continue;
+    cloud.positions.push_back(full.positions[i]);
+    if (full.has_normals()) cloud.normals.push_back(full.normals[i]);
+  }
+  ASSERT_TRUE(write_ply(path("cap.ply"), cloud).ok());
+  const CliResult plain = bodyscan("reconstruct " + quote(path("cap.ply")) + " -o " + quote(path("plain.ply")), dir_);
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("surface     open"), std::string::npos) << plain.out;
+  const CliResult body =
+      bodyscan("reconstruct " + quote(path("cap.ply")) + " --body -o " + quote(path("body.ply")), dir_);
+  ASSERT_EQ(body.exit_code, 0) << body.err;
+  EXPECT_NE(body.out.find("surface     closed"), std::string::npos) << body.out;
+  auto mesh = read_ply_mesh(path("body.ply"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_TRUE(analyze_topology(*mesh).closed());
+  // The thin plate continues the sphere over the cap: its top within 10 % of the radius.
+  float top = -1e9f;
+  for (const Vec3f& v : mesh->vertices) top = std::max(top, v.y());
+  EXPECT_NEAR(top, 100.f, 10.f);
+}
+
 TEST_F(ReconstructCli, MissingInputNamesTheFile) {
   const std::string missing = path("no-such-cloud.ply");
   const CliResult r = bodyscan("reconstruct " + quote(missing) + " -o " + quote(path("out.ply")), dir_);

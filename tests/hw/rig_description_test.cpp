@@ -39,11 +39,23 @@ TEST(RigDescription, ShippedLayoutsLoad) {
   const RigDescription square = load_shipped("square");
   EXPECT_EQ(square.cameras.size(), 4u);
   EXPECT_EQ(square.frame.width, square.frame.depth);
+  // The tiered layout: the square's columns with a low and a high tier, each camera
+  // looking at the middle of the frame's lights from its height, one laser at a time.
+  const RigDescription tiered = load_shipped("tiered");
+  ASSERT_EQ(tiered.cameras.size(), 8u);
+  ASSERT_EQ(tiered.lasers.size(), 8u);
+  EXPECT_EQ(tiered.laser_groups.size(), 8u);
+  for (const CameraDescription& c : tiered.cameras) {
+    EXPECT_TRUE(c.position.y() < 600 || c.position.y() > 1700) << c.id;
+    EXPECT_NE(c.id.find(c.position.y() < 600 ? "-low" : "-high"), std::string::npos) << c.id;
+  }
+  EXPECT_EQ(tiered.frame.width, square.frame.width);
+  EXPECT_EQ(tiered.processing.max_view_deg, square.processing.max_view_deg);
   EXPECT_FALSE(shipped_rig_path("hexagon").ok());
 }
 
 TEST(RigDescription, EveryShippedCameraSeesTheEightLightsOfItsSide) {
-  for (const char* name : {"thesis", "square"}) {
+  for (const std::string& name : shipped_rig_names()) {
     const RigDescription rig = load_shipped(name);
     for (const CameraDescription& c : rig.cameras) {
       const std::vector<Vec3d> lights = visible_lights(rig.frame, c.position.z() > 0);
@@ -67,7 +79,7 @@ TEST(RigDescription, EveryShippedLaserSweepCrossesThePolesOverMostOfItsSteps) {
   // fit (the square rig's side lasers cross both poles on 47 % of their steps; the fit
   // extrapolates within 0.3 mm, tests/recon/scan/laser_sweep_test.cpp). The middle
   // and at least 40 % of the steps must cross.
-  for (const char* name : {"thesis", "square"}) {
+  for (const std::string& name : shipped_rig_names()) {
     const RigDescription rig = load_shipped(name);
     const double half_w = 0.5 * rig.frame.width - rig.frame.tube, half_d = 0.5 * rig.frame.depth;
     for (const LaserDescription& l : rig.lasers) {

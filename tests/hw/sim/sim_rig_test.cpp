@@ -121,7 +121,7 @@ TEST(SimulatedRig, ShippedRigsTakeAStandingAdultOfTwoMetres) {
   float lo = 1e9f, hi = -1e9f;
   for (const Vec3f& v : body->vertices) lo = std::min(lo, v.y()), hi = std::max(hi, v.y());
   for (Vec3f& v : body->vertices) v *= 2000.f / (hi - lo);
-  for (const char* name : {"thesis", "square"}) {
+  for (const std::string& name : shipped_rig_names()) {
     auto desc = load_rig_description(*shipped_rig_path(name));
     ASSERT_TRUE(desc.ok());
     auto rig = SimulatedRig::create(*desc, *body);
