@@ -6,7 +6,7 @@
 // (calibration needs all eight unobstructed; a half-hidden light moves its centroid):
 // the smallest clearance, in mm around the light's centre, that every camera has.
 //
-//   rig_coverage [--rig thesis|square|FILE]... [--body BODY.ply] [--min-angle DEG]
+//   rig_coverage [--rig thesis|square|tiered|FILE]... [--body BODY.ply] [--min-angle DEG]
 //                [--max-view DEG] [--cross]
 //
 // --max-view counts a camera only within DEG of the surface's normal (default 90:
@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
     else if (a == "--cross") cross = true;
     else return std::fprintf(stderr, "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG] [--max-view DEG] [--cross]\n"), 2;
   }
-  if (rigs.empty()) rigs = {"thesis", "square"};
+  if (rigs.empty()) rigs = hw::shipped_rig_names();  // all of them
   for (const std::string& name : rigs) {
     auto sim = pipeline::open_simulated_rig(name, body);
     if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
