@@ -46,11 +46,10 @@ uint64_t checksum(const TriangleMesh& mesh) {
 // The scan's surface before fill_holes: reconstruct_surface with the body options,
 // its flaps trimmed and its holes left open.
 StatusOr<TriangleMesh> open_surface(const PointCloud& cloud, float min_relative_weight) {
-  ReconstructOptions ro = pipeline::body_surface_options();
+  ReconstructOptions ro = pipeline::with_scan_normals(pipeline::body_surface_options(), cloud);
   if (min_relative_weight >= 0.f) ro.min_relative_weight = min_relative_weight;
   ro.leave_trimmed_holes_open = true;
   ro.min_component_fraction = 0.0;  // after the filling, as in the pipeline
-  if (cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
   ASSIGN_OR_RETURN(ReconstructResult r, reconstruct_surface(cloud, ro));
   std::printf("surfaced %zu points at %.2f voxels in %.1f s; %zu flap triangles trimmed\n", cloud.size(),
               r.stats.voxel_size, r.stats.total_seconds(), r.stats.flap_triangles_trimmed);

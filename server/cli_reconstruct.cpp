@@ -174,9 +174,7 @@ int run_reconstruct(int argc, char** argv) {
       return true;
     };
   }
-  // As the scan job does: a scan's own normals are the stripes', too noisy for the
-  // kernels; the surface estimates its own and turns them to the cameras.
-  if (body && opt.normal_source == NormalSource::kAuto && cloud.has_cameras()) opt.normal_source = NormalSource::kCameras;
+  if (body) opt = pipeline::with_scan_normals(opt, cloud);  // as the scan job does
   auto rec = reconstruct_surface(cloud, opt);
   if (!rec.ok()) {
     std::fprintf(stderr, "bodyscan reconstruct: %s: %s\n", in.c_str(), rec.status().message().c_str());

@@ -27,11 +27,8 @@ Status surface_and_measure(const ScanJobOptions& options, ScanJobResult* out) {
                                                                               out->scan.first_plane_error + ")"));
   }
   if (options.reconstruct) {
-    ReconstructOptions ro = options.surface;
+    ReconstructOptions ro = with_scan_normals(options.surface, out->cloud);
     if (!ro.progress) ro.progress = options.progress;
-    // The view-angle step leaves quick normals (fixed k) in the cloud for viewers;
-    // the surface estimates its own, sized to the noise, and turns them to the cameras.
-    if (ro.normal_source == NormalSource::kAuto && out->cloud.has_cameras()) ro.normal_source = NormalSource::kCameras;
     StatusOr<ReconstructResult> r = reconstruct_surface(out->cloud, ro);
     if (r.ok()) {
       out->mesh = std::move(r->mesh);

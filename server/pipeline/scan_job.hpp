@@ -40,6 +40,14 @@ inline ReconstructOptions body_surface_options() {
   return o;
 }
 
+// The options for surfacing a scan's cloud. The view-angle step leaves quick normals
+// (fixed k) in the cloud for viewers; unless told otherwise, the surface estimates its
+// own, sized to the noise, and turns them to the cameras that saw each point.
+inline ReconstructOptions with_scan_normals(ReconstructOptions o, const PointCloud& cloud) {
+  if (o.normal_source == NormalSource::kAuto && cloud.has_cameras()) o.normal_source = NormalSource::kCameras;
+  return o;
+}
+
 struct ScanJobOptions {
   int every = 1;  // scan every Nth laser step
   CalibrateOptions calibrate;
