@@ -236,19 +236,30 @@ class Finder {
     return not_found("measure: no crotch found between 25 % and 65 % of the height");
   }
 
+  // The arm's loop on side s in a cut: at least 5 % of the height round (a wrist is
+  // over 9 %). A scrap of surface a coarse scan leaves beside the hip is no arm.
+  const Ring* arm_ring(const std::vector<Ring>& r, int s) const { return side_ring(r, xc_, s, true, 0.05 * h_); }
+
   Status find_armpit(int s) {
-    auto arm = [&](double y) { return side_ring(rings(y), xc_, s, true) != nullptr; };
+    auto arm = [&](double y) { return arm_ring(rings(y), s) != nullptr; };
+    // Upwards from just above the crotch, the first run of cuts with the arm apart
+    // from the body that is at least 4 % of the height long (a scrap that comes and
+    // goes is not); the armpit is where that run ends.
     const double step = 5;
-    double y = crotch_y_ + 0.03 * h_;
-    while (y < at(0.9) && !arm(y)) y += step;
-    if (y >= at(0.9)) return not_found("measure: no " + side(s) + " arm apart from the body; hold the arms away from the sides");
-    double last = y;
-    for (y += step; y < at(0.95) && arm(y); y += step) last = y;
+    double y = crotch_y_ + 0.03 * h_, first = y, last = y;
+    for (;; y += step) {
+      while (y < at(0.9) && !arm(y)) y += step;
+      if (y >= at(0.9))
+        return not_found("measure: no " + side(s) + " arm apart from the body; hold the arms away from the sides");
+      first = last = y;
+      for (y += step; y < at(0.95) && arm(y); y += step) last = y;
+      if (last - first >= 0.04 * h_) break;
+    }
     const double armpit = bisect(y, last, arm);
     armpit_y_[s > 0 ? 0 : 1] = armpit;
     // The armpit: halfway across the last gap between arm and torso.
     const std::vector<Ring>& r = rings(armpit - 0.5);
-    const Ring* a = side_ring(r, xc_, s, true);
+    const Ring* a = arm_ring(r, s);
     const Ring* t = midline(r, xc_);
     Eigen::Vector3d p(xc_ + s * 0.1 * h_, armpit, zc_);
     if (a && t) {

@@ -175,6 +175,33 @@ TEST(BodyMeasurements, AStrayFoldBesideTheFlankDoesNotEndTheArm) {
     EXPECT_NEAR(b->find(name)->value_mm, clean->find(name)->value_mm, 0.5) << name;
 }
 
+TEST(BodyMeasurements, AScrapBesideTheHipIsNoArm) {
+  // A coarse scan (every 6th laser step) can leave a scrap of surface beside the hip,
+  // a small loop of its own in a few cuts above the crotch. The armpit search once
+  // took it for the arm and put the armpit at the hip; the bust, under-bust and
+  // waist then followed it down, and the waist girth came out 23 cm large.
+  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
+  ASSERT_TRUE(mesh.ok());
+  auto clean = measure_body(*mesh);
+  ASSERT_TRUE(clean.ok());
+  // Below the fingertips (which hang 90 mm above the crotch).
+  const double y = clean->landmark("crotch")->position.y() + 55;
+  const BodySlicer slicer(*mesh, 0, 1800);
+  const std::vector<Ring> cut = slicer.rings(y);
+  const Ring* torso = nullptr;
+  for (const Ring& r : cut)
+    if (r.spans_x(0)) torso = &r;
+  ASSERT_TRUE(torso);
+  const Eigen::Vector2d at(torso->x_max + 9, torso->centroid.z());
+  // 8 mm round (a tape of 50 mm) and 30 mm tall, 1 mm clear of the flank.
+  const TriangleMesh with_scrap = testing::merged(*mesh, testing::prism(testing::circle(8, at, 60), at, y - 15, y + 15));
+  auto b = measure_body(with_scrap);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  EXPECT_NEAR(b->landmark("armpit_left")->position.y(), clean->landmark("armpit_left")->position.y(), 0.5);
+  for (const char* name : {"bust_girth", "waist_girth", "upper_arm_girth_left", "wrist_girth_left"})
+    EXPECT_NEAR(b->find(name)->value_mm, clean->find(name)->value_mm, 0.5) << name;
+}
+
 TEST(BodyMeasurements, ALegCutInPiecesIsNoLevelToMeasureAt) {
   // A scan can leave a slit behind the ankle that cuts the heel off in the
   // horizontal cuts there; the piece nearer the midline was taken for the leg, and

@@ -2,7 +2,7 @@
 // folder (simulated rig, a free port), Debian's Chromium driven by playwright-core
 // (no browser download), screenshots kept as artefacts, and ground truth from the
 // demo body the simulated rig scans.
-import { spawn } from 'node:child_process';
+import { execFileSync, spawn } from 'node:child_process';
 import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
@@ -30,8 +30,19 @@ export const ARTEFACTS = process.env.BODYSCAN_TEST_ARTIFACTS || join(REPO, 'web/
 mkdirSync(ARTEFACTS, { recursive: true });
 
 // The demo body the simulated rig scans (mm, Y up, soles on Y=0, facing +Z).
+const DEMO_BODY = () => join(REPO, 'hw/sim/bodies/male_average.ply');
+
+// A measurement of the automatic set (mm) as `bodyscan measure --auto` takes it on
+// the true demo body.
+export function demoBodyMeasurement(name) {
+  const out = JSON.parse(execFileSync(BIN(), ['measure', DEMO_BODY(), '--auto'], { encoding: 'utf8' }));
+  const m = out.measurements.find((x) => x.name === name);
+  if (!m) throw new Error(`the demo body has no ${name}`);
+  return m.value_mm;
+}
+
 export function demoBodyBounds() {
-  const bytes = readFileSync(join(REPO, 'hw/sim/bodies/male_average.ply'));
+  const bytes = readFileSync(DEMO_BODY());
   const end = bytes.indexOf('end_header\n') + 'end_header\n'.length;
   const header = bytes.subarray(0, end).toString('latin1');
   if (!/format binary_little_endian/.test(header) || !/element vertex (\d+)\nproperty float x\nproperty float y\nproperty float z\n/.test(header))
@@ -82,7 +93,9 @@ export async function startServer({ every = 6, extraArgs = [], seed = null } = {
       const exited = new Promise((r) => proc.on('exit', (code) => r(code)));
       proc.kill('SIGTERM');
       const code = await exited;
-      rmSync(data, { recursive: true, force: true });
+      // BODYSCAN_E2E_KEEP=1 keeps the data folder to look into after a failure.
+      if (process.env.BODYSCAN_E2E_KEEP) console.log(`# kept the server's data folder: ${data}`);
+      else rmSync(data, { recursive: true, force: true });
       return code;
     },
   };
