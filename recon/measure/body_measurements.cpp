@@ -6,8 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <future>
 #include <limits>
 #include <unordered_map>
+
+#include <tbb/parallel_for.h>
 
 #include "recon/measure/body_slicer.hpp"
 #include "recon/measure/girth.hpp"
@@ -162,8 +165,10 @@ class Finder {
     out_->floor_y = floor_;
     h_ = hi - floor_;
     if (!(h_ > 500)) return invalid_argument("measure: the body is under 500 mm tall; is it a standing body in mm, Y up?");
+    // The surface-path structures (a tenth of the work) are built beside the
+    // landmark search, which needs them only for the lengths at the end.
+    paths_ready_ = std::async(std::launch::async, [this] { paths_.emplace(mesh_); });
     slicer_.emplace(mesh_, lo, hi, opt_.step_mm);
-    paths_.emplace(mesh_);
     RETURN_IF_ERROR(find_axis());
     RETURN_IF_ERROR(find_crotch());
     for (int s : {1, -1}) RETURN_IF_ERROR(find_armpit(s));
@@ -190,6 +195,22 @@ class Finder {
     auto it = ring_cache_.find(key);
     if (it == ring_cache_.end()) it = ring_cache_.emplace(key, slicer_->rings(static_cast<double>(key) / 64)).first;
     return it->second;
+  }
+  // The cuts a walk from y0 towards y1 in steps of `step` (either sign) will ask for,
+  // made ahead on every core: the searches and profiles walk hundreds of levels and
+  // each cut stands alone. (The same levels as the walk's own loop, to the bit.)
+  void prefetch(double y0, double y1, double step) const {
+    std::vector<int64_t> keys;
+    for (double y = y0; step > 0 ? y <= y1 : y >= y1; y += step) {
+      const auto key = static_cast<int64_t>(std::llround(y * 64));
+      if (!ring_cache_.count(key)) keys.push_back(key);
+    }
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    std::vector<std::vector<Ring>> made(keys.size());
+    tbb::parallel_for(size_t{0}, keys.size(),
+                      [&](size_t i) { made[i] = slicer_->rings(static_cast<double>(keys[i]) / 64); });
+    for (size_t i = 0; i < keys.size(); ++i) ring_cache_.emplace(keys[i], std::move(made[i]));
   }
 
   void landmark(const std::string& name, const Eigen::Vector3d& p) {
@@ -222,6 +243,7 @@ class Finder {
     const double step = 5;
     double prev = at(0.25);
     if (merged(prev)) return not_found("measure: the legs are not apart at a quarter of the height; stand with feet apart");
+    prefetch(prev + step, at(0.55), step);
     for (double y = prev + step; y <= at(0.65); y += step) {
       if (merged(y)) {
         crotch_y_ = bisect(prev, y, merged);
@@ -247,6 +269,7 @@ class Finder {
     // goes is not); the armpit is where that run ends.
     const double step = 5;
     double y = crotch_y_ + 0.03 * h_, first = y, last = y;
+    prefetch(y, at(0.8), step);
     for (;; y += step) {
       while (y < at(0.9) && !arm(y)) y += step;
       if (y >= at(0.9))
@@ -295,6 +318,7 @@ class Finder {
     const double ya = std::max(armpit_y_[0], armpit_y_[1]);
     std::vector<double> ys, gs;
     std::vector<Eigen::Vector3d> cs;
+    prefetch(ya + 0.04 * h_, floor_ + h_ - 0.09 * h_, 2);
     for (double y = ya + 0.04 * h_; y <= floor_ + h_ - 0.09 * h_; y += 2) {
       const std::vector<Ring>& r = rings(y);
       if (const Ring* m = midline(r, xc_)) ys.push_back(y), gs.push_back(m->girth), cs.push_back(m->centroid);
@@ -311,6 +335,7 @@ class Finder {
     std::vector<Eigen::Vector3d> extreme;
     double w0 = -1;
     const double ya = std::max(armpit_y_[0], armpit_y_[1]);
+    prefetch(neck_y_, ya, -2);
     for (double y = neck_y_; y > ya; y -= 2) {
       const std::vector<Ring>& r = rings(y);
       const Ring* m = midline(r, xc_);
@@ -370,6 +395,7 @@ class Finder {
     if (const Ring* m = midline(rr, xc_)) m->crossing_z(xc_, &f, &b);
     landmark("back_neck_point", {xc_, y_snp, b});
     std::vector<Eigen::Vector2d> curve;  // (y, front z), top down
+    prefetch(neck_y_, y_snp - 0.08 * h_, -2);
     for (double y = neck_y_; y >= y_snp - 0.08 * h_; y -= 2) {
       const std::vector<Ring>& r = rings(y);
       double fz = 0, bz = 0;
@@ -391,6 +417,7 @@ class Finder {
     auto profile = [&](double y0, double y1, const std::function<double(const Ring&)>& f, bool largest, double tol,
                        double fallback) {
       std::vector<double> ys, vs;
+      prefetch(y0, y1, 2);
       for (double y = y0; y <= y1; y += 2) {
         const std::vector<Ring>& r = rings(y);
         if (const Ring* m = midline(r, xc_)) ys.push_back(y), vs.push_back(f(*m));
@@ -416,6 +443,7 @@ class Finder {
       const double xb = 0.5 * (lm("bust_point_left").x() + lm("bust_point_right").x());
       const double xs = 0.5 * (lm("bust_point_left").x() - lm("bust_point_right").x());
       std::vector<Eigen::Vector2d> curve;
+      prefetch(bust_y_, bust_y_ - 0.1 * h_, -2);
       for (double y = bust_y_; y >= bust_y_ - 0.1 * h_; y -= 2) {
         const std::vector<Ring>& r = rings(y);
         double f = 0, b = 0, f2 = 0, b2 = 0;
@@ -555,6 +583,7 @@ class Finder {
           "horizontal, at the level of the buttocks' greatest backward projection");
     {
       double best = -kInf, yb = hip_y_;
+      prefetch(crotch_y_ + 0.01 * h_, waist_y_, 2);
       for (double y = crotch_y_ + 0.01 * h_; y <= waist_y_; y += 2) {
         const std::vector<Ring>& r = rings(y);
         if (const Ring* m = midline(r, xc_); m && m->girth > best) best = m->girth, yb = y;
@@ -582,6 +611,7 @@ class Finder {
     auto extreme = [&](double y0, double y1, bool largest, double* y_at) {
       std::vector<double> ys, gs;
       std::vector<Eigen::Vector3d> cs;
+      prefetch(y0, y1, 2);
       for (double y = y0; y <= y1; y += 2) {
         const std::vector<Ring>& r = rings(y);
         if (const Ring* l = leg(r, s)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
@@ -600,6 +630,7 @@ class Finder {
     // calf: the largest cut below it.
     std::vector<double> ys, gs;
     std::vector<Eigen::Vector3d> cs;
+    prefetch(at(0.18), at(0.36), 2);
     for (double y = at(0.18); y <= at(0.36); y += 2) {
       const std::vector<Ring>& r = rings(y);
       if (const Ring* l = leg(r, s)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
@@ -650,6 +681,7 @@ class Finder {
     const double ya = armpit_y_[s > 0 ? 0 : 1];
     std::vector<Eigen::Vector3d> c;  // centroids, armpit downwards
     std::vector<double> g;
+    prefetch(ya - 3, crotch_y_ - 0.05 * h_, -3);  // where a hanging arm ends
     for (double y = ya - 3; y > floor_; y -= 3) {
       const std::vector<Ring>& r = rings(y);
       const Ring* a = side_ring(r, xc_, s, true);
@@ -774,6 +806,7 @@ class Finder {
     BodyMeasurement m;
     m.name = name, m.label = label, m.iso_clause = clause, m.kind = "surface_length";
     for (size_t i = 0; i + 1 < via.size(); ++i) {
+      if (paths_ready_.valid()) paths_ready_.get();
       StatusOr<SurfacePath> p = paths_->shortest(via[i], via[i + 1]);
       if (!p.ok()) {
         skip(name, p.status().message());
@@ -809,6 +842,9 @@ class Finder {
   BodyMeasurements* out_;
   std::optional<BodySlicer> slicer_;
   std::optional<SurfacePaths> paths_;
+  // paths_ is being made: waited for before its first use, or (this future is
+  // destroyed before paths_, and an async future waits) at the latest on leaving.
+  std::future<void> paths_ready_;
   mutable std::unordered_map<int64_t, std::vector<Ring>> ring_cache_;
   Eigen::Vector3d top_ = Eigen::Vector3d::Zero(), neck_c_ = Eigen::Vector3d::Zero();
   double floor_ = 0, h_ = 0, xc_ = 0, zc_ = 0;
