@@ -8,6 +8,7 @@
 #include <functional>
 #include <future>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 
 #include <tbb/parallel_for.h>
@@ -129,6 +130,31 @@ size_t settle(const std::vector<double>& v, size_t k, double tol) {
   while (a > 0 && std::abs(v[a - 1] - v[k]) <= tol) --a;
   while (b + 1 < v.size() && std::abs(v[b + 1] - v[k]) <= tol) ++b;
   return (a + b) / 2;
+}
+
+// The vertex of the parabola least-squares fitted to the samples (x[i], v[i]) within
+// `half` of x[k]: where a shallow, noisy profile bottoms out (`lowest`) or tops out.
+// Nothing when fewer than 7 samples lie there, the fit opens the other way (or is
+// flat), or its vertex falls outside the window.
+std::optional<double> parabola_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k,
+                                      double half, bool lowest) {
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double t = x[i] - x[k];
+    if (std::abs(t) > half) continue;
+    const Eigen::Vector3d row(t * t, t, 1);
+    ata += row * row.transpose();
+    atb += row * v[i];
+    ++n;
+  }
+  if (n < 7) return std::nullopt;
+  const Eigen::Vector3d c = ata.ldlt().solve(atb);
+  if (!((lowest ? c(0) : -c(0)) > 1e-9)) return std::nullopt;
+  const double t = -c(1) / (2 * c(0));
+  if (!(std::abs(t) <= half)) return std::nullopt;
+  return x[k] + t;
 }
 
 size_t arg_extreme(const std::vector<double>& v, bool largest) {
@@ -648,9 +674,18 @@ class Finder {
       if (minimum && i > 0 && i + 1 < gs.size() && gs[i] < deepest) deepest = gs[i], kk = i;
     }
     if (!(deepest < kInf)) kk = arg_extreme(gs, false);
-    kk = settle(gs, kk, 1.0);
-    const double ky = ys[kk];
-    const Eigen::Vector3d kc = cs[kk];
+    // The knee's profile is shallow: its lowest sample wanders with the scan's noise
+    // (8-10 mm between two scans of one body). The vertex of a parabola fitted over
+    // 2 % of the height either side does not.
+    double ky = ys[kk];
+    Eigen::Vector3d kc = cs[kk];
+    if (const std::optional<double> v = parabola_vertex(ys, gs, kk, 0.02 * h_, true)) {
+      ky = *v;
+      size_t near = kk;
+      for (size_t i = 0; i < ys.size(); ++i)
+        if (std::abs(ys[i] - ky) < std::abs(ys[near] - ky)) near = i;
+      kc = cs[near];
+    }
     double cy = at(0.2);
     const Eigen::Vector3d cc = extreme(at(0.10), ky, true, &cy);
     {
