@@ -50,7 +50,7 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
   }
   std::sort(by_edge.begin(), by_edge.end());
   // The segment across each end of each segment, found once (a search per step of
-  // the walk was a fifth of the automatic measurements' time): across[2 s + k] for
+  // the walk was a sixth of the automatic measurements' time): across[2 s + k] for
   // segments[s]'s edge a (k = 0) or b (k = 1). kNone on the mesh's border; kMany on
   // an edge more than two segments cross (non-manifold), where the walk takes any
   // unused one.
