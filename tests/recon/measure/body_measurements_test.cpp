@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
 #include <random>
 
 #include "recon/io/ply.hpp"
@@ -126,11 +127,27 @@ TEST_P(BodyMeasurementsTest, GirthsAgreeWithTheManifestAndAreSymmetric) {
 
 INSTANTIATE_TEST_SUITE_P(ShippedBodies, BodyMeasurementsTest, ::testing::ValuesIn(kBodies));
 
+// The demo body, read and measured once, for the tests that change it and compare.
+struct MaleAverage {
+  TriangleMesh mesh;
+  BodyMeasurements measured;
+};
+const MaleAverage* male_average() {
+  static const std::optional<MaleAverage> body = []() -> std::optional<MaleAverage> {
+    auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
+    if (!mesh.ok()) return std::nullopt;
+    auto measured = measure_body(*mesh);
+    if (!measured.ok()) return std::nullopt;
+    return MaleAverage{std::move(*mesh), std::move(*measured)};
+  }();
+  return body ? &*body : nullptr;
+}
+
 TEST(BodyMeasurements, DoNotDependOnWhereTheBodyStands) {
-  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
-  ASSERT_TRUE(mesh.ok());
-  auto a = measure_body(*mesh);
-  ASSERT_TRUE(a.ok());
+  const MaleAverage* body = male_average();
+  ASSERT_TRUE(body);
+  const TriangleMesh* mesh = &body->mesh;
+  const BodyMeasurements* a = &body->measured;
   TriangleMesh moved = *mesh;
   for (Vec3f& v : moved.vertices) v += Vec3f(83.f, -20.f, -41.f);
   BodyMeasureOptions o;
@@ -152,10 +169,10 @@ TEST(BodyMeasurements, AStrayFoldBesideTheFlankDoesNotEndTheArm) {
   // Scans sometimes keep a small fold of surface against the flank, below the
   // armpit, a loop of its own in the cuts there. The arm's track must run past it to
   // the hand: it once stopped there and put the wrist halfway up the arm.
-  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
-  ASSERT_TRUE(mesh.ok());
-  auto clean = measure_body(*mesh);
-  ASSERT_TRUE(clean.ok());
+  const MaleAverage* body = male_average();
+  ASSERT_TRUE(body);
+  const TriangleMesh* mesh = &body->mesh;
+  const BodyMeasurements* clean = &body->measured;
   const Eigen::Vector3d armpit = clean->landmark("armpit_left")->position;
   const double y = armpit.y() - 150;
   const BodySlicer slicer(*mesh, 0, 1800);
@@ -181,10 +198,10 @@ TEST(BodyMeasurements, AScrapBesideTheHipIsNoArm) {
   // a small loop of its own in a few cuts above the crotch. The armpit search once
   // took it for the arm and put the armpit at the hip; the bust, under-bust and
   // waist then followed it down, and the waist girth came out 23 cm large.
-  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
-  ASSERT_TRUE(mesh.ok());
-  auto clean = measure_body(*mesh);
-  ASSERT_TRUE(clean.ok());
+  const MaleAverage* body = male_average();
+  ASSERT_TRUE(body);
+  const TriangleMesh* mesh = &body->mesh;
+  const BodyMeasurements* clean = &body->measured;
   // Below the fingertips (which hang 90 mm above the crotch).
   const double y = clean->landmark("crotch")->position.y() + 55;
   const BodySlicer slicer(*mesh, 0, 1800);
@@ -208,10 +225,10 @@ TEST(BodyMeasurements, TheKneeStaysPutUnderTheScansNoise) {
   // shallow: its lowest sample moved 8-10 mm between two scans of one body, taking
   // the knee height and the mid-thigh girth with it. Skin noise of +-0.5 mm along the
   // normals, two seeds: the knee stays within 2 mm of the clean body's.
-  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
-  ASSERT_TRUE(mesh.ok());
-  auto clean = measure_body(*mesh);
-  ASSERT_TRUE(clean.ok());
+  const MaleAverage* body = male_average();
+  ASSERT_TRUE(body);
+  const TriangleMesh* mesh = &body->mesh;
+  const BodyMeasurements* clean = &body->measured;
   const std::vector<Vec3f> normals = compute_vertex_normals(*mesh);
   for (uint32_t seed : {1u, 2u}) {
     TriangleMesh noisy = *mesh;
@@ -232,10 +249,10 @@ TEST(BodyMeasurements, ALegCutInPiecesIsNoLevelToMeasureAt) {
   // horizontal cuts there; the piece nearer the midline was taken for the leg, and
   // the minimum leg girth came out 33 mm small (male_muscular, left). A loop beside
   // the ankle, inside it, stands for that piece.
-  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
-  ASSERT_TRUE(mesh.ok());
-  auto clean = measure_body(*mesh);
-  ASSERT_TRUE(clean.ok());
+  const MaleAverage* body = male_average();
+  ASSERT_TRUE(body);
+  const TriangleMesh* mesh = &body->mesh;
+  const BodyMeasurements* clean = &body->measured;
   const double y = 85;  // within the minimum leg girth's window, 4 % of the height up
   const BodySlicer slicer(*mesh, 0, 1800);
   const Ring* ankle = nullptr;
