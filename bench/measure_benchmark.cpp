@@ -7,7 +7,8 @@
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR]
 //                     [--seed N] [--min-weight W]
 //
-// --save writes each scan's surface and the posed true body as PLY into DIR.
+// --save writes each scan's surface and the posed true body as PLY into DIR (with
+// --repeat, the second scan's surface too).
 // --min-weight sets the surface's ReconstructOptions::min_relative_weight.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
@@ -104,8 +105,8 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   auto a = scan(rig, body, g_seed, 0, every);
   if (!a.ok()) return std::fprintf(stderr, "scan: %s\n", a.status().message().c_str()), 1;
   std::printf("scan job %.0f s, mesh %zu triangles\n", secs(t0), a->mesh.triangles.size());
+  const std::string stem = g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
   if (!g_save.empty()) {
-    const std::string stem = g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
     const Status w1 = write_ply(stem + "-scan.ply", a->mesh), w2 = write_ply(stem + "-truth.ply", a->truth);
     if (!w1.ok() || !w2.ok()) std::fprintf(stderr, "--save: %s\n", (w1.ok() ? w2 : w1).message().c_str());
   }
@@ -200,6 +201,9 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   if (repeat) {
     auto b = scan(rig, body, g_seed + 1, sway, every);
     if (!b.ok()) return std::fprintf(stderr, "second scan: %s\n", b.status().message().c_str()), 1;
+    if (!g_save.empty()) {
+      if (Status w = write_ply(stem + "-scan2.ply", b->mesh); !w.ok()) std::fprintf(stderr, "--save: %s\n", w.message().c_str());
+    }
     double worst = 0;
     std::string worst_name;
     std::vector<double> diffs;
