@@ -579,7 +579,19 @@ SurfacePaths::~SurfacePaths() = default;
 
 StatusOr<SurfacePath> SurfacePaths::shortest(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
                                              const SurfacePathOptions& options) const {
-  return impl_->find(from, to, options);
+  // A body has more than one locally shortest path between two points (over a
+  // muscle's ridge or round it), and which one the strip settles into depends on
+  // the Dijkstra strip it starts from. The search from each end starts from a
+  // different strip: the shorter of the two. (Acromion to back neck point on a
+  // true body: 253.6 mm one way, 240.2 the other.)
+  ASSIGN_OR_RETURN(SurfacePath there, impl_->find(from, to, options));
+  StatusOr<SurfacePath> back = impl_->find(to, from, options);
+  if (!back.ok() || back->path_mm >= there.path_mm) return there;
+  SurfacePath out = *std::move(back);
+  std::reverse(out.path.begin(), out.path.end());
+  std::swap(out.from, out.to);
+  out.reroutes += there.reroutes;
+  return out;
 }
 
 StatusOr<SurfacePath> mesh_surface_path(const TriangleMesh& mesh, const Eigen::Vector3d& from,

@@ -13,7 +13,10 @@
 //     (the angle there, going round the other way, is under 180 degrees), the strip
 //     is re-routed through that vertex's other triangles, and step 3 repeats until
 //     no vertex is left to re-route. What remains is a locally shortest geodesic:
-//     it passes through a vertex only where the surface is saddle-shaped.
+//     it passes through a vertex only where the surface is saddle-shaped;
+//  5. a body has more than one of those between two points (over a muscle's ridge
+//     or round it), and steps 2-4 settle into the one nearest the strip they start
+//     from: they run from each end, and the shorter path is kept.
 #pragma once
 
 #include <Eigen/Core>
@@ -34,7 +37,7 @@ struct SurfacePath {
   std::vector<Eigen::Vector3d> path;  // on the surface, from the first end to the second
   Eigen::Vector3d from = Eigen::Vector3d::Zero(), to = Eigen::Vector3d::Zero();  // the ends as snapped
   float min_confidence = 1;           // lowest mesh confidence along the path (1: all measured)
-  size_t reroutes = 0;                // vertex re-routings step 4 made
+  size_t reroutes = 0;                // vertex re-routings step 4 made (both searches)
 };
 
 struct SurfacePathOptions {

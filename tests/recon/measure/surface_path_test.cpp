@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "recon/io/ply.hpp"
 #include "tests/shapes.hpp"
 #include "tests/test_meshes.hpp"
 
@@ -190,6 +191,25 @@ TEST(SurfacePath, WithinOneTriangleItIsTheChord) {
   ASSERT_TRUE(p.ok());
   EXPECT_NEAR(p->path_mm, std::hypot(30.0, 20.0), 1e-5);
   EXPECT_EQ(p->path.size(), 2u);
+}
+
+TEST(SurfacePath, OfTwoLocallyShortestPathsTheShorter) {
+  // The upper back of a true body holds two locally shortest paths between the right
+  // acromion and the back neck point: over the trapezius's ridge and round it. The
+  // search from the acromion settled into the longer (253.9 mm), the one from the neck
+  // into the shorter: both ways now give the shorter.
+  auto back = read_ply_mesh(BODYSCAN_SOURCE_DIR "/tests/data/male_heavy_upper_back.ply");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  const Eigen::Vector3d acromion(-220.744975, 1434.23018, -125.491871), neck(0, 1501.57812, -181.647546);
+  const SurfacePaths paths(*back);
+  auto out = paths.shortest(acromion, neck), in = paths.shortest(neck, acromion);
+  ASSERT_TRUE(out.ok() && in.ok());
+  EXPECT_NEAR(out->path_mm, 240.32, 0.05);
+  EXPECT_NEAR(in->path_mm, out->path_mm, 1e-6);
+  // Each runs from its first point to its second.
+  EXPECT_LT((out->path.front() - acromion).norm(), 1.0);
+  EXPECT_LT((out->path.back() - neck).norm(), 1.0);
+  EXPECT_LT((in->path.front() - neck).norm(), 1.0);
 }
 
 }  // namespace
