@@ -14,7 +14,7 @@ namespace bodyscan::pipeline {
 
 inline constexpr const char* kMeasurementsSchema = "bodyscan.measurements/1";
 inline constexpr const char* kGirthAlgorithm = "girth/convex-hull-1";
-inline constexpr const char* kSurfaceAlgorithm = "surface/geodesic-funnel-1";
+inline constexpr const char* kSurfaceAlgorithm = "surface/geodesic-funnel-2";
 
 // Positions (mm) rounded to the micrometre.
 nlohmann::json point_json(const Eigen::Vector3d& p);
