@@ -241,20 +241,18 @@ std::pair<double, Eigen::Vector3d> place_on(const std::vector<Eigen::Vector3d>& 
 
 }  // namespace
 
-StatusOr<Arc> tape_arc(Girth girth, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
-                       const std::optional<Eigen::Vector3d>& via) {
-  const Girth& g = girth;
+StatusOr<Arc> mesh_arc(const TriangleMesh& mesh, const Plane& plane, const Eigen::Vector3d& from,
+                       const Eigen::Vector3d& to) {
+  ASSIGN_OR_RETURN(Girth g, mesh_girth(mesh, plane, Eigen::Vector3d(0.5 * (from + to))));
   if (g.tape.size() < 3) return not_found("arc: the section is too small to measure along");
   const auto [sa, pa] = place_on(g.tape, from);
   const auto [sb, pb] = place_on(g.tape, to);
-  auto ahead_of = [&](double s, double t) { return t >= s ? t - s : g.value_mm - (s - t); };  // along the tape's order
-  const double forward = ahead_of(sa, sb);
-  // Forward from `from` when that way is the shorter or the one passing `via`.
-  const bool ahead = via ? ahead_of(sa, place_on(g.tape, *via).first) <= forward : forward <= g.value_mm - forward;
+  const double forward = sb >= sa ? sb - sa : g.value_mm - (sa - sb);  // along the tape's order
   Arc arc;
-  arc.value_mm = ahead ? forward : g.value_mm - forward;
+  arc.value_mm = std::min(forward, g.value_mm - forward);
   arc.other_way_mm = g.value_mm - arc.value_mm;
-  // The path: the corners passed on that way, between the two places.
+  // The path: the corners passed on the shorter way, between the two places.
+  const bool ahead = forward <= g.value_mm - forward;
   const double start = ahead ? sa : sb, length = arc.value_mm;
   arc.path.push_back(ahead ? pa : pb);
   double along = 0;
@@ -269,14 +267,8 @@ StatusOr<Arc> tape_arc(Girth girth, const Eigen::Vector3d& from, const Eigen::Ve
   for (const auto& c : corners) arc.path.push_back(c.second);
   arc.path.push_back(ahead ? pb : pa);
   if (!ahead) std::reverse(arc.path.begin(), arc.path.end());  // from `from` to `to`
-  arc.girth = std::move(girth);
+  arc.girth = std::move(g);
   return arc;
-}
-
-StatusOr<Arc> mesh_arc(const TriangleMesh& mesh, const Plane& plane, const Eigen::Vector3d& from,
-                       const Eigen::Vector3d& to) {
-  ASSIGN_OR_RETURN(Girth g, mesh_girth(mesh, plane, Eigen::Vector3d(0.5 * (from + to))));
-  return tape_arc(std::move(g), from, to);
 }
 
 }  // namespace bodyscan

@@ -60,10 +60,6 @@ struct Arc {
   Girth girth;                        // the girth whose tape it follows
 };
 
-// The arc along `girth`'s tape between the tape's places nearest `from` and `to`:
-// the shorter way round, or with `via`, the way passing the place nearest it.
-StatusOr<Arc> tape_arc(Girth girth, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
-                       const std::optional<Eigen::Vector3d>& via = std::nullopt);
 // The arc on the section loop nearest the two points' midpoint.
 StatusOr<Arc> mesh_arc(const TriangleMesh& mesh, const Plane& plane, const Eigen::Vector3d& from,
                        const Eigen::Vector3d& to);

@@ -45,7 +45,7 @@ nlohmann::json to_json(const BodyMeasurement& m) {
                       {"min_confidence", m.min_confidence},
                       {"crosses_filled_hole", m.crosses_filled_hole()},
                       {"algorithm", std::string(kBodyMeasurementsAlgorithm) + "/" +
-                                        (m.kind == "girth" ? kGirthAlgorithm
+                                        (m.kind == "girth" && m.plane ? kGirthAlgorithm
                                          : m.kind == "height" || m.kind == "distance" ? "straight-1"
                                                                                       : kSurfaceAlgorithm)}};
   if (m.plane) j["plane"] = plane_json(*m.plane);

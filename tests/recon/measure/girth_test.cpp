@@ -166,34 +166,6 @@ TEST(MeshArc, FollowsTheTapeTheShorterWayRound) {
   EXPECT_NEAR(across->value_mm, 200 * std::sin(18 * deg), 1e-3);
 }
 
-TEST(TapeArc, GoesTheWayRoundThatPassesTheThirdPoint) {
-  const TriangleMesh body = prism(circle(150), {0, 0}, 0, 400);
-  const double perimeter = 2 * 720 * 150 * std::sin(M_PI / 720);
-  auto g = mesh_girth(body, horizontal(210), Eigen::Vector3d(0, 210, 0));
-  ASSERT_TRUE(g.ok()) << g.status().message();
-  const Eigen::Vector3d front(0, 210, 150), right(150, 210, 0), back(0, 210, -150);
-  // Front to right: a quarter of the way round, or three quarters by the back.
-  auto shorter = tape_arc(*g, front, right);
-  auto by_back = tape_arc(*g, front, right, Eigen::Vector3d(0, 210, -170));
-  auto by_side = tape_arc(*g, front, right, Eigen::Vector3d(110, 210, 110));
-  ASSERT_TRUE(shorter.ok() && by_back.ok() && by_side.ok());
-  EXPECT_NEAR(shorter->value_mm, perimeter / 4, 1e-3);
-  EXPECT_NEAR(by_side->value_mm, perimeter / 4, 1e-3);
-  EXPECT_NEAR(by_back->value_mm, 3 * perimeter / 4, 1e-3);
-  EXPECT_NEAR(by_back->other_way_mm, perimeter / 4, 1e-3);
-  // Its path runs from the first point by the back to the second.
-  EXPECT_NEAR((by_back->path.front() - front).norm(), 0, 1e-3);
-  EXPECT_NEAR((by_back->path.back() - right).norm(), 0, 1e-3);
-  double nearest_back = 1e9;
-  for (const Eigen::Vector3d& p : by_back->path) nearest_back = std::min(nearest_back, (p - back).norm());
-  EXPECT_LT(nearest_back, 1.0);
-  // The other way, from right to front by the back: the same three quarters.
-  auto reversed = tape_arc(*g, right, front, back);
-  ASSERT_TRUE(reversed.ok());
-  EXPECT_NEAR(reversed->value_mm, 3 * perimeter / 4, 1e-3);
-  EXPECT_NEAR((reversed->path.front() - right).norm(), 0, 1e-3);
-}
-
 TEST(CloudGirth, PointsNearThePlaneMeasureLikeTheMesh) {
   const TriangleMesh torso = prism(circle(150), {0, 0}, 0, 600);
   const TriangleMesh arm = prism(circle(40, {250, 0}, 360), {250, 0}, 100, 600);
