@@ -34,9 +34,11 @@ const BodyLandmark* BodyMeasurements::landmark(const std::string& name) const {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// How far below a flat extreme (the neck's side, the top of the shoulder) a point
-// still counts as on it, mm.
+// How far below a flat extreme (the neck's side) a point still counts as on it, mm.
 constexpr double kFlatBand = 3;
+// The same for the top of the shoulder, which is broad front to back: a parabola over
+// 3 mm of it is nearly flat, and its vertex moved 7-8 mm under +-0.5 mm of noise.
+constexpr double kRidgeBand = 10;
 
 // The loop that spans the midline X = xc (torso, neck, head), the longest if several.
 const Ring* midline(const std::vector<Ring>& rings, double xc) {
@@ -106,22 +108,6 @@ Eigen::Vector3d middle_of_extreme(const std::vector<Eigen::Vector3d>& pts, const
   double best_d = kInf;
   for (const Eigen::Vector3d& p : pts)
     if (p.dot(dir) >= top - band && std::abs(p.dot(across) - mid) < best_d) best_d = std::abs(p.dot(across) - mid), best = p;
-  return best;
-}
-
-// The corner of a sampled curve: the sample farthest from the chord joining its
-// ends (sign +1: on the chord's left, -1: right, 0: either).
-size_t corner(const std::vector<Eigen::Vector2d>& c, int sign = 0) {
-  if (c.size() < 3) return 0;
-  const Eigen::Vector2d a = c.front(), d = (c.back() - a).normalized();
-  size_t best = 0;
-  double best_v = -kInf;
-  for (size_t i = 1; i + 1 < c.size(); ++i) {
-    const Eigen::Vector2d p = c[i] - a;
-    const double dist = d.x() * p.y() - d.y() * p.x();
-    const double v = sign == 0 ? std::abs(dist) : sign * dist;
-    if (v > best_v) best_v = v, best = i;
-  }
   return best;
 }
 
@@ -442,39 +428,59 @@ class Finder {
     // X = const through a column's centre, the section's points are where the mesh's
     // edges cross it. (The highest vertex per column dropped 15-40 mm wherever the
     // 107k-triangle true bodies have no vertex near the top in a 3 mm column.)
-    std::vector<std::vector<Eigen::Vector3d>> column(nb);
-    std::vector<double> top(nb, -kInf);
-    for (const auto& t : mesh_.triangles)
-      for (int e = 0; e < 3; ++e) {
-        const Eigen::Vector3d p = mesh_.vertices[t[e]].cast<double>(), q = mesh_.vertices[t[(e + 1) % 3]].cast<double>();
-        if (std::max(p.y(), q.y()) < ya || std::min(p.y(), q.y()) > y_hi) continue;
-        const double up = s * (p.x() - xc_), uq = s * (q.x() - xc_);
-        const double lo = std::max(std::min(up, uq), u0), hi = std::min(std::max(up, uq), u1);
-        if (lo > hi || up == uq) continue;
-        for (auto c = static_cast<size_t>(std::ceil((lo - u0) / bin - 0.5)); c < nb && u0 + (c + 0.5) * bin <= hi; ++c) {
-          const Eigen::Vector3d x = p + ((u0 + (c + 0.5) * bin - up) / (uq - up)) * (q - p);
-          if (x.y() < ya || x.y() > y_hi) continue;
-          column[c].push_back(x);
-          top[c] = std::max(top[c], x.y());
+    // `at`: the columns' centres, or one plane's offset.
+    auto sections = [&](const std::function<double(size_t)>& at, size_t count) {
+      std::vector<std::vector<Eigen::Vector3d>> column(count);
+      const double c_lo = at(0), c_hi = at(count - 1), step = count > 1 ? at(1) - at(0) : 1;
+      for (const auto& t : mesh_.triangles)
+        for (int e = 0; e < 3; ++e) {
+          const Eigen::Vector3d p = mesh_.vertices[t[e]].cast<double>(), q = mesh_.vertices[t[(e + 1) % 3]].cast<double>();
+          if (std::max(p.y(), q.y()) < ya || std::min(p.y(), q.y()) > y_hi) continue;
+          const double up = s * (p.x() - xc_), uq = s * (q.x() - xc_);
+          const double lo = std::max(std::min(up, uq), c_lo), hi = std::min(std::max(up, uq), c_hi);
+          if (lo > hi || up == uq) continue;
+          for (auto c = static_cast<size_t>(std::max(0.0, std::ceil((lo - c_lo) / step))); c < count && at(c) <= hi; ++c) {
+            const Eigen::Vector3d x = p + ((at(c) - up) / (uq - up)) * (q - p);
+            if (x.y() >= ya && x.y() <= y_hi) column[c].push_back(x);
+          }
         }
-      }
-    std::vector<Eigen::Vector2d> curve;
-    std::vector<size_t> bins;
-    curve.emplace_back(w_snp, snp.y());
-    bins.push_back(nb);
-    for (size_t c = 0; c < nb; ++c) {
-      if (!(top[c] > -kInf)) continue;
-      curve.emplace_back(u0 + (c + 0.5) * bin, top[c]);
-      bins.push_back(c);
-      if (top[c] <= ya + 0.25 * (snp.y() - ya)) break;  // well down the arm
+      return column;
+    };
+    const std::vector<std::vector<Eigen::Vector3d>> column = sections([&](size_t c) { return u0 + (c + 0.5) * bin; }, nb);
+    std::vector<double> us = {w_snp}, tops = {snp.y()};
+    const double y_arm = ya + 0.25 * (snp.y() - ya);  // well down the arm
+    for (size_t c = 0; c < nb && tops.back() > y_arm; ++c) {
+      if (column[c].empty()) continue;
+      double top = -kInf;
+      for (const Eigen::Vector3d& x : column[c]) top = std::max(top, x.y());
+      us.push_back(u0 + (c + 0.5) * bin), tops.push_back(top);
     }
-    if (curve.size() < 4) return not_found("measure: no " + side(s) + " shoulder outline");
-    // The shoulder's corner bulges above the chord from the neck to the arm.
-    const size_t c = bins[corner(curve, 1)];
+    if (us.size() < 4) return not_found("measure: no " + side(s) + " shoulder outline");
+    // The shoulder's corner bulges above the chord from the neck to where the outline
+    // is well down the arm (that end interpolated between columns), refined to the
+    // vertex of a parabola fitted to the height above the chord over 1 % of the
+    // height either side: the outline is a smooth curve there, and its highest
+    // sample above the chord moved 6-10 mm under +-0.5 mm of skin noise.
+    const size_t n = us.size();
+    Eigen::Vector2d end(us[n - 1], tops[n - 1]);
+    if (tops[n - 1] < y_arm && tops[n - 2] > y_arm) {
+      const double t = (tops[n - 2] - y_arm) / (tops[n - 2] - tops[n - 1]);
+      end = {us[n - 2] + t * (us[n - 1] - us[n - 2]), y_arm};
+    }
+    const Eigen::Vector2d a(us[0], tops[0]), d = (end - a).normalized();
+    std::vector<double> above;
+    for (size_t i = 0; i < n; ++i) above.push_back(d.x() * (tops[i] - a.y()) - d.y() * (us[i] - a.x()));
+    const size_t k = arg_extreme(above, true);
+    if (k == 0) {
+      landmark("shoulder_point_" + side(s), snp);
+      return Status();
+    }
+    const double u = parabola_vertex(us, above, k, 0.01 * h_, false).value_or(us[k]);
     // The top of the shoulder runs front to back: its middle there.
-    landmark("shoulder_point_" + side(s), c == nb ? snp
-                                                   : middle_of_extreme(column[c], Eigen::Vector3d::UnitY(),
-                                                                       Eigen::Vector3d::UnitZ(), kFlatBand));
+    const std::vector<std::vector<Eigen::Vector3d>> at_u = sections([&](size_t) { return u; }, 1);
+    landmark("shoulder_point_" + side(s),
+             middle_of_extreme(at_u[0].empty() ? column[std::min(nb - 1, static_cast<size_t>((us[k] - u0) / bin))] : at_u[0],
+                               Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), kRidgeBand));
     return Status();
   }
 
