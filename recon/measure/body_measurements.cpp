@@ -181,6 +181,31 @@ size_t arg_extreme(const std::vector<double>& v, bool largest) {
                              v.begin());
 }
 
+// The corner of a smooth curve sampled as (x[i], v[i]) and walked until v passed
+// `v_end`: the sample farthest from the chord from the first sample to where v
+// reaches v_end (interpolated between the last two: the last sample jumps with the
+// walk's step, and the chord's end with it), refined to the vertex of a parabola
+// fitted to that distance over `half` of x either side. `sign` +1: farthest on the
+// chord's left (above an outline); 0: either side. Returns the sample and the
+// refined x; the sample is 0 where nothing lies on that side.
+std::pair<size_t, double> refined_corner(const std::vector<double>& x, const std::vector<double>& v, double v_end,
+                                         int sign, double half) {
+  const size_t n = x.size();
+  Eigen::Vector2d end(x[n - 1], v[n - 1]);
+  if ((v[n - 1] - v_end) * (v[n - 2] - v_end) < 0) {
+    const double t = (v_end - v[n - 2]) / (v[n - 1] - v[n - 2]);
+    end = {x[n - 2] + t * (x[n - 1] - x[n - 2]), v_end};
+  }
+  const Eigen::Vector2d a(x[0], v[0]), d = (end - a).normalized();
+  std::vector<double> dist;
+  for (size_t i = 0; i < n; ++i) {
+    const double signed_dist = d.x() * (v[i] - a.y()) - d.y() * (x[i] - a.x());
+    dist.push_back(sign == 0 ? std::abs(signed_dist) : sign * signed_dist);
+  }
+  const size_t k = arg_extreme(dist, true);
+  return {k, parabola_vertex(x, dist, k, half, false).value_or(x[k])};
+}
+
 // Whether a loop in the plane with normal n winds round p (the loop is the limb's
 // own, not a neighbour's that the nearest-loop rule fell back to).
 bool winds_round(const std::vector<Eigen::Vector3d>& loop, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
@@ -397,18 +422,7 @@ class Finder {
     // a parabola fitted to that distance over 1 % of the height either side. The
     // outline is a smooth curve, and its farthest sample moved 4 mm under +-0.5 mm of
     // skin noise.
-    const size_t n = ys.size();
-    const double target = ws.front() + 0.035 * h_;
-    Eigen::Vector2d end(ys[n - 1], ws[n - 1]);
-    if (ws[n - 1] > target && ws[n - 2] < target) {
-      const double t = (target - ws[n - 2]) / (ws[n - 1] - ws[n - 2]);
-      end = {ys[n - 2] + t * (ys[n - 1] - ys[n - 2]), target};
-    }
-    const Eigen::Vector2d a(ys[0], ws[0]), d = (end - a).normalized();
-    std::vector<double> dist;
-    for (size_t i = 0; i < n; ++i) dist.push_back(std::abs(d.x() * (ws[i] - a.y()) - d.y() * (ys[i] - a.x())));
-    const size_t k = arg_extreme(dist, true);
-    const double y_turn = parabola_vertex(ys, dist, k, 0.01 * h_, false).value_or(ys[k]);
+    const double y_turn = refined_corner(ys, ws, ws.front() + 0.035 * h_, 0, 0.01 * h_).second;
     const Ring* m = midline(rings(y_turn), xc_);
     if (!m) return not_found("measure: no " + side(s) + " side of the neck at its base");
     landmark("side_neck_point_" + side(s),
@@ -461,21 +475,11 @@ class Finder {
     // vertex of a parabola fitted to the height above the chord over 1 % of the
     // height either side: the outline is a smooth curve there, and its highest
     // sample above the chord moved 6-10 mm under +-0.5 mm of skin noise.
-    const size_t n = us.size();
-    Eigen::Vector2d end(us[n - 1], tops[n - 1]);
-    if (tops[n - 1] < y_arm && tops[n - 2] > y_arm) {
-      const double t = (tops[n - 2] - y_arm) / (tops[n - 2] - tops[n - 1]);
-      end = {us[n - 2] + t * (us[n - 1] - us[n - 2]), y_arm};
-    }
-    const Eigen::Vector2d a(us[0], tops[0]), d = (end - a).normalized();
-    std::vector<double> above;
-    for (size_t i = 0; i < n; ++i) above.push_back(d.x() * (tops[i] - a.y()) - d.y() * (us[i] - a.x()));
-    const size_t k = arg_extreme(above, true);
+    const auto [k, u] = refined_corner(us, tops, y_arm, 1, 0.01 * h_);
     if (k == 0) {
       landmark("shoulder_point_" + side(s), snp);
       return Status();
     }
-    const double u = parabola_vertex(us, above, k, 0.01 * h_, false).value_or(us[k]);
     // The top of the shoulder runs front to back: its middle there.
     const std::vector<std::vector<Eigen::Vector3d>> at_u = sections([&](size_t) { return u; }, 1);
     landmark("shoulder_point_" + side(s),
