@@ -111,18 +111,14 @@ Eigen::Vector3d middle_of_extreme(const std::vector<Eigen::Vector3d>& pts, const
   return best;
 }
 
-// On a front profile sampled as (y, z), the sample lying farthest behind (at smaller
-// Z than) the chord joining its ends: a notch (the front neck point, the fold under
-// the bust). The ends count, at depth 0.
-size_t deepest_behind_chord(const std::vector<Eigen::Vector2d>& c) {
+// On a front profile sampled as (y, z), each sample's depth in front of (+) or behind
+// (−) the chord joining its ends. The deepest is a notch (the front neck point, the
+// fold under the bust); the ends count, at depth 0.
+std::vector<double> depth_behind_chord(const std::vector<Eigen::Vector2d>& c) {
   const Eigen::Vector2d a = c.front(), e = c.back();
-  size_t best = 0;
-  double deepest = kInf;
-  for (size_t i = 0; i < c.size(); ++i) {
-    const double chord_z = a.y() + (c[i].x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y());
-    if (c[i].y() - chord_z < deepest) deepest = c[i].y() - chord_z, best = i;
-  }
-  return best;
+  std::vector<double> depth;
+  for (const Eigen::Vector2d& q : c) depth.push_back(q.y() - (a.y() + (q.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y())));
+  return depth;
 }
 
 // Least-squares line through points: (centre, unit direction with y >= 0).
@@ -508,12 +504,11 @@ class Finder {
       // profile's bottom is flat over 10-15 mm, and its deepest sample moved 6 mm under
       // +-0.5 mm of skin noise: refined to the vertex of a parabola fitted to the depth
       // over 2 % of the height either side, as the knee.
-      const size_t k = deepest_behind_chord(curve);
+      const std::vector<double> depth = depth_behind_chord(curve);
+      std::vector<double> ys;
+      for (const Eigen::Vector2d& q : curve) ys.push_back(q.x());
+      const size_t k = arg_extreme(depth, false);
       front = {xc_, curve[k].x(), curve[k].y()};
-      const Eigen::Vector2d a = curve.front(), e = curve.back();
-      std::vector<double> ys, depth;
-      for (const Eigen::Vector2d& q : curve)
-        ys.push_back(q.x()), depth.push_back(q.y() - (a.y() + (q.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y())));
       if (const std::optional<double> yv = parabola_vertex(ys, depth, k, 0.02 * h_, true)) {
         for (size_t i = 0; i + 1 < curve.size(); ++i)
           if (curve[i].x() >= *yv && *yv >= curve[i + 1].x()) {
@@ -566,7 +561,7 @@ class Finder {
           curve.emplace_back(y, 0.5 * (f + f2));
       }
       underbust_y_ = bust_y_ - 0.05 * h_;
-      if (curve.size() >= 3) underbust_y_ = curve[deepest_behind_chord(curve)].x();
+      if (curve.size() >= 3) underbust_y_ = curve[arg_extreme(depth_behind_chord(curve), false)].x();
       landmark("underbust_front_point", {xc_, underbust_y_, front_z(underbust_y_)});
     }
     // Hip: the buttocks' greatest backward projection.
