@@ -43,6 +43,9 @@ void usage(FILE* out) {
       "                   body; default: the rig description's processing\n"
       "                   .max_view_deg, else 90: keep them all)\n"
       "  --no-surface     stop at the point cloud\n"
+      "  --keep-sway      keep every point where it was measured (default: the\n"
+      "                   subject's sway between sweeps is estimated from the\n"
+      "                   cloud and undone; scan.json \"sway\" has its path)\n"
       "  --archive DIR    also store the scan in the archive in DIR (created;\n"
       "                   docs/archive.md); --out is then optional\n"
       "  --customer ID    the archived scan's customer (default: a new one)\n"
@@ -56,6 +59,16 @@ void usage(FILE* out) {
       "Before each real camera a person holds the lens dot-grid board: the request\n"
       "is printed, and Enter (a line on standard input) answers it.\n",
       out);
+}
+
+// What the sway estimate found (pipeline::ScanOptions::compensate_sway).
+void print_sway(const pipeline::ScanStats& scan) {
+  if (!scan.sway.empty()) {
+    std::printf("sway: up to %.1f mm, undone; where sweeps meet they differ by %.2f mm RMS (%.2f as measured)\n",
+                scan.sway.peak_mm, scan.sway.rms_after_mm, scan.sway.rms_before_mm);
+  } else if (!scan.sway_error.empty()) {
+    std::printf("sway: not estimated (%s); the cloud is as measured\n", scan.sway_error.c_str());
+  }
 }
 
 }  // namespace
@@ -117,6 +130,8 @@ int run_scan(int argc, char** argv) {
       }
     } else if (a == "--no-surface") {
       options.reconstruct = false;
+    } else if (a == "--keep-sway") {
+      options.scan.compensate_sway = false;
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
     } else if (a == "--operator-dot-grid") {
@@ -239,6 +254,7 @@ int run_scan(int argc, char** argv) {
     std::printf("scan: %zu points from %zu frames (%zu without a laser plane), processing %.2f s\n",
                 result->cloud.size(), result->scan.frames, result->scan.frames_without_plane,
                 result->scan.processing_seconds);
+    print_sway(result->scan);
     if (!result->mesh.triangles.empty()) {
       std::printf("surface: %zu vertices, %zu triangles in %.1f s\n", result->mesh.vertices.size(),
                   result->mesh.triangles.size(), result->surface.total_seconds());
@@ -271,6 +287,7 @@ int run_reprocess(int argc, char** argv) {
     if (a == "--help" || a == "-h") {
       std::puts(
           "usage: bodyscan reprocess SCAN_DIR --out DIR [--method ray|homography] [--max-view DEG] [--no-surface]\n"
+          "                         [--keep-sway]\n"
           "\n"
           "Makes a scan again from the raw record `bodyscan scan` left in SCAN_DIR/raw\n"
           "(calibration and stripe samples; no camera frames), with today's processing,\n"
@@ -299,6 +316,8 @@ int run_reprocess(int argc, char** argv) {
       }
     } else if (a == "--no-surface") {
       options.reconstruct = false;
+    } else if (a == "--keep-sway") {
+      options.scan.compensate_sway = false;
     } else if (!a.empty() && a[0] != '-' && in.empty()) {
       in = a;
     } else {
@@ -332,6 +351,7 @@ int run_reprocess(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan reprocess: %s\n", w.message().c_str());
     return 1;
   }
+  print_sway(result->scan);
   std::printf("reprocessed: %zu points%s, written to %s\n", result->cloud.size(),
               result->mesh.triangles.empty() ? "" : (", " + std::to_string(result->mesh.num_triangles()) + " triangles").c_str(),
               out.c_str());

@@ -3,7 +3,8 @@
 // poles and the stripe's samples where that plane can meet the subject. When the
 // scan is over, each laser's sweep is fitted to all its pole points (LaserSweep),
 // and every sample is taken to its step's plane. Every camera's points land in the
-// frame's world directly; there is no registration.
+// frame's world directly; there is no registration between cameras. The subject's
+// sway between sweeps is estimated from the cloud and undone (subject_sway.hpp).
 #pragma once
 
 #include <map>
@@ -14,6 +15,7 @@
 #include "recon/geometry/point_cloud.hpp"
 #include "recon/scan/laser_sweep.hpp"
 #include "recon/scan/redundancy.hpp"
+#include "recon/scan/subject_sway.hpp"
 #include "recon/scan/view_angle.hpp"
 #include "recon/scan/triangulate.hpp"
 #include "server/pipeline/calibrate.hpp"
@@ -40,6 +42,10 @@ struct ScanOptions {
   // the grazing points are the only ones on the flanks, and dropping them costs the
   // thesis rig its coverage must (docs/scan-processing.md, "Grazing views").
   ViewAngleOptions view = {.max_view_deg = 90};
+  // The subject's sway between sweeps, estimated from the cloud and undone before
+  // the redundancy rule (subject_sway.hpp).
+  bool compensate_sway = true;
+  SwayOptions sway;
 };
 
 struct LaserSweepReport {
@@ -64,6 +70,8 @@ struct ScanStats {
   size_t points_redundant = 0;      // dropped for a better point nearby
   size_t points_grazing = 0;        // dropped for a grazing view (ScanOptions::view)
   std::vector<LaserSweepReport> sweeps;
+  SwayEstimate sway;                // empty when not compensated
+  std::string sway_error;           // why the sway estimate failed (the cloud is kept as measured)
   double processing_seconds = 0;    // frames to points, acquisition excluded
   std::string first_plane_error;    // the first frame without a plane, for the log
 };

@@ -159,6 +159,20 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
                            {"axis_point_mm", {s.axis_point.x(), s.axis_point.y(), s.axis_point.z()}},
                            {"axis_direction", {s.axis_direction.x(), s.axis_direction.y(), s.axis_direction.z()}}});
   }
+  if (!r.scan.sway.empty()) {
+    const SwayEstimate& w = r.scan.sway;
+    nlohmann::json path = nlohmann::json::array();
+    for (const Eigen::Vector3d& k : w.knots) path.push_back({k.x(), k.y(), k.z()});
+    j["sway"] = {{"peak_mm", w.peak_mm},
+                 {"pairs", w.pairs},
+                 {"pair_rms_before_mm", w.rms_before_mm},
+                 {"pair_rms_after_mm", w.rms_after_mm},
+                 {"first_frame", w.first_frame},
+                 {"knot_frames", w.knot_frames},
+                 {"path_mm", path}};
+  } else if (!r.scan.sway_error.empty()) {
+    j["sway_error"] = r.scan.sway_error;
+  }
   if (!r.surface_error.empty()) j["surface_error"] = r.surface_error;
   if (!r.measure_error.empty()) j["measure_error"] = r.measure_error;
   j["calibration_seconds"] = r.calibration_seconds;

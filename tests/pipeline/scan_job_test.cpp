@@ -8,6 +8,7 @@
 #include "recon/geometry/mesh_distance.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/rig_backend.hpp"
+#include "tests/distance_after_shift.hpp"
 #include "tests/half_resolution.hpp"
 
 namespace bodyscan::pipeline {
@@ -82,6 +83,41 @@ TEST(ScanJob, PointsLieOnTheBodyFromEveryCamera) {
   auto missing = reprocess_scan(no_cameras, result->raw_stripes, options);
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.status().message().find("calibration record"), std::string::npos) << missing.status().message();
+}
+
+TEST(ScanJob, ASwayingSubjectsSwayIsFoundAndUndone) {
+  // The subject sways 3 mm sideways and 1.5 mm front to back at 0.25 Hz while the
+  // four lasers sweep one after another.
+  hw::RigDescription desc = testing::half_resolution_rig();
+  desc.simulation.motion.sway_mm = 3;
+  auto rig = hw::sim::SimulatedRig::create(desc);
+  ASSERT_TRUE(rig.ok()) << rig.status().message();
+  ScanJobOptions options;
+  options.every = 4;
+  options.reconstruct = false;
+  auto result = run_scan_job(rig_handle(**rig), options);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const SwayEstimate& sway = result->scan.sway;
+  ASSERT_FALSE(sway.empty()) << result->scan.sway_error;
+  // Every 4th step: stripes 4 times as far apart, and the neighbourhood with them.
+  EXPECT_GT(sway.stripe_spacing_mm, 10);
+  EXPECT_GT(sway.radius_mm, 2.4 * sway.stripe_spacing_mm);
+  EXPECT_GT(sway.peak_mm, 1.5);
+  EXPECT_LT(sway.peak_mm, 5);
+  EXPECT_LT(sway.rms_after_mm, 0.6 * sway.rms_before_mm);
+  // The same frames with the sway kept: the undone cloud lies closer to the body.
+  ScanJobOptions keep = options;
+  keep.scan.compensate_sway = false;
+  auto kept = reprocess_scan(result->raw_record, result->raw_stripes, keep);
+  ASSERT_TRUE(kept.ok()) << kept.status().message();
+  EXPECT_TRUE(kept->scan.sway.empty());
+  const MeshDistance truth((*rig)->scene().subject());
+  const double undone = testing::rms_distance_after_shift(result->cloud, truth);
+  const double as_measured = testing::rms_distance_after_shift(kept->cloud, truth);
+  std::printf("[ sway ] up to %.2f mm; sweeps meet within %.2f mm RMS (%.2f as measured); cloud to body %.3f mm RMS (%.3f as measured)\n",
+              sway.peak_mm, sway.rms_after_mm, sway.rms_before_mm, undone, as_measured);
+  EXPECT_LT(undone, 0.8 * as_measured);
+  for (int i = 0; i < (*rig)->controller().num_lasers(); ++i) EXPECT_FALSE((*rig)->controller().laser_on(i));
 }
 
 TEST(ScanJob, TheSquareRigDropsGrazingViewsAsItsDescriptionAsks) {

@@ -1,0 +1,322 @@
+#include "recon/scan/subject_sway.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <tbb/parallel_for.h>
+
+#include "recon/spatial/knn_index.hpp"
+
+namespace bodyscan {
+namespace {
+
+// One point against another sweep's local plane. With the sway x (knot values),
+// its distance is r0 - n . (x(frame of the point) - mean of x(frames of the plane's
+// points)); the frames enter through the knots' hat weights.
+struct Pair {
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double r0 = 0;      // the distance as measured, mm
+  double weight = 1;  // confidence
+  std::vector<std::pair<int, double>> knots;  // (knot, weight): +point, -plane
+};
+
+struct Knots {
+  int first = 0, spacing = 1, count = 0;
+  // Adds frame f's hat weights, times `scale`, to `out`.
+  void add(int f, double scale, std::vector<std::pair<int, double>>& out) const {
+    const double u = static_cast<double>(f - first) / spacing;
+    const int k = std::clamp(static_cast<int>(std::floor(u)), 0, count - 1);
+    const double a = std::clamp(u - k, 0.0, 1.0);
+    out.emplace_back(k, scale * (1 - a));
+    if (k + 1 < count && a > 0) out.emplace_back(k + 1, scale * a);
+  }
+};
+
+void merge(std::vector<std::pair<int, double>>& v) {
+  std::sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  size_t w = 0;
+  for (size_t r = 0; r < v.size(); ++r) {
+    if (w > 0 && v[w - 1].first == v[r].first) v[w - 1].second += v[r].second;
+    else v[w++] = v[r];
+  }
+  v.resize(w);
+}
+
+double residual(const Pair& p, const std::vector<Eigen::Vector3d>& x) {
+  double r = p.r0;
+  for (const auto& [k, a] : p.knots) r -= a * p.normal.dot(x[static_cast<size_t>(k)]);
+  return r;
+}
+
+// The pairs at the current sway: each anchor against every other sweep's plane
+// within the radius.
+// The median distance from a point to the nearest point of its laser's next or
+// previous stripe (another frame of the same laser), over a sample of the anchors.
+double stripe_spacing(const PointCloud& cloud, const KnnIndex& index, const std::vector<size_t>& anchors) {
+  const size_t step = std::max<size_t>(1, anchors.size() / 2000);
+  std::vector<double> found(anchors.size() / step + 1, -1);
+  tbb::parallel_for(size_t{0}, found.size(), [&](size_t s) {
+    if (s * step >= anchors.size()) return;
+    const size_t i = anchors[s * step];
+    for (const auto& [j, d2] : index.within_radius(cloud.positions[i], 40.f)) {
+      if (cloud.laser[j] == cloud.laser[i] && cloud.frame[j] != cloud.frame[i] && cloud.frame[j] >= 0) {
+        found[s] = std::sqrt(static_cast<double>(d2));
+        return;  // nearest first
+      }
+    }
+  });
+  found.erase(std::remove(found.begin(), found.end(), -1.0), found.end());
+  if (found.empty()) return 0;
+  std::nth_element(found.begin(), found.begin() + static_cast<std::ptrdiff_t>(found.size() / 2), found.end());
+  return found[found.size() / 2];
+}
+
+// The anchor i against the other sweep's points other[b, e): their surface near the
+// anchor, a height field over their plane (quadratic where they span three stripes
+// or more, else flat), fitted with Gaussian weights towards the anchor (sigma a
+// third of the radius). The anchor's height above it is the pair's distance; as
+// each of their points enters that height linearly, so does its moment's sway.
+bool local_height(const PointCloud& cloud, const std::vector<Vec3f>& moved, size_t i,
+                  const std::vector<std::pair<int32_t, uint32_t>>& other, size_t b, size_t e, float radius,
+                  const Knots& knots, const std::vector<Eigen::Vector3d>& x, Pair& p) {
+  const bool has_conf = cloud.has_confidence();
+  const Eigen::Vector3d at = moved[i].cast<double>();
+  const double inv = 1 / (2 * std::pow(radius / 3.0, 2));
+  const size_t m = e - b;
+  std::vector<double> w(m);
+  Eigen::Vector3d cm = Eigen::Vector3d::Zero();
+  double sw = 0, conf = 0;
+  for (size_t t = 0; t < m; ++t) {
+    const uint32_t j = other[b + t].second;
+    w[t] = std::exp(-(moved[j].cast<double>() - at).squaredNorm() * inv);
+    cm += w[t] * moved[j].cast<double>();
+    sw += w[t];
+    conf += w[t] * (has_conf ? cloud.confidence[j] : 1.f);
+  }
+  cm /= sw;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (size_t t = 0; t < m; ++t) {
+    const Eigen::Vector3d d = moved[other[b + t].second].cast<double>() - cm;
+    cov += w[t] * d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov / sw);
+  const Eigen::Vector3d ev = es.eigenvalues();
+  // More than one stripe (the middle spread, against the radius, which scales with
+  // the stripes' spacing), and a surface rather than a blob.
+  if (ev[1] < 0.01 * radius * radius || ev[0] > 0.3 * ev[1]) return false;
+  const Eigen::Vector3d n = es.eigenvectors().col(0), t1 = es.eigenvectors().col(2), t2 = es.eigenvectors().col(1);
+  // Height field h(u, v) over the plane, u and v in radii.
+  auto basis = [&](const Eigen::Vector3d& q, int terms) {
+    const Eigen::Vector3d d = q - cm;
+    const double u = t1.dot(d) / radius, v = t2.dot(d) / radius;
+    Eigen::Matrix<double, 6, 1> f;
+    f << 1, u, v, u * u, u * v, v * v;
+    if (terms < 6) f.tail(3).setZero();
+    return f;
+  };
+  int frames_seen = 0;
+  {
+    int last = INT32_MIN;
+    std::vector<int> fs;
+    for (size_t t = 0; t < m; ++t) fs.push_back(cloud.frame[other[b + t].second]);
+    std::sort(fs.begin(), fs.end());
+    for (int f : fs) frames_seen += f != last, last = f;
+  }
+  for (int terms : {frames_seen >= 3 ? 6 : 3, 3}) {
+    Eigen::Matrix<double, 6, 6> mm = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+    for (size_t t = 0; t < m; ++t) {
+      const Eigen::Vector3d q = moved[other[b + t].second].cast<double>();
+      const auto f = basis(q, terms);
+      mm += w[t] * f * f.transpose();
+      rhs += w[t] * f * n.dot(q - cm);
+    }
+    if (terms < 6) mm.bottomRightCorner<3, 3>().setIdentity();
+    const Eigen::FullPivLU<Eigen::Matrix<double, 6, 6>> lu(mm);
+    if (lu.rank() < 6 || lu.rcond() < 1e-6) continue;
+    const Eigen::Matrix<double, 6, 1> fa = basis(at, terms);
+    const Eigen::Matrix<double, 6, 1> z = lu.solve(fa);
+    const double height = n.dot(at - cm) - z.dot(rhs);
+    p.normal = n;
+    p.knots.clear();
+    knots.add(cloud.frame[i], 1, p.knots);
+    for (size_t t = 0; t < m; ++t) {
+      const Eigen::Vector3d q = moved[other[b + t].second].cast<double>();
+      knots.add(cloud.frame[other[b + t].second], -w[t] * z.dot(basis(q, terms)), p.knots);
+    }
+    merge(p.knots);
+    // As measured (no sway undone): the height plus the sway the moved points carry.
+    p.r0 = height;
+    for (const auto& [k, c] : p.knots) p.r0 += c * n.dot(x[static_cast<size_t>(k)]);
+    p.weight = conf / sw;
+    return true;
+  }
+  return false;
+}
+
+std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& moved, const std::vector<size_t>& anchors,
+                             const Knots& knots, const SwayOptions& o, float radius, const std::vector<Eigen::Vector3d>& x) {
+  const KnnIndex index(moved);
+  std::vector<std::vector<Pair>> found(anchors.size());
+  const bool has_conf = cloud.has_confidence();
+  tbb::parallel_for(size_t{0}, anchors.size(), [&](size_t a) {
+    const size_t i = anchors[a];
+    const int fi = cloud.frame[i];
+    auto near = index.within_radius(moved[i], radius);
+    // Group the other moments' points by laser (one laser sweeps once, so its points
+    // near here were seen at nearly one moment).
+    std::vector<std::pair<int32_t, uint32_t>> other;
+    for (const auto& [j, d2] : near) {
+      const int fj = cloud.frame[j];
+      if (fj < 0 || std::abs(fj - fi) < o.min_frame_gap) continue;
+      other.emplace_back(cloud.laser[j], j);
+    }
+    std::sort(other.begin(), other.end());
+    for (size_t b = 0; b < other.size();) {
+      size_t e = b;
+      while (e < other.size() && other[e].first == other[b].first) ++e;
+      if (e - b >= o.min_group) {
+        Pair p;
+        if (local_height(cloud, moved, i, other, b, e, radius, knots, x, p)) {
+          p.weight *= has_conf ? cloud.confidence[i] : 1.f;
+          if (p.weight > 0) found[a].push_back(std::move(p));
+        }
+      }
+      b = e;
+    }
+  });
+  std::vector<Pair> pairs;
+  for (auto& f : found)
+    for (Pair& p : f) pairs.push_back(std::move(p));
+  return pairs;
+}
+
+}  // namespace
+
+Eigen::Vector3d SwayEstimate::at(double frame) const {
+  if (knots.empty()) return Eigen::Vector3d::Zero();
+  const double u = (frame - first_frame) / knot_frames;
+  if (u <= 0) return knots.front();
+  const size_t k = static_cast<size_t>(std::floor(u));
+  if (k + 1 >= knots.size()) return knots.back();
+  const double a = u - static_cast<double>(k);
+  return (1 - a) * knots[k] + a * knots[k + 1];
+}
+
+StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions& o) {
+  const size_t n = cloud.size();
+  if (cloud.frame.size() != n || cloud.laser.size() != n)
+    return invalid_argument("sway: the cloud needs each point's frame and laser");
+  if (o.knot_frames < 1 || o.radius_mm <= 0 || o.min_frame_gap < 1 || o.iterations < 1 || o.min_group < 3)
+    return invalid_argument("sway: bad options");
+  SwayEstimate est;
+  est.knot_frames = o.knot_frames;
+  int fmin = INT32_MAX, fmax = INT32_MIN;
+  for (int32_t f : cloud.frame)
+    if (f >= 0) fmin = std::min(fmin, f), fmax = std::max(fmax, f);
+  if (fmin > fmax || fmax - fmin < o.min_frame_gap) return est;
+  Knots knots{fmin, o.knot_frames, (fmax - fmin) / o.knot_frames + 2};
+  est.first_frame = fmin;
+  const size_t m = static_cast<size_t>(knots.count);
+  std::vector<int> axes = o.vertical ? std::vector<int>{0, 1, 2} : std::vector<int>{0, 2};
+  const size_t dims = axes.size(), unknowns = m * dims;
+
+  std::vector<size_t> anchors;
+  const size_t stride = std::max<size_t>(1, (n + o.max_anchors - 1) / std::max<size_t>(1, o.max_anchors));
+  for (size_t i = 0; i < n; i += stride)
+    if (cloud.frame[i] >= 0) anchors.push_back(i);
+
+  {
+    const KnnIndex index(cloud.positions);
+    est.stripe_spacing_mm = stripe_spacing(cloud, index, anchors);
+  }
+  est.radius_mm = std::max<double>(o.radius_mm, 2.5 * est.stripe_spacing_mm);
+  const float radius = static_cast<float>(est.radius_mm);
+
+  std::vector<Eigen::Vector3d> x(m, Eigen::Vector3d::Zero());
+  std::vector<Vec3f> moved = cloud.positions;
+  std::vector<Pair> pairs;
+  for (int it = 0; it < o.iterations; ++it) {
+    pairs = find_pairs(cloud, moved, anchors, knots, o, radius, x);
+    if (it == 0) {
+      double ss = 0, sw = 0;
+      for (const Pair& p : pairs) {
+        const double r = std::min(std::abs(p.r0), o.max_residual_mm);
+        ss += p.weight * r * r, sw += p.weight;
+      }
+      est.rms_before_mm = sw > 0 ? std::sqrt(ss / sw) : 0;
+    }
+    if (pairs.empty()) break;
+    // Robust weights at the current sway; then the normal equations.
+    Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(unknowns), static_cast<Eigen::Index>(unknowns));
+    Eigen::VectorXd atb = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(unknowns));
+    double total = 0;
+    std::vector<std::pair<Eigen::Index, double>> row;
+    for (const Pair& p : pairs) {
+      const double r = std::abs(residual(p, x));
+      if (r > o.max_residual_mm) continue;
+      const double w = p.weight * (r <= o.huber_mm ? 1.0 : o.huber_mm / r);
+      total += w;
+      row.clear();
+      for (const auto& [k, a] : p.knots)
+        for (size_t d = 0; d < dims; ++d)
+          row.emplace_back(static_cast<Eigen::Index>(static_cast<size_t>(k) * dims + d), a * p.normal[axes[d]]);
+      for (const auto& [ri, rv] : row) {
+        atb[ri] += w * rv * p.r0;
+        for (const auto& [ci, cv] : row) ata(ri, ci) += w * rv * cv;
+      }
+    }
+    if (total <= 0) break;
+    const double per_knot = total / static_cast<double>(m);
+    const double lambda = o.smoothness * per_knot;
+    for (size_t k = 1; k + 1 < m; ++k) {
+      for (size_t d = 0; d < dims; ++d) {
+        const std::array<Eigen::Index, 3> idx = {static_cast<Eigen::Index>((k - 1) * dims + d),
+                                                 static_cast<Eigen::Index>(k * dims + d),
+                                                 static_cast<Eigen::Index>((k + 1) * dims + d)};
+        const std::array<double, 3> c = {1, -2, 1};
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) ata(idx[a], idx[b]) += lambda * c[a] * c[b];
+      }
+    }
+    // Mean zero (the scan cannot tell where the body stands on average), and a hair
+    // of ridge so that knots nothing constrains stay put.
+    for (size_t d = 0; d < dims; ++d)
+      for (size_t a = 0; a < m; ++a)
+        for (size_t b = 0; b < m; ++b)
+          ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(b * dims + d)) += per_knot / static_cast<double>(m);
+    ata.diagonal().array() += o.ridge * per_knot;
+    const Eigen::VectorXd sol = ata.ldlt().solve(atb);
+    if (!sol.allFinite()) return internal_error("sway: the path's least-squares system is singular");
+    for (size_t k = 0; k < m; ++k) {
+      x[k].setZero();
+      for (size_t d = 0; d < dims; ++d) x[k][axes[d]] = sol[static_cast<Eigen::Index>(k * dims + d)];
+    }
+    est.knots = x;
+    tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+      moved[i] = cloud.frame[i] >= 0 ? (cloud.positions[i].cast<double>() - est.at(cloud.frame[i])).cast<float>()
+                                     : cloud.positions[i];
+    });
+  }
+  est.knots = x;
+  est.pairs = pairs.size();
+  double ss = 0, sw = 0;
+  for (const Pair& p : pairs) {
+    const double r = std::min(std::abs(residual(p, x)), o.max_residual_mm);
+    ss += p.weight * r * r, sw += p.weight;
+  }
+  est.rms_after_mm = sw > 0 ? std::sqrt(ss / sw) : 0;
+  for (const Eigen::Vector3d& k : x) est.peak_mm = std::max(est.peak_mm, k.norm());
+  return est;
+}
+
+void undo_sway(PointCloud& cloud, const SwayEstimate& sway) {
+  if (sway.empty() || cloud.frame.size() != cloud.size()) return;
+  for (size_t i = 0; i < cloud.size(); ++i)
+    if (cloud.frame[i] >= 0) cloud.positions[i] = (cloud.positions[i].cast<double>() - sway.at(cloud.frame[i])).cast<float>();
+}
+
+}  // namespace bodyscan

@@ -1,0 +1,73 @@
+// A standing person sways: a few millimetres, slowly (postural sway, mostly below
+// 1 Hz, mostly horizontal). The lasers sweep one after another, so each sweep sees
+// the body where it stood at that moment, and two sweeps of the same skin seconds
+// apart disagree by the sway in between: every girth comes out a few millimetres
+// large, the small ones (neck, wrist) the most. The thesis rig takes every point as
+// it was measured (§3.1.4: no registration).
+//
+// Here the sway is estimated from the scan itself and undone. Each point keeps its
+// frame (its moment). Where a sweep's point lies on skin another sweep saw at a
+// clearly different moment, the distance from the point to that sweep's local
+// plane, along the plane's normal, is the sway between the two moments along that
+// normal. Over a scan that is tens of thousands of such differences, from skin that
+// faces every way, and one smooth horizontal path through time - a piecewise-linear
+// curve with a knot every few frames, its second differences penalised - explains
+// them best (robust least squares, re-paired a few times as the sweeps come
+// together). Its mean is zero: the body is put where it stood on average.
+//
+// What the scan cannot tell: a sway that moves every pair of overlapping moments
+// alike (e.g. one sweep alone moving sideways along a flat patch), and any sway
+// between moments whose sweeps see no common skin. The smoothness term carries the
+// estimate across those; docs/scan-processing.md ("Sway") has the figures.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "recon/core/status.hpp"
+#include "recon/geometry/point_cloud.hpp"
+
+namespace bodyscan {
+
+struct SwayOptions {
+  int knot_frames = 20;         // knot spacing of the sway's path, frames (1/3 s at 60 Hz)
+  // Neighbourhood in which a point meets another sweep's skin: at least this, and at
+  // least 2.5 stripe spacings (measured from the cloud: a scan of every Nth step has
+  // its stripes N times farther apart), so that it holds two stripes of each sweep.
+  float radius_mm = 8.f;
+  int min_frame_gap = 30;       // moments closer than this (frames) are taken as one
+  size_t max_anchors = 60000;   // points whose neighbourhoods are examined, spread over the scan
+  size_t min_group = 6;         // points of the other sweep needed for its local plane
+  int iterations = 4;           // re-pairings
+  double smoothness = 0.01;     // weight of the path's second differences, relative to the data
+  double ridge = 0.003;        // weight of the sway itself (pulls knots without data to zero), relative
+  double huber_mm = 0.75;       // residuals beyond this count linearly
+  double max_residual_mm = 6;   // pairs farther apart than this are not the same skin
+  bool vertical = false;        // also estimate a vertical sway (off: posture moves sideways)
+};
+
+struct SwayEstimate {
+  int first_frame = 0;                   // frame of knot 0
+  int knot_frames = 1;
+  std::vector<Eigen::Vector3d> knots;    // the sway at each knot, mm (mean zero)
+  size_t pairs = 0;                      // point-to-sweep pairs in the last solve
+  double radius_mm = 0;                  // the neighbourhood used
+  double stripe_spacing_mm = 0;          // median distance between a sweep's neighbouring stripes
+  double rms_before_mm = 0, rms_after_mm = 0;  // of those pairs' distances (robust RMS)
+  double peak_mm = 0;                    // largest |sway| over the knots
+
+  // The sway at `frame` (linear between knots, constant beyond the ends).
+  Eigen::Vector3d at(double frame) const;
+  bool empty() const { return knots.empty(); }
+};
+
+// Needs positions, frame and laser per point (confidence optional). A cloud whose
+// points come from fewer than two moments far enough apart yields an empty
+// estimate (nothing to compare), not an error.
+StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions& options = {});
+
+// Moves every point back by the sway at its frame. Points of unknown frame stay.
+void undo_sway(PointCloud& cloud, const SwayEstimate& sway);
+
+}  // namespace bodyscan

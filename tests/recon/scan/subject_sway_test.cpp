@@ -1,0 +1,163 @@
+#include "recon/scan/subject_sway.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <string>
+
+#include "recon/geometry/mesh_distance.hpp"
+#include "recon/io/ply.hpp"
+#include "recon/measure/plane_section.hpp"
+#include "tests/distance_after_shift.hpp"
+
+namespace bodyscan {
+namespace {
+
+// A known sway: 3 mm sideways at 0.2 Hz, 2 mm front to back at 0.3 Hz (other
+// frequencies than the simulated rig's, so nothing here is tuned to it).
+Eigen::Vector3d true_sway(int frame) {
+  const double t = frame / 60.0;
+  return {3 * std::sin(2 * M_PI * 0.2 * t), 0, 2 * std::sin(2 * M_PI * 0.3 * t + 1.0)};
+}
+
+// The thesis rig's four line lasers, swept one after another over the demo body:
+// 351 steps of 0.1 degree each, one frame per step at 60 Hz. Each step's stripe is
+// the vertical plane through the laser cut from the body where the laser reaches
+// first (the nearest skin along each elevation), densified to 2 mm, displaced by the
+// sway at its frame, with 0.2 mm of noise.
+PointCloud swept_body(const TriangleMesh& body, double sway_scale) {
+  struct Laser {
+    Eigen::Vector3d at, aim;
+  };
+  const Laser lasers[] = {{{-500, 1150, 1900}, {0.254493, 0, -0.967075}},
+                          {{500, 1150, 1900}, {-0.254493, 0, -0.967075}},
+                          {{-500, 1150, -1900}, {0.254493, 0, 0.967075}},
+                          {{500, 1150, -1900}, {-0.254493, 0, 0.967075}}};
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0, 0.2);
+  PointCloud cloud;
+  int frame = 0;
+  for (int l = 0; l < 4; ++l) {
+    for (int step = -175; step <= 175; ++step, ++frame) {
+      const double a = step * 0.1 * M_PI / 180;
+      const Eigen::Vector3d dir = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()) * lasers[l].aim;
+      const Eigen::Vector3d across = Eigen::Vector3d::UnitY().cross(dir).normalized();
+      // Nearest skin per 0.05 degree of elevation.
+      std::map<int, std::pair<double, Eigen::Vector3d>> first;
+      for (const SectionLoop& loop : plane_section(body, Plane{lasers[l].at, across})) {
+        const size_t n = loop.points.size();
+        for (size_t i = 0; i < (loop.closed ? n : n - 1); ++i) {
+          const Eigen::Vector3d p = loop.points[i], q = loop.points[(i + 1) % n];
+          const int pieces = std::max(1, static_cast<int>(std::ceil((q - p).norm() / 2)));
+          for (int k = 0; k < pieces; ++k) {
+            const Eigen::Vector3d s = p + (q - p) * (static_cast<double>(k) / pieces);
+            const Eigen::Vector3d v = s - lasers[l].at;
+            const double range = v.norm();
+            const int bin = static_cast<int>(std::floor(std::asin(v.y() / range) * 180 / M_PI / 0.05));
+            auto it = first.find(bin);
+            if (it == first.end() || range < it->second.first) first[bin] = {range, s};
+          }
+        }
+      }
+      const Eigen::Vector3d d = sway_scale * true_sway(frame);
+      for (const auto& [bin, hit] : first) {
+        const Eigen::Vector3d p = hit.second + d + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+        cloud.positions.push_back(p.cast<float>());
+        cloud.frame.push_back(frame);
+        cloud.laser.push_back(l);
+      }
+    }
+  }
+  return cloud;
+}
+
+class SubjectSway : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    auto mesh = read_ply_mesh(std::string(BODYSCAN_SOURCE_DIR) + "/hw/sim/bodies/male_average.ply");
+    ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+    body_ = new TriangleMesh(std::move(*mesh));
+    distance_ = new MeshDistance(*body_);
+  }
+  static void TearDownTestSuite() {
+    delete distance_;
+    delete body_;
+  }
+  static TriangleMesh* body_;
+  static MeshDistance* distance_;
+};
+TriangleMesh* SubjectSway::body_ = nullptr;
+MeshDistance* SubjectSway::distance_ = nullptr;
+
+TEST_F(SubjectSway, FindsTheSwayBetweenSweepsAndUndoesIt) {
+  PointCloud cloud = swept_body(*body_, 1.0);
+  auto sway = estimate_sway(cloud);
+  ASSERT_TRUE(sway.ok()) << sway.status().message();
+  ASSERT_FALSE(sway->empty());
+  EXPECT_GT(sway->pairs, 10000u);
+  // Where the sweeps meet, they agree once the sway is undone.
+  EXPECT_GT(sway->rms_before_mm, 1.5);
+  EXPECT_LT(sway->rms_after_mm, 0.5);
+  // The path, both taken to mean zero over the scan: 2.6 mm RMS of true sway.
+  const int frames = 4 * 351;
+  Eigen::Vector3d mean_true = Eigen::Vector3d::Zero(), mean_est = Eigen::Vector3d::Zero();
+  for (int f = 0; f < frames; ++f) mean_true += true_sway(f), mean_est += sway->at(f);
+  mean_true /= frames;
+  mean_est /= frames;
+  double err = 0, amplitude = 0;
+  for (int f = 0; f < frames; ++f) {
+    err += ((sway->at(f) - mean_est) - (true_sway(f) - mean_true)).squaredNorm();
+    amplitude += (true_sway(f) - mean_true).squaredNorm();
+  }
+  err = std::sqrt(err / frames);
+  amplitude = std::sqrt(amplitude / frames);
+  EXPECT_GT(amplitude, 2.4);
+  EXPECT_LT(err, 0.45 * amplitude) << "path error " << err << " mm against " << amplitude << " mm of sway";
+  // The body's shape comes back: the points lie on the still body.
+  const double before = testing::rms_distance_after_shift(cloud, *distance_);
+  undo_sway(cloud, *sway);
+  const double after = testing::rms_distance_after_shift(cloud, *distance_);
+  EXPECT_GT(before, 1.3);
+  EXPECT_LT(after, 0.6 * before) << before << " -> " << after << " mm";
+  EXPECT_LT(after, 0.7);
+}
+
+TEST_F(SubjectSway, AStillBodyStaysPut) {
+  PointCloud cloud = swept_body(*body_, 0.0);
+  const double before = testing::rms_distance_after_shift(cloud, *distance_);
+  auto sway = estimate_sway(cloud);
+  ASSERT_TRUE(sway.ok()) << sway.status().message();
+  // Nothing moved: what it finds is the noise's (0.2 mm per axis; the pairs' RMS
+  // is 0.33 mm), not a sway.
+  EXPECT_LT(sway->peak_mm, 0.5);
+  undo_sway(cloud, *sway);
+  EXPECT_LT(testing::rms_distance_after_shift(cloud, *distance_), before + 0.02);
+}
+
+TEST(SubjectSwayInput, NeedsEachPointsFrameAndLaser) {
+  PointCloud c;
+  c.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0)};
+  c.frame = {0, 100};
+  auto r = estimate_sway(c);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("frame and laser"), std::string::npos);
+  // One moment: nothing to compare, nothing moved.
+  c.laser = {0, 0};
+  c.frame = {5, 5};
+  auto one = estimate_sway(c);
+  ASSERT_TRUE(one.ok());
+  EXPECT_TRUE(one->empty());
+  undo_sway(c, *one);
+  EXPECT_EQ(c.positions[1], Vec3f(1, 0, 0));
+  // Unknown frames are left where they are.
+  c.frame = {kUnknownSource, kUnknownSource};
+  auto none = estimate_sway(c);
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->empty());
+}
+
+}  // namespace
+}  // namespace bodyscan
