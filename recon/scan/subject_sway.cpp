@@ -51,8 +51,6 @@ double residual(const Pair& p, const std::vector<Eigen::Vector3d>& x) {
   return r;
 }
 
-// The pairs at the current sway: each anchor against every other sweep's plane
-// within the radius.
 // The median distance from a point to the nearest point of its laser's next or
 // previous stripe (another frame of the same laser), over a sample of the anchors.
 double stripe_spacing(const PointCloud& cloud, const KnnIndex& index, const std::vector<size_t>& anchors) {
@@ -157,9 +155,14 @@ bool local_height(const PointCloud& cloud, const std::vector<Vec3f>& moved, size
   return false;
 }
 
+// The pairs at the current sway: each anchor against the other sweeps' points among
+// `candidates` (every point, or an even share of a dense cloud).
 std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& moved, const std::vector<size_t>& anchors,
-                             const Knots& knots, const SwayOptions& o, float radius, const std::vector<Eigen::Vector3d>& x) {
-  const KnnIndex index(moved);
+                             const std::vector<uint32_t>& candidates, const Knots& knots, const SwayOptions& o,
+                             float radius, const std::vector<Eigen::Vector3d>& x) {
+  std::vector<Vec3f> at(candidates.size());
+  for (size_t c = 0; c < candidates.size(); ++c) at[c] = moved[candidates[c]];
+  const KnnIndex index(at);
   std::vector<std::vector<Pair>> found(anchors.size());
   const bool has_conf = cloud.has_confidence();
   tbb::parallel_for(size_t{0}, anchors.size(), [&](size_t a) {
@@ -169,7 +172,8 @@ std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& 
     // Group the other moments' points by laser (one laser sweeps once, so its points
     // near here were seen at nearly one moment).
     std::vector<std::pair<int32_t, uint32_t>> other;
-    for (const auto& [j, d2] : near) {
+    for (const auto& [c, d2] : near) {
+      const uint32_t j = candidates[c];
       const int fj = cloud.frame[j];
       if (fj < 0 || std::abs(fj - fi) < o.min_frame_gap) continue;
       other.emplace_back(cloud.laser[j], j);
@@ -237,10 +241,14 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   const float radius = static_cast<float>(est.radius_mm);
 
   std::vector<Eigen::Vector3d> x(m, Eigen::Vector3d::Zero());
+  std::vector<uint32_t> candidates;
+  const size_t every = std::max<size_t>(1, (n + o.max_candidates - 1) / std::max<size_t>(1, o.max_candidates));
+  for (size_t i = 0; i < n; i += every)
+    if (cloud.frame[i] >= 0) candidates.push_back(static_cast<uint32_t>(i));
   std::vector<Vec3f> moved = cloud.positions;
   std::vector<Pair> pairs;
   for (int it = 0; it < o.iterations; ++it) {
-    pairs = find_pairs(cloud, moved, anchors, knots, o, radius, x);
+    pairs = find_pairs(cloud, moved, anchors, candidates, knots, o, radius, x);
     if (it == 0) {
       double ss = 0, sw = 0;
       for (const Pair& p : pairs) {

@@ -37,9 +37,10 @@ struct SwayOptions {
   // its stripes N times farther apart), so that it holds two stripes of each sweep.
   float radius_mm = 8.f;
   int min_frame_gap = 30;       // moments closer than this (frames) are taken as one
-  size_t max_anchors = 60000;   // points whose neighbourhoods are examined, spread over the scan
+  size_t max_anchors = 30000;   // points whose neighbourhoods are examined, spread over the scan
+  size_t max_candidates = 500000;  // points their neighbourhoods are drawn from (an even share of a denser cloud)
   size_t min_group = 6;         // points of the other sweep needed for its local plane
-  int iterations = 4;           // re-pairings
+  int iterations = 3;           // re-pairings
   double smoothness = 0.01;     // weight of the path's second differences, relative to the data
   double ridge = 0.003;        // weight of the sway itself (pulls knots without data to zero), relative
   double huber_mm = 0.75;       // residuals beyond this count linearly
