@@ -66,8 +66,8 @@ void print_sway(const pipeline::ScanStats& scan) {
   if (!scan.sway.empty()) {
     std::printf("sway: up to %.1f mm, undone; where sweeps meet they differ by %.2f mm RMS (%.2f as measured)\n",
                 scan.sway.peak_mm, scan.sway.rms_after_mm, scan.sway.rms_before_mm);
-  } else if (!scan.sway_error.empty()) {
-    std::printf("sway: not estimated (%s); the cloud is as measured\n", scan.sway_error.c_str());
+  } else if (!scan.sway_not_estimated.empty()) {
+    std::printf("sway: not estimated (%s); the cloud is as measured\n", scan.sway_not_estimated.c_str());
   }
 }
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <tbb/parallel_for.h>
 
 #include "recon/spatial/knn_index.hpp"
@@ -221,7 +222,10 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   int fmin = INT32_MAX, fmax = INT32_MIN;
   for (int32_t f : cloud.frame)
     if (f >= 0) fmin = std::min(fmin, f), fmax = std::max(fmax, f);
-  if (fmin > fmax || fmax - fmin < o.min_frame_gap) return est;
+  if (fmin > fmax || fmax - fmin < o.min_frame_gap) {
+    est.not_estimated = "the scan's points were all seen within " + std::to_string(o.min_frame_gap) + " frames";
+    return est;
+  }
   Knots knots{fmin, o.knot_frames, (fmax - fmin) / o.knot_frames + 2};
   est.first_frame = fmin;
   const size_t m = static_cast<size_t>(knots.count);
@@ -236,6 +240,17 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   {
     const KnnIndex index(cloud.positions);
     est.stripe_spacing_mm = stripe_spacing(cloud, index, anchors);
+  }
+  if (est.stripe_spacing_mm > o.max_stripe_spacing_mm) {
+    char why[160];
+    std::snprintf(why, sizeof why, "the stripes are %.0f mm apart, more than %.0f: scan more steps", est.stripe_spacing_mm,
+                  o.max_stripe_spacing_mm);
+    est.not_estimated = why;
+    return est;
+  }
+  if (est.stripe_spacing_mm <= 0) {
+    est.not_estimated = "no laser's stripes lie side by side";
+    return est;
   }
   est.radius_mm = std::max<double>(o.radius_mm, 2.5 * est.stripe_spacing_mm);
   const float radius = static_cast<float>(est.radius_mm);
@@ -309,8 +324,12 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
                                      : cloud.positions[i];
     });
   }
-  est.knots = x;
   est.pairs = pairs.size();
+  if (pairs.empty()) {
+    est.not_estimated = "no two sweeps saw the same skin";
+    return est;
+  }
+  est.knots = x;
   double ss = 0, sw = 0;
   for (const Pair& p : pairs) {
     const double r = std::min(std::abs(residual(p, x)), o.max_residual_mm);

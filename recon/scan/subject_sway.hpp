@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "recon/core/status.hpp"
@@ -46,6 +47,9 @@ struct SwayOptions {
   double huber_mm = 0.75;       // residuals beyond this count linearly
   double max_residual_mm = 6;   // pairs farther apart than this are not the same skin
   bool vertical = false;        // also estimate a vertical sway (off: posture moves sideways)
+  // Stripes farther apart than this (a scan of every 5th step or coarser on the
+  // thesis rig) leave too little overlap to tell sway from shape: not estimated.
+  double max_stripe_spacing_mm = 16;
 };
 
 struct SwayEstimate {
@@ -57,6 +61,7 @@ struct SwayEstimate {
   double stripe_spacing_mm = 0;          // median distance between a sweep's neighbouring stripes
   double rms_before_mm = 0, rms_after_mm = 0;  // of those pairs' distances (robust RMS)
   double peak_mm = 0;                    // largest |sway| over the knots
+  std::string not_estimated;             // when empty(): why (nothing to compare, stripes too far apart)
 
   // The sway at `frame` (linear between knots, constant beyond the ends).
   Eigen::Vector3d at(double frame) const;
@@ -64,8 +69,8 @@ struct SwayEstimate {
 };
 
 // Needs positions, frame and laser per point (confidence optional). A cloud whose
-// points come from fewer than two moments far enough apart yields an empty
-// estimate (nothing to compare), not an error.
+// points come from fewer than two moments far enough apart, or whose stripes lie
+// too far apart, yields an empty estimate saying why, not an error.
 StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions& options = {});
 
 // Moves every point back by the sway at its frame. Points of unknown frame stay.

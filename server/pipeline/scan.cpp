@@ -178,14 +178,15 @@ StatusOr<PointCloud> ScanProcessor::finish() {
   for (const CameraCalibration& c : cal_.cameras) cloud.camera_centres.push_back(c.centre.cast<float>());
   records_.clear();
   stats_.sway = {};
-  stats_.sway_error.clear();
+  stats_.sway_not_estimated.clear();
   if (options_.compensate_sway) {
     auto sway = estimate_sway(cloud, options_.sway);
     if (sway.ok()) {
       undo_sway(cloud, *sway);
+      stats_.sway_not_estimated = sway->not_estimated;
       stats_.sway = std::move(*sway);
     } else {
-      stats_.sway_error = sway.status().message();
+      stats_.sway_not_estimated = sway.status().message();
     }
   }
   if (options_.view.max_view_deg < 90) stats_.points_grazing = weigh_by_view_angle(cloud, options_.view).dropped;

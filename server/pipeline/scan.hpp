@@ -71,7 +71,7 @@ struct ScanStats {
   size_t points_grazing = 0;        // dropped for a grazing view (ScanOptions::view)
   std::vector<LaserSweepReport> sweeps;
   SwayEstimate sway;                // empty when not compensated
-  std::string sway_error;           // why the sway estimate failed (the cloud is kept as measured)
+  std::string sway_not_estimated;   // why there is no sway estimate (the cloud is kept as measured)
   double processing_seconds = 0;    // frames to points, acquisition excluded
   std::string first_plane_error;    // the first frame without a plane, for the log
 };

@@ -170,8 +170,8 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
                  {"first_frame", w.first_frame},
                  {"knot_frames", w.knot_frames},
                  {"path_mm", path}};
-  } else if (!r.scan.sway_error.empty()) {
-    j["sway_error"] = r.scan.sway_error;
+  } else if (!r.scan.sway_not_estimated.empty()) {
+    j["sway_not_estimated"] = r.scan.sway_not_estimated;
   }
   if (!r.surface_error.empty()) j["surface_error"] = r.surface_error;
   if (!r.measure_error.empty()) j["measure_error"] = r.measure_error;

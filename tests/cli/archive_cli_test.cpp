@@ -39,6 +39,13 @@ TEST(ArchiveCli, AScanIsArchivedAndMadeAgainFromItsRawRecord) {
   const CliResult again = bodyscan("reprocess " + D + " --out " + E + " --no-surface", dir);
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_EQ(slurp(dir + "/D/points.ply"), slurp(dir + "/E/points.ply"));
+  // --keep-sway: the sway is not looked for (every 12th step is too coarse to find
+  // it anyway, and says so; ScanJob.ASwayingSubjectsSwayIsFoundAndUndone has one).
+  const std::string K = quote(dir + "/K");
+  const CliResult kept = bodyscan("reprocess " + D + " --out " + K + " --no-surface --keep-sway", dir);
+  ASSERT_EQ(kept.exit_code, 0) << kept.err;
+  EXPECT_FALSE(nlohmann::json::parse(slurp(dir + "/K/scan.json")).contains("sway_not_estimated"));
+  EXPECT_TRUE(nlohmann::json::parse(slurp(dir + "/E/scan.json")).contains("sway_not_estimated"));
 
   const CliResult list = bodyscan("archive " + A + " list", dir);
   ASSERT_EQ(list.exit_code, 0) << list.err;

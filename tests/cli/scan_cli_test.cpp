@@ -28,6 +28,10 @@ TEST(ScanCli, CalibratesScansAndWritesTheCloudAndFigures) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/scan/mesh.ply"));  // --no-surface
   EXPECT_EQ(scan["points_grazing"].get<size_t>(), 0u);              // off by default
   EXPECT_TRUE(cloud->cloud.normals.empty());
+  // Every 12th step leaves the stripes 42 mm apart: too far to tell sway from shape.
+  EXPECT_FALSE(scan.contains("sway"));
+  EXPECT_NE(scan.value("sway_not_estimated", "").find("stripes are"), std::string::npos) << scan.dump(1);
+  EXPECT_NE(r.out.find("sway: not estimated"), std::string::npos) << r.out;
 
   // --max-view drops what the cameras saw edge-on and leaves normals facing them.
   const CliResult v =

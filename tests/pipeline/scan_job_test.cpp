@@ -98,7 +98,7 @@ TEST(ScanJob, ASwayingSubjectsSwayIsFoundAndUndone) {
   auto result = run_scan_job(rig_handle(**rig), options);
   ASSERT_TRUE(result.ok()) << result.status().message();
   const SwayEstimate& sway = result->scan.sway;
-  ASSERT_FALSE(sway.empty()) << result->scan.sway_error;
+  ASSERT_FALSE(sway.empty()) << result->scan.sway_not_estimated;
   // Every 4th step: stripes 4 times as far apart, and the neighbourhood with them.
   EXPECT_GT(sway.stripe_spacing_mm, 10);
   EXPECT_GT(sway.radius_mm, 2.4 * sway.stripe_spacing_mm);
