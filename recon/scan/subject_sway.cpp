@@ -14,9 +14,11 @@
 namespace bodyscan {
 namespace {
 
-// One point against another sweep's local plane. With the sway x (knot values),
-// its distance is r0 - n . (x(frame of the point) - mean of x(frames of the plane's
-// points)); the frames enter through the knots' hat weights.
+// One point against another sweep's local surface. With the sway x (knot values),
+// its height above that surface is r0 - n . (x(frame of the point) - sum_j c_j
+// x(frame of point j)), the c_j being how much each of the surface's points weighs
+// in its height there (they sum to 1); the frames enter through the knots' hat
+// weights.
 struct Pair {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   double r0 = 0;      // the distance as measured, mm
@@ -305,8 +307,9 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
           for (int b = 0; b < 3; ++b) ata(idx[a], idx[b]) += lambda * c[a] * c[b];
       }
     }
-    // Mean zero (the scan cannot tell where the body stands on average), and a hair
-    // of ridge so that knots nothing constrains stay put.
+    // Mean zero (the scan cannot tell where the body stands on average), and a
+    // small weight on the sway itself, which holds the directions the pairs cannot
+    // see (and knots nothing constrains) near zero instead of letting them drift.
     for (size_t d = 0; d < dims; ++d)
       for (size_t a = 0; a < m; ++a)
         for (size_t b = 0; b < m; ++b)
@@ -326,6 +329,7 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   }
   est.pairs = pairs.size();
   if (pairs.empty()) {
+    est.knots.clear();
     est.not_estimated = "no two sweeps saw the same skin";
     return est;
   }

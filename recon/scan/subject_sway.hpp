@@ -7,9 +7,9 @@
 //
 // Here the sway is estimated from the scan itself and undone. Each point keeps its
 // frame (its moment). Where a sweep's point lies on skin another sweep saw at a
-// clearly different moment, the distance from the point to that sweep's local
-// plane, along the plane's normal, is the sway between the two moments along that
-// normal. Over a scan that is tens of thousands of such differences, from skin that
+// clearly different moment, the point's height above that sweep's local surface
+// (a small quadratic height field), along its normal, is the sway between the two
+// moments along that normal. Over a scan that is tens of thousands of such differences, from skin that
 // faces every way, and one smooth horizontal path through time - a piecewise-linear
 // curve with a knot every few frames, its second differences penalised - explains
 // them best (robust least squares, re-paired a few times as the sweeps come
@@ -17,8 +17,9 @@
 //
 // What the scan cannot tell: a sway that moves every pair of overlapping moments
 // alike (e.g. one sweep alone moving sideways along a flat patch), and any sway
-// between moments whose sweeps see no common skin. The smoothness term carries the
-// estimate across those; docs/scan-processing.md ("Sway") has the figures.
+// between moments whose sweeps see no common skin. A small weight on the sway itself
+// holds those near zero, and the smoothness term carries the path across;
+// docs/scan-processing.md ("The subject's sway") has the figures.
 #pragma once
 
 #include <Eigen/Core>
@@ -40,10 +41,10 @@ struct SwayOptions {
   int min_frame_gap = 30;       // moments closer than this (frames) are taken as one
   size_t max_anchors = 30000;   // points whose neighbourhoods are examined, spread over the scan
   size_t max_candidates = 500000;  // points their neighbourhoods are drawn from (an even share of a denser cloud)
-  size_t min_group = 6;         // points of the other sweep needed for its local plane
+  size_t min_group = 6;         // points of the other sweep needed for its local surface
   int iterations = 3;           // re-pairings
   double smoothness = 0.01;     // weight of the path's second differences, relative to the data
-  double ridge = 0.003;        // weight of the sway itself (pulls knots without data to zero), relative
+  double ridge = 0.003;         // weight of the sway itself, relative: holds what the pairs cannot see near zero
   double huber_mm = 0.75;       // residuals beyond this count linearly
   double max_residual_mm = 6;   // pairs farther apart than this are not the same skin
   bool vertical = false;        // also estimate a vertical sway (off: posture moves sideways)
