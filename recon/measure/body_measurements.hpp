@@ -35,7 +35,7 @@
 
 namespace bodyscan {
 
-inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-2";
+inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-3";
 
 struct BodyLandmark {
   std::string name;  // e.g. "crotch", "armpit_left", "back_neck_point"
