@@ -114,15 +114,6 @@ Eigen::Vector3d middle_of_extreme(const std::vector<Eigen::Vector3d>& pts, const
   return best;
 }
 
-// On a front profile sampled as (y, z), each sample's depth in front of (+) or behind
-// (−) the chord joining its ends. The deepest is a notch (the front neck point, the
-// fold under the bust); the ends count, at depth 0.
-std::vector<double> depth_behind_chord(const std::vector<Eigen::Vector2d>& c) {
-  const Eigen::Vector2d a = c.front(), e = c.back();
-  std::vector<double> depth;
-  for (const Eigen::Vector2d& q : c) depth.push_back(q.y() - (a.y() + (q.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y())));
-  return depth;
-}
 
 // Least-squares line through points: (centre, unit direction with y >= 0).
 std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Vector3d>& p, size_t b, size_t e,
@@ -178,6 +169,28 @@ std::optional<double> parabola_vertex(const std::vector<double>& x, const std::v
 size_t arg_extreme(const std::vector<double>& v, bool largest) {
   return static_cast<size_t>((largest ? std::max_element(v.begin(), v.end()) : std::min_element(v.begin(), v.end())) -
                              v.begin());
+}
+
+// A notch in a front profile sampled as (y, z) from top to bottom (the front neck
+// point, the fold under the bust): the sample lying farthest behind (at smaller Z
+// than) the chord joining the profile's ends, which count at depth 0; its depth
+// (<= 0, mm); and the vertex of a parabola fitted to the depths over `half` of y
+// either side (parabola_vertex), where the fit finds one.
+struct Notch {
+  size_t k = 0;
+  double depth = 0;
+  std::optional<double> vertex_y;
+};
+Notch deepest_behind_chord(const std::vector<Eigen::Vector2d>& c, double half) {
+  const Eigen::Vector2d a = c.front(), e = c.back();
+  std::vector<double> ys, depth;
+  for (const Eigen::Vector2d& q : c)
+    ys.push_back(q.x()), depth.push_back(q.y() - (a.y() + (q.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y())));
+  Notch n;
+  n.k = arg_extreme(depth, false);
+  n.depth = depth[n.k];
+  n.vertex_y = parabola_vertex(ys, depth, n.k, half, true);
+  return n;
 }
 
 // The corner of a smooth curve sampled as (x[i], v[i]) and walked until v passed
@@ -507,12 +520,9 @@ class Finder {
       // profile's bottom is flat over 10-15 mm, and its deepest sample moved 6 mm under
       // +-0.5 mm of skin noise: refined to the vertex of a parabola fitted to the depth
       // over 2 % of the height either side, as the knee.
-      const std::vector<double> depth = depth_behind_chord(curve);
-      std::vector<double> ys;
-      for (const Eigen::Vector2d& q : curve) ys.push_back(q.x());
-      const size_t k = arg_extreme(depth, false);
-      front = {xc_, curve[k].x(), curve[k].y()};
-      if (const std::optional<double> yv = parabola_vertex(ys, depth, k, 0.02 * h_, true)) {
+      const Notch notch = deepest_behind_chord(curve, 0.02 * h_);
+      front = {xc_, curve[notch.k].x(), curve[notch.k].y()};
+      if (const std::optional<double> yv = notch.vertex_y) {
         for (size_t i = 0; i + 1 < curve.size(); ++i)
           if (curve[i].x() >= *yv && *yv >= curve[i + 1].x()) {
             const double t = (curve[i].x() - *yv) / (curve[i].x() - curve[i + 1].x());
@@ -565,20 +575,15 @@ class Finder {
       }
       underbust_y_ = bust_y_ - 0.05 * h_;
       if (curve.size() >= 3) {
-        const std::vector<double> depth = depth_behind_chord(curve);
-        const size_t k = arg_extreme(depth, false);
-        underbust_y_ = curve[k].x();
+        const Notch notch = deepest_behind_chord(curve, 0.02 * h_);
+        underbust_y_ = curve[notch.k].x();
         // A shallow fold (a man's: 0-6 mm behind the chord, against 17-46 mm under a
         // woman's breast) is flat at the bottom, and its deepest sample is the skin
         // noise's: it moved 10 mm between two scans of male_average. There the vertex
         // of a parabola over 2 % of the height either side stands (within 3 mm on four
         // scans). A deep fold is a crease, steep above and gentle below, where that
         // vertex would slide 6-12 mm down the ribs; there the deepest sample stands.
-        if (depth[k] > -kShallowFoldMm) {
-          std::vector<double> ys;
-          for (const Eigen::Vector2d& q : curve) ys.push_back(q.x());
-          if (const std::optional<double> yv = parabola_vertex(ys, depth, k, 0.02 * h_, true)) underbust_y_ = *yv;
-        }
+        if (notch.depth > -kShallowFoldMm && notch.vertex_y) underbust_y_ = *notch.vertex_y;
       }
       landmark("underbust_front_point", {xc_, underbust_y_, front_z(underbust_y_)});
     }
