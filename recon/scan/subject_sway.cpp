@@ -54,6 +54,16 @@ double residual(const Pair& p, const std::vector<Eigen::Vector3d>& x) {
   return r;
 }
 
+// The pairs' weighted RMS distance at the sway x, each distance capped at `cap`.
+double pair_rms(const std::vector<Pair>& pairs, const std::vector<Eigen::Vector3d>& x, double cap) {
+  double ss = 0, sw = 0;
+  for (const Pair& p : pairs) {
+    const double r = std::min(std::abs(residual(p, x)), cap);
+    ss += p.weight * r * r, sw += p.weight;
+  }
+  return sw > 0 ? std::sqrt(ss / sw) : 0;
+}
+
 // The median distance from a point to the nearest point of its laser's next or
 // previous stripe (another frame of the same laser), over a sample of the anchors.
 double stripe_spacing(const PointCloud& cloud, const KnnIndex& index, const std::vector<size_t>& anchors) {
@@ -266,14 +276,7 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   std::vector<Pair> pairs;
   for (int it = 0; it < o.iterations; ++it) {
     pairs = find_pairs(cloud, moved, anchors, candidates, knots, o, radius, x);
-    if (it == 0) {
-      double ss = 0, sw = 0;
-      for (const Pair& p : pairs) {
-        const double r = std::min(std::abs(p.r0), o.max_residual_mm);
-        ss += p.weight * r * r, sw += p.weight;
-      }
-      est.rms_before_mm = sw > 0 ? std::sqrt(ss / sw) : 0;
-    }
+    if (it == 0) est.rms_before_mm = pair_rms(pairs, x, o.max_residual_mm);  // x is zero: as measured
     if (pairs.empty()) break;
     // Robust weights at the current sway; then the normal equations.
     Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(unknowns), static_cast<Eigen::Index>(unknowns));
@@ -334,12 +337,7 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
     return est;
   }
   est.knots = x;
-  double ss = 0, sw = 0;
-  for (const Pair& p : pairs) {
-    const double r = std::min(std::abs(residual(p, x)), o.max_residual_mm);
-    ss += p.weight * r * r, sw += p.weight;
-  }
-  est.rms_after_mm = sw > 0 ? std::sqrt(ss / sw) : 0;
+  est.rms_after_mm = pair_rms(pairs, x, o.max_residual_mm);
   for (const Eigen::Vector3d& k : x) est.peak_mm = std::max(est.peak_mm, k.norm());
   return est;
 }
