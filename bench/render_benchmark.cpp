@@ -4,7 +4,10 @@
 // separately the calibration sequence (the dot grid before each camera, the frame
 // lights, each laser alone).
 //
-//   render_benchmark [--rig thesis|square|FILE] [--every N]
+//   render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM]
+//
+// --sway makes the subject sway (docs/simulated-rig.md), so every frame is posed
+// and cast anew.
 //
 // Prints frames, wall time, frames per second and the time for the whole scan.
 #include <chrono>
@@ -12,6 +15,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "hw/sim/sim_rig.hpp"
 #include "server/pipeline/acquire.hpp"
 #include "server/pipeline/rig_backend.hpp"
 
@@ -20,12 +24,14 @@ using namespace bodyscan;
 int main(int argc, char** argv) {
   std::string rig_name = "thesis";
   int every = 1;
+  double sway = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--rig" && i + 1 < argc) rig_name = argv[++i];
     else if (a == "--every" && i + 1 < argc) every = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--sway" && i + 1 < argc) sway = std::atof(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: render_benchmark [--rig thesis|square|FILE] [--every N]\n");
+      std::fprintf(stderr, "usage: render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM]\n");
       return 2;
     }
   }
@@ -33,6 +39,18 @@ int main(int argc, char** argv) {
   const auto t0 = Clock::now();
   auto sim = pipeline::open_simulated_rig(rig_name, "");
   if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
+  if (sway > 0) {
+    // The same description, its subject swaying.
+    auto path = rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos
+                    ? hw::shipped_rig_path(rig_name)
+                    : StatusOr<std::string>(rig_name);
+    if (!path.ok()) return std::fprintf(stderr, "%s\n", path.status().message().c_str()), 1;
+    auto d = hw::load_rig_description(*path);
+    if (!d.ok()) return std::fprintf(stderr, "%s\n", d.status().message().c_str()), 1;
+    d->simulation.motion.sway_mm = sway;
+    sim = hw::sim::SimulatedRig::create(*d);
+    if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
+  }
   const pipeline::Rig rig = pipeline::rig_handle(**sim);
   const hw::RigDescription& desc = *rig.description;
   size_t frames = 0;
@@ -53,6 +71,7 @@ int main(int argc, char** argv) {
   auto secs = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
   const size_t scan_frames = frames - calibration_frames;
   const auto& cam = desc.cameras[0];
+  if (sway > 0) std::printf("the subject sways %.1f mm\n", sway);
   std::printf("rig %s: %zu cameras of %dx%d, %zu lasers in %zu groups, %.0f frames/s cameras\n", desc.name.c_str(),
               desc.cameras.size(), cam.width, cam.height, desc.lasers.size(), desc.laser_groups.size(),
               desc.simulation.frame_rate_hz);
