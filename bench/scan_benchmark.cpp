@@ -60,12 +60,13 @@ Quantiles quantiles(std::vector<double> v) {
 }
 
 double g_min_angle = 10;
-int g_smooth = 3;
+int g_smooth = TriangulateOptions{}.smooth_rows;
 int g_threshold = 0;
 float g_redundant = 4;
 float g_weak = -1;
 int g_radius = -1;
 double g_max_view = -1;
+bool g_keep_sway = false;
 
 int run(const std::string& rig_name, const std::string& body, int every) {
   auto sim = pipeline::open_simulated_rig(rig_name, body);
@@ -142,6 +143,7 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       if (g_radius >= 0) o.triangulate.stripe.radius = g_radius;
       if (g_threshold > 0) o.triangulate.stripe.threshold = g_threshold;
       o.redundant_radius_mm = g_redundant;
+      o.compensate_sway = !g_keep_sway;
       if (g_weak >= 0) o.redundant_weak = g_weak;
       o.view.max_view_deg = g_max_view > 0 ? g_max_view : desc.processing.max_view_deg;
       processors.push_back(std::make_unique<pipeline::ScanProcessor>(*cal, o));
@@ -281,10 +283,86 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       };
       report("confidence", {0.0, 0.1, 0.25, 0.5, 0.75, 1.0 + 1e-6}, confidence);
       report("view (deg)", {0, 60, 70, 75, 80, 85, 90.01}, view);
+      // Each laser's share: the point lies on its estimated plane, so its distance
+      // from the true plane of its step (the nearest of the laser's steps) is the
+      // plane's error there; moved onto the true plane along its normal, what is
+      // left of its distance to the body is the camera's and the stripe's.
+      {
+        std::vector<double> on_body(desc.lasers.size(), 0.0), plane_corrected(desc.lasers.size(), 0.0),
+            plane_off(desc.lasers.size(), 0.0);
+        std::vector<size_t> nl(desc.lasers.size(), 0);
+        for (size_t i = 0; i < dd.size(); ++i) {
+          if (dd[i] > 5) continue;
+          const size_t li = static_cast<size_t>(cloud.laser[i]);
+          const hw::LaserDescription& l = desc.lasers[li];
+          const Eigen::Vector3d p = cloud.positions[i].cast<double>();
+          double best = 1e9;
+          Eigen::Vector3d bn = Eigen::Vector3d::UnitX();
+          for (int st = l.min_step; st <= l.max_step; ++st) {
+            const double e = l.plane_normal(st).dot(p) - l.plane_offset(st);
+            if (std::abs(e) < std::abs(best)) best = e, bn = l.plane_normal(st);
+          }
+          const Eigen::Vector3d q = p - best * bn;
+          // Signed: + where the plane error moves the point out of the body.
+          const ClosestPoint cp = distance.closest_point(cloud.positions[i]);
+          const ClosestPoint cq = distance.closest_point(q.cast<float>());
+          on_body[li] += cp.signed_distance;
+          plane_corrected[li] += cq.signed_distance;
+          plane_off[li] += cp.signed_distance - cq.signed_distance;
+          nl[li]++;
+        }
+        for (size_t li = 0; li < desc.lasers.size(); ++li) {
+          const double n = static_cast<double>(std::max<size_t>(nl[li], 1));
+          std::printf("    laser %-16s %7zu points within 5 mm: signed mean %+.3f mm, of which the plane %+.3f, the rest (camera, stripe) %+.3f\n",
+                      desc.lasers[li].id.c_str(), nl[li], on_body[li] / n, plane_off[li] / n, plane_corrected[li] / n);
+        }
+      }
       std::printf("    signed mean within 5 mm by camera:");
       for (size_t c = 0; c < camera_n.size(); ++c)
         std::printf(" %s %+.3f", cal->cameras[c].camera_id.c_str(),
                     camera_bias[c] / static_cast<double>(std::max<size_t>(camera_n[c], 1)));
+      std::printf("\n");
+    }
+    // The calibration alone: each camera's image-to-laser-plane transform for the
+    // true plane (every 10th step of each laser it sees), applied to where the true
+    // camera sees the true body's vertices on that plane. The signed error along the
+    // body's normal (outside +) is what the calibration adds to a perfect stripe.
+    {
+      std::printf("    calibration alone (true planes, true pixels):");
+      const std::vector<Vec3f> vn = compute_vertex_normals(truth);
+      for (size_t c = 0; c < cal->cameras.size(); ++c) {
+        const CameraCalibration& cc = cal->cameras[c];
+        const hw::CameraModel model = desc.cameras[c].model();
+        double sum = 0, sum_abs = 0;
+        size_t n = 0;
+        for (int li : cal->lasers_seen[c]) {
+          const hw::LaserDescription& l = desc.lasers[static_cast<size_t>(li)];
+          for (int st = l.min_step; st <= l.max_step; st += 10) {
+            LaserPlane plane;
+            if (!complete_plane(cc, l.plane_normal(st), l.plane_offset(st), &plane).ok()) continue;
+            for (size_t v = 0; v < truth.vertices.size(); v += 3) {
+              const Eigen::Vector3d p = truth.vertices[v].cast<double>();
+              if (std::abs(l.plane_normal(st).dot(p) - l.plane_offset(st)) > 1.0) continue;
+              const Eigen::Vector3d to_cam = model.centre() - p;
+              if (vn[v].cast<double>().dot(to_cam.normalized()) < 0.26) continue;  // beyond 75 degrees
+              if (rig.scene().occluded(p + 0.5 * to_cam.normalized(), to_cam.normalized(), to_cam.norm() - 1)) continue;
+              const auto raw = model.project(p);
+              if (!raw) continue;
+              // The vertex lies within 1 mm of the plane: the true point is where its
+              // camera ray meets the plane.
+              const Eigen::Vector3d ray = (p - model.centre()).normalized();
+              const double den = l.plane_normal(st).dot(ray);
+              if (std::abs(den) < 0.17) continue;  // under 10 degrees: no triangulation
+              const Eigen::Vector3d t =
+                  model.centre() + ((l.plane_offset(st) - l.plane_normal(st).dot(model.centre())) / den) * ray;
+              const Eigen::Vector3d q = plane.triangulate(cc, cc.lens.correct(*raw), TriangulationMethod::kLaserHomography);
+              const double e = (q - t).dot(vn[v].cast<double>().normalized());
+              sum += e, sum_abs += std::abs(e), ++n;
+            }
+          }
+        }
+        std::printf(" %s %+.3f (|.| %.3f, %zu)", cc.camera_id.c_str(), n ? sum / n : 0.0, n ? sum_abs / n : 0.0, n);
+      }
       std::printf("\n");
     }
     // Coverage: the share of the body's area within 5 mm of a point, and where the rest is.
@@ -328,11 +406,12 @@ int main(int argc, char** argv) {
     else if (a == "--smooth" && i + 1 < argc) g_smooth = std::atoi(argv[++i]);
     else if (a == "--radius" && i + 1 < argc) g_radius = std::atoi(argv[++i]);
     else if (a == "--max-view" && i + 1 < argc) g_max_view = std::atof(argv[++i]);
+    else if (a == "--keep-sway") g_keep_sway = true;
     else if (a == "--threshold" && i + 1 < argc) g_threshold = std::atoi(argv[++i]);
     else if (a == "--redundant" && i + 1 < argc) g_redundant = static_cast<float>(std::atof(argv[++i]));
     else if (a == "--weak" && i + 1 < argc) g_weak = static_cast<float>(std::atof(argv[++i]));
     else {
-      std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] [--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C]\n");
+      std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] [--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C] [--keep-sway]\n");
       return 2;
     }
   }

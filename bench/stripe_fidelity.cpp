@@ -11,6 +11,12 @@
 // angle in one renderer and not the other is the renderer's.
 //
 //   stripe_fidelity [--rig NAME|FILE] [--body BODY.ply] [--every N] [--sub K] [--radius PX]
+//   [--noisy [--smooth N]]
+//
+// --noisy compares the noise-free image with the frame a camera delivers (sensor
+// noise, speckle, its pixel format), extracted against a base frame and smoothed
+// along the stripe exactly as the scan does, still with the true camera and plane:
+// what the frame itself costs, apart from calibration.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -38,7 +44,8 @@ struct Bins {
   std::vector<double> sum, sum2;
   std::vector<size_t> n;
   std::vector<std::vector<double>> all;
-  Bins() : sum(edges.size() - 1), sum2(edges.size() - 1), n(edges.size() - 1), all(edges.size() - 1) {}
+  Bins()
+      : sum(edges.size() - 1), sum2(edges.size() - 1), n(edges.size() - 1), all(edges.size() - 1) {}
   void add(double view, double err) {
     for (size_t b = 0; b + 1 < edges.size(); ++b)
       if (view >= edges[b] && view < edges[b + 1]) {
@@ -55,8 +62,8 @@ struct Bins {
       for (double e : v) a.push_back(std::abs(e));
       std::sort(v.begin(), v.end());
       std::sort(a.begin(), a.end());
-      std::printf("    %2.0f-%2.0f  %+.3f  %+.3f  %.3f / %.3f  %zu\n", edges[b], edges[b + 1], sum[b] / n[b],
-                  v[v.size() / 2], a[a.size() / 2], a[a.size() * 9 / 10], n[b]);
+      std::printf("    %2.0f-%2.0f  %+.3f  %+.3f  %.3f / %.3f  %zu\n", edges[b], edges[b + 1],
+                  sum[b] / n[b], v[v.size() / 2], a[a.size() / 2], a[a.size() * 9 / 10], n[b]);
     }
   }
 };
@@ -65,8 +72,8 @@ struct Bins {
 // lens's spread and the pixel's integration. The sub-ray's own footprint (1/k of a
 // pixel) on the tangent plane widens the profile as a box: at that scale the
 // surface is flat enough for it.
-double laser_radiance(const Scene& scene, const CameraModel& model, const LaserDescription& l, int step, double px,
-                      double py, int k) {
+double laser_radiance(const Scene& scene, const CameraModel& model, const LaserDescription& l,
+                      int step, double px, double py, int k) {
   const Vec3d n = l.plane_normal(step);
   const double offset = l.plane_offset(step), sigma = l.line_width_mm / 2.354820045;
   const Vec3d aim = Eigen::AngleAxisd(step * l.step_angle_deg * M_PI / 180.0, l.axis) * l.aim;
@@ -108,7 +115,8 @@ double box_gauss(double u, double s) {
 
 std::vector<uint16_t> to_pixels(const std::vector<float>& img) {
   std::vector<uint16_t> out(img.size());
-  for (size_t i = 0; i < img.size(); ++i) out[i] = static_cast<uint16_t>(std::clamp(img[i] * 20000.0f, 0.f, 65535.f));
+  for (size_t i = 0; i < img.size(); ++i)
+    out[i] = static_cast<uint16_t>(std::clamp(img[i] * 20000.0f, 0.f, 65535.f));
   return out;
 }
 
@@ -117,15 +125,28 @@ std::vector<uint16_t> to_pixels(const std::vector<float>& img) {
 int main(int argc, char** argv) {
   std::string rig_name = "tiered", body;
   int every = 12, sub = 8, radius = 4;
+  bool noisy = false;
+  int smooth = 3;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc) rig_name = argv[++i];
-    else if (a == "--body" && i + 1 < argc) body = argv[++i];
-    else if (a == "--every" && i + 1 < argc) every = std::atoi(argv[++i]);
-    else if (a == "--sub" && i + 1 < argc) sub = std::atoi(argv[++i]);
-    else if (a == "--radius" && i + 1 < argc) radius = std::atoi(argv[++i]);
+    if (a == "--rig" && i + 1 < argc)
+      rig_name = argv[++i];
+    else if (a == "--body" && i + 1 < argc)
+      body = argv[++i];
+    else if (a == "--every" && i + 1 < argc)
+      every = std::atoi(argv[++i]);
+    else if (a == "--sub" && i + 1 < argc)
+      sub = std::atoi(argv[++i]);
+    else if (a == "--radius" && i + 1 < argc)
+      radius = std::atoi(argv[++i]);
+    else if (a == "--noisy")
+      noisy = true;
+    else if (a == "--smooth" && i + 1 < argc)
+      smooth = std::atoi(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: stripe_fidelity [--rig NAME|FILE] [--body BODY.ply] [--every N] [--sub K] [--radius PX]\n");
+      std::fprintf(stderr,
+                   "usage: stripe_fidelity [--rig NAME|FILE] [--body BODY.ply] [--every N] [--sub "
+                   "K] [--radius PX] [--noisy [--smooth N]]\n");
       return 2;
     }
   }
@@ -148,8 +169,9 @@ int main(int argc, char** argv) {
   if (!rig.ok()) return std::fprintf(stderr, "%s\n", rig.status().message().c_str()), 1;
   const Scene& scene = (*rig)->scene();
   const MeshDistance truth(scene.subject());
-  std::printf("rig %s, body %s, every %d steps, %dx%d rays per pixel, centroid radius %d\n", desc->name.c_str(),
-              body.empty() ? "(the rig's)" : body.c_str(), every, sub, sub, radius);
+  std::printf("rig %s, body %s, every %d steps, %dx%d rays per pixel, centroid radius %d\n",
+              desc->name.c_str(), body.empty() ? "(the rig's)" : body.c_str(), every, sub, sub,
+              radius);
   Bins shipped_all, reference_all;
   for (size_t c = 0; c < desc->cameras.size(); ++c) {
     const CameraDescription& cam = desc->cameras[c];
@@ -169,64 +191,88 @@ int main(int argc, char** argv) {
           shipped_img[i] = std::max(0.f, with[i] - without[i]);
           lit_mask[i] = shipped_img[i] > 1e-4f;
         }
-        // The reference: the radiance on a k-times finer grid around the stripe, each
-        // pixel then the integral of it against the box convolved with the spread.
-        const int k = sub, sw = w * k;
-        const int reach = static_cast<int>(std::ceil(3 * cam.blur_px + 0.5));
-        std::vector<uint8_t> want(with.size(), 0);
-        for (int y = 0; y < h; ++y)
-          for (int x = 0; x < w; ++x) {
-            if (!lit_mask[static_cast<size_t>(y) * w + x]) continue;
-            for (int dy = -3 - reach; dy <= 3 + reach; ++dy)
-              for (int dx = -3 - reach; dx <= 3 + reach; ++dx) {
-                const int xx = x + dx, yy = y + dy;
-                if (xx >= 0 && yy >= 0 && xx < w && yy < h) want[static_cast<size_t>(yy) * w + xx] = 1;
-              }
-          }
-        std::vector<float> fine(static_cast<size_t>(sw) * h * k, 0.f);
-        tbb::parallel_for(0, h, [&](int y) {
-          for (int x = 0; x < w; ++x) {
-            if (!want[static_cast<size_t>(y) * w + x]) continue;
-            for (int j = 0; j < k; ++j)
-              for (int i = 0; i < k; ++i)
-                fine[static_cast<size_t>(y * k + j) * sw + x * k + i] = static_cast<float>(
-                    laser_radiance(scene, model, l, step, x - 0.5 + (i + 0.5) / k, y - 0.5 + (j + 0.5) / k, k));
-          }
-        });
-        std::vector<double> wt(static_cast<size_t>((2 * reach + 1) * k));
-        for (int q = 0; q < static_cast<int>(wt.size()); ++q)
-          wt[static_cast<size_t>(q)] = box_gauss(-reach - 0.5 + (q + 0.5) / k, cam.blur_px) / k;
-        tbb::parallel_for(0, h, [&](int y) {
-          for (int x = 0; x < w; ++x) {
-            const int lo_x = x - reach, lo_y = y - reach;
-            bool near = false;
-            for (int dy = -3; dy <= 3 && !near; ++dy)
-              for (int dx = -3; dx <= 3 && !near; ++dx) {
-                const int xx = x + dx, yy = y + dy;
-                near = xx >= 0 && yy >= 0 && xx < w && yy < h && lit_mask[static_cast<size_t>(yy) * w + xx];
-              }
-            if (!near) continue;
-            double acc = 0;
-            for (int qy = 0; qy < static_cast<int>(wt.size()); ++qy) {
-              const int fy = lo_y * k + qy;
-              if (fy < 0 || fy >= h * k) continue;
-              for (int qx = 0; qx < static_cast<int>(wt.size()); ++qx) {
-                const int fx = lo_x * k + qx;
-                if (fx < 0 || fx >= sw) continue;
-                acc += wt[static_cast<size_t>(qy)] * wt[static_cast<size_t>(qx)] * fine[static_cast<size_t>(fy) * sw + fx];
-              }
+        if (!noisy) {
+          // The reference: the radiance on a k-times finer grid around the stripe, each
+          // pixel then the integral of it against the box convolved with the spread.
+          const int k = sub, sw = w * k;
+          const int reach = static_cast<int>(std::ceil(3 * cam.blur_px + 0.5));
+          std::vector<uint8_t> want(with.size(), 0);
+          for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+              if (!lit_mask[static_cast<size_t>(y) * w + x]) continue;
+              for (int dy = -3 - reach; dy <= 3 + reach; ++dy)
+                for (int dx = -3 - reach; dx <= 3 + reach; ++dx) {
+                  const int xx = x + dx, yy = y + dy;
+                  if (xx >= 0 && yy >= 0 && xx < w && yy < h)
+                    want[static_cast<size_t>(yy) * w + xx] = 1;
+                }
             }
-            ref_img[static_cast<size_t>(y) * w + x] = static_cast<float>(acc);
-          }
-        });
+          std::vector<float> fine(static_cast<size_t>(sw) * h * k, 0.f);
+          tbb::parallel_for(0, h, [&](int y) {
+            for (int x = 0; x < w; ++x) {
+              if (!want[static_cast<size_t>(y) * w + x]) continue;
+              for (int j = 0; j < k; ++j)
+                for (int i = 0; i < k; ++i)
+                  fine[static_cast<size_t>(y * k + j) * sw + x * k + i] = static_cast<float>(
+                      laser_radiance(scene, model, l, step, x - 0.5 + (i + 0.5) / k,
+                                     y - 0.5 + (j + 0.5) / k, k));
+            }
+          });
+          std::vector<double> wt(static_cast<size_t>((2 * reach + 1) * k));
+          for (int q = 0; q < static_cast<int>(wt.size()); ++q)
+            wt[static_cast<size_t>(q)] = box_gauss(-reach - 0.5 + (q + 0.5) / k, cam.blur_px) / k;
+          tbb::parallel_for(0, h, [&](int y) {
+            for (int x = 0; x < w; ++x) {
+              const int lo_x = x - reach, lo_y = y - reach;
+              bool near = false;
+              for (int dy = -3; dy <= 3 && !near; ++dy)
+                for (int dx = -3; dx <= 3 && !near; ++dx) {
+                  const int xx = x + dx, yy = y + dy;
+                  near = xx >= 0 && yy >= 0 && xx < w && yy < h &&
+                         lit_mask[static_cast<size_t>(yy) * w + xx];
+                }
+              if (!near) continue;
+              double acc = 0;
+              for (int qy = 0; qy < static_cast<int>(wt.size()); ++qy) {
+                const int fy = lo_y * k + qy;
+                if (fy < 0 || fy >= h * k) continue;
+                for (int qx = 0; qx < static_cast<int>(wt.size()); ++qx) {
+                  const int fx = lo_x * k + qx;
+                  if (fx < 0 || fx >= sw) continue;
+                  acc += wt[static_cast<size_t>(qy)] * wt[static_cast<size_t>(qx)] *
+                         fine[static_cast<size_t>(fy) * sw + fx];
+                }
+              }
+              ref_img[static_cast<size_t>(y) * w + x] = static_cast<float>(acc);
+            }
+          });
+        }
         const std::vector<uint16_t> zero(with.size(), 0);
         const ImageView base{zero.data(), w, h};
         StripeOptions so;
         so.radius = radius;
         so.threshold = 40;
         for (int which = 0; which < 2; ++which) {
-          const std::vector<uint16_t> px = to_pixels(which == 0 ? shipped_img : ref_img);
-          auto samples = extract_stripe(ImageView{px.data(), w, h}, base, so, 1 << 30);
+          StatusOr<std::vector<StripeSample>> samples = internal_error("unset");
+          if (which == 1 && noisy) {
+            // As the scan sees it: the camera's frame against the base frame taken
+            // with the lasers off, its threshold, smoothed along the stripe.
+            Exposure e;
+            e.format = cam.pixel_format;
+            e.exposure_us = cam.exposure_us;
+            e.gain_db = cam.gain_db;
+            const uint64_t frame_id = 1000 + static_cast<uint64_t>(step - l.min_step);
+            const Frame f = renderer.render(scene, lit, e, frame_id),
+                        b0 = renderer.render(scene, Lighting{}, e, frame_id + 777);
+            StripeOptions pso;
+            pso.radius = radius;
+            samples = extract_stripe(ImageView{f.pixels.data(), w, h},
+                                     ImageView{b0.pixels.data(), w, h}, pso, f.max_value());
+            if (samples.ok() && smooth > 0) smooth_stripe(*samples, smooth);
+          } else {
+            const std::vector<uint16_t> px = to_pixels(which == 0 ? shipped_img : ref_img);
+            samples = extract_stripe(ImageView{px.data(), w, h}, base, so, 1 << 30);
+          }
           if (!samples.ok()) continue;
           const Vec3d n = l.plane_normal(step);
           const double off = l.plane_offset(step);
@@ -242,7 +288,8 @@ int main(int argc, char** argv) {
             if (cp.distance > 10) continue;  // the frame, or lost
             const Triangle& tri = scene.subject().triangles[cp.triangle];
             const auto& v = scene.subject().vertices;
-            const Vec3d nn = (v[tri[1]] - v[tri[0]]).cross(v[tri[2]] - v[tri[0]]).cast<double>().normalized();
+            const Vec3d nn =
+                (v[tri[1]] - v[tri[0]]).cross(v[tri[2]] - v[tri[0]]).cast<double>().normalized();
             const Vec3d to_cam = (model.centre() - p).normalized();
             const double view = std::acos(std::min(1.0, std::abs(nn.dot(to_cam)))) * 180 / M_PI;
             (which == 0 ? shipped : reference).add(view, cp.signed_distance);
@@ -253,11 +300,11 @@ int main(int argc, char** argv) {
     }
     std::printf("camera %s\n", cam.id.c_str());
     shipped.print("shipped");
-    reference.print("reference");
+    reference.print(noisy ? "frames" : "reference");
     std::fflush(stdout);
   }
   std::printf("all cameras\n");
   shipped_all.print("shipped");
-  reference_all.print("reference");
+  reference_all.print(noisy ? "frames" : "reference");
   return 0;
 }

@@ -103,8 +103,11 @@ void smooth_stripe(std::vector<StripeSample>& samples, int half_window, double m
   std::vector<float> out(n);
   for (size_t i = 0; i < n; ++i) {
     out[i] = samples[i].column;
-    // Walk out from sample i each way while the stripe continues.
-    double s1 = 1, sr = 0, srr = 0, sc = samples[i].column, src = 0;
+    // Walk out from sample i each way while the stripe continues; the sums of a
+    // least-squares parabola in dr = row - row_i (the column relative to sample i's).
+    const double c0 = samples[i].column;
+    double s0 = 1, s1 = 0, s2 = 0, s3 = 0, s4 = 0, t0 = 0, t1 = 0, t2 = 0;
+    int below = 0, above = 0;
     for (int dir : {-1, 1}) {
       size_t prev = i;
       for (long j = static_cast<long>(i) + dir; j >= 0 && j < static_cast<long>(n); j += dir) {
@@ -113,14 +116,27 @@ void smooth_stripe(std::vector<StripeSample>& samples, int half_window, double m
         if (std::abs(dr) > half_window) break;
         const int step = std::abs(a.row - samples[prev].row);
         if (std::abs(a.column - samples[prev].column) > max_step * step) break;
-        s1 += 1, sr += dr, srr += double(dr) * dr, sc += a.column, src += dr * double(a.column);
+        const double r = dr, r2 = r * r, c = a.column - c0;
+        s0 += 1, s1 += r, s2 += r2, s3 += r2 * r, s4 += r2 * r2;
+        t0 += c, t1 += r * c, t2 += r2 * c;
+        (dir < 0 ? below : above) += 1;
         prev = static_cast<size_t>(j);
       }
     }
-    if (s1 < 3) continue;
-    const double det = s1 * srr - sr * sr;
+    if (s0 < 3) continue;
+    if (below >= 2 && above >= 2) {
+      // The parabola's value at dr = 0 (Cramer's rule on the 3x3 normal equations).
+      const double det = s0 * (s2 * s4 - s3 * s3) - s1 * (s1 * s4 - s2 * s3) + s2 * (s1 * s3 - s2 * s2);
+      if (std::abs(det) > 1e-9) {
+        const double num = t0 * (s2 * s4 - s3 * s3) - s1 * (t1 * s4 - s3 * t2) + s2 * (t1 * s3 - s2 * t2);
+        out[i] = static_cast<float>(c0 + num / det);
+        continue;
+      }
+    }
+    // Too near an end of the stripe for a parabola: a straight line.
+    const double det = s0 * s2 - s1 * s1;
     if (det <= 0) continue;
-    out[i] = static_cast<float>((sc * srr - sr * src) / det);  // the line's value at dr = 0
+    out[i] = static_cast<float>(c0 + (t0 * s2 - s1 * t1) / det);
   }
   for (size_t i = 0; i < n; ++i) samples[i].column = out[i];
 }

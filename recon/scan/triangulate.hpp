@@ -36,7 +36,7 @@ struct TriangulateOptions {
   StripeOptions stripe;
   TriangulationMethod method = TriangulationMethod::kLaserHomography;
   int window_pad_px = 8;
-  int smooth_rows = 3;  // smooth_stripe's half window (0: off)
+  int smooth_rows = 5;  // smooth_stripe's half window (0: off)
   double floor_line_mm = 3;
   // The angle between a pixel's ray and the laser plane: the depth error is the
   // stripe's error over its sine. Points seen at less than min_angle_deg are dropped;
