@@ -50,7 +50,8 @@ TEST(RigDescription, ShippedLayoutsLoad) {
     EXPECT_NE(c.id.find(c.position.y() < 600 ? "-low" : "-high"), std::string::npos) << c.id;
   }
   EXPECT_EQ(tiered.frame.width, square.frame.width);
-  EXPECT_EQ(tiered.processing.max_view_deg, square.processing.max_view_deg);
+  EXPECT_EQ(tiered.processing.max_view_deg, 90.0);  // no view cut (docs/rig-description.md)
+  EXPECT_EQ(square.processing.max_view_deg, 90.0);
   EXPECT_FALSE(shipped_rig_path("hexagon").ok());
 }
 
