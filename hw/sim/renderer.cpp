@@ -276,6 +276,17 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
   // The light of the planes at a surface point, for a sample whose area spans ex
   // and ey (mm) on the surface, with a shadow ray of its own toward each laser
   // whose light arrives.
+  // How squarely plane p's laser lights a surface point: 0 where it does not (the
+  // point behind its fan, lit from the other side, or in shadow).
+  auto incidence_of = [&](const LaserPlane& p, const Vec3d& position, const Vec3d& normal) {
+    const Vec3d to_laser = p.laser->position - position;
+    if (p.aim.dot(-to_laser) <= 0) return 0.0;  // behind the laser's fan
+    const Vec3d toward = to_laser.normalized();
+    const double incidence = normal.dot(toward);
+    if (incidence <= 0) return 0.0;  // the laser lights the other side
+    if (scene.occluded(position + 0.05 * normal, toward, to_laser.norm())) return 0.0;  // laser shadow
+    return incidence;
+  };
   auto point_light = [&](const Vec3d& position, const Vec3d& normal, Surface surface, const Vec3d& ex,
                          const Vec3d& ey) {
     double v = 0;
@@ -284,14 +295,9 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
       const double gx = p.normal.dot(ex), gy = p.normal.dot(ey);
       const double var = p.sigma * p.sigma + (gx * gx + gy * gy) / 12.0;
       if (d * d > 16 * var) continue;
-      const LaserDescription& l = *p.laser;
-      const Vec3d to_laser = l.position - position;
-      if (p.aim.dot(-to_laser) <= 0) continue;  // behind the laser's fan
-      const Vec3d toward = to_laser.normalized();
-      const double incidence = normal.dot(toward);
-      if (incidence <= 0) continue;  // the laser lights the other side
-      if (scene.occluded(position + 0.05 * normal, toward, to_laser.norm())) continue;  // laser shadow
-      v += l.power * albedo(surface) * incidence * (p.sigma / std::sqrt(var)) * std::exp(-0.5 * d * d / var);
+      const double incidence = incidence_of(p, position, normal);
+      if (incidence <= 0) continue;
+      v += p.laser->power * albedo(surface) * incidence * (p.sigma / std::sqrt(var)) * std::exp(-0.5 * d * d / var);
     }
     return v;
   };
@@ -332,14 +338,9 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
           const double dc = p.normal.dot(hp) - p.offset;
           const double var = p.sigma * p.sigma + (gx * gx + gy * gy) / (12.0 * k * k);
           if (std::abs(dc) - 0.5 * (std::abs(gx) + std::abs(gy)) > 4 * std::sqrt(var)) continue;
-          const LaserDescription& l = *p.laser;
-          const Vec3d to_laser = l.position - hp;
-          if (p.aim.dot(-to_laser) <= 0) continue;  // behind the laser's fan
-          const Vec3d toward = to_laser.normalized();
-          const double incidence = hn.dot(toward);
-          if (incidence <= 0) continue;  // the laser lights the other side
-          if (scene.occluded(hp + 0.05 * hn, toward, to_laser.norm())) continue;  // laser shadow
-          const double peak = l.power * albedo(hit[pix].surface) * incidence * (p.sigma / std::sqrt(var));
+          const double incidence = incidence_of(p, hp, hn);
+          if (incidence <= 0) continue;
+          const double peak = p.laser->power * albedo(hit[pix].surface) * incidence * (p.sigma / std::sqrt(var));
           for (int j = 0; j < k; ++j)
             for (int i = 0; i < k; ++i) {
               const double d = dc + gx * (-0.5 + (i + 0.5) / k) + gy * (-0.5 + (j + 0.5) / k);
