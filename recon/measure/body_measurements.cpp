@@ -838,12 +838,8 @@ class Finder {
       skip("upper_arm_girth_" + sd, "the " + sd + " arm is too short to follow");
       return;
     }
-    // Wrist: the narrowest cut in the lower part of the arm, above the palm's end.
-    const size_t n = c.size();
-    size_t w = n - 4;
-    for (size_t i = n * 55 / 100; i + 3 < n; ++i)
-      if (g[i] < g[w]) w = i;
-    w = settle(g, w, 1.0);
+    // Wrist: the narrowest cut in the lower part of the arm, above the palm.
+    const size_t w = settle(g, wrist_cut(g, 0.006 * h_), 1.0);
     // Elbow: where the axis bends (two lines fitted to the centroids, wrist to armpit).
     size_t e = w / 2;
     double best = kInf;
@@ -994,6 +990,26 @@ class Finder {
 };
 
 }  // namespace
+
+size_t wrist_cut(const std::vector<double>& g, double palm_rise) {
+  const size_t n = g.size();
+  if (n < 4) return 0;
+  const size_t from = std::min(n * 55 / 100, n - 4);
+  size_t w = n - 4;
+  for (size_t i = from; i + 3 < n; ++i)
+    if (g[i] < g[w]) w = i;
+  // Between there and the narrowest, the largest widening over the narrowest above it.
+  size_t low = from, palm = from;
+  double rise = 0;
+  for (size_t i = from; i < w; ++i) {
+    if (g[i] < g[low]) low = i;
+    if (g[i] - g[low] > rise) rise = g[i] - g[low], palm = i;
+  }
+  if (rise <= palm_rise) return w;
+  return static_cast<size_t>(std::min_element(g.begin() + static_cast<std::ptrdiff_t>(from),
+                                              g.begin() + static_cast<std::ptrdiff_t>(palm)) -
+                             g.begin());
+}
 
 StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeasureOptions& options) {
   BodyMeasurements out;

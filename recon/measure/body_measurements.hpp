@@ -83,4 +83,12 @@ struct BodyMeasurements {
 // cannot be told apart; single measurements that fail are listed in `skipped`.
 StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeasureOptions& options = {});
 
+// The wrist among an arm's horizontal cuts, armpit downwards (`girths`: their tapes,
+// mm), as an index: the narrowest in the lower 45 % above the last three cuts. A
+// scan can fuse the fingers, so that the arm's track runs on past the palm into
+// them, and they are narrower than the wrist. Where the cuts widen by more than
+// `palm_rise` over the narrowest above them (the palm), the wrist is the narrowest
+// above that rise. measure_body passes 0.6 % of the stature.
+size_t wrist_cut(const std::vector<double>& girths, double palm_rise);
+
 }  // namespace bodyscan

@@ -249,6 +249,31 @@ TEST(BodyMeasurements, TheKneeStaysPutUnderTheScansNoise) {
   }
 }
 
+TEST(BodyMeasurements, TheWristIsAboveThePalmWhenAScanFusesTheFingers) {
+  // An arm's horizontal cuts, armpit downwards, every 3 mm (tapes in mm): the upper
+  // arm, the forearm narrowing to the wrist at cut 60, the palm widening to 306 mm by
+  // cut 67. Shaped on a thesis-rig scan of female_heavy whose fingers the surface
+  // fused, so the track ran on into them (to 244 mm) and the wrist was taken there:
+  // wrist girth 105 mm instead of 157, outer arm length 571 mm instead of 438.
+  std::vector<double> g;
+  for (int i = 0; i < 30; ++i) g.push_back(350);
+  for (int i = 30; i <= 60; ++i) g.push_back(350 - 80.0 * (i - 30) / 30);  // 270 at the wrist
+  for (int i = 61; i <= 67; ++i) g.push_back(270 + 36.0 * (i - 60) / 7);   // the palm
+  std::vector<double> fused = g;
+  for (int i = 68; i <= 80; ++i) fused.push_back(306 - 62.0 * (i - 67) / 13);  // fused fingers
+  EXPECT_EQ(wrist_cut(fused, 10), 60u);
+  // Where the fingers part, the track ends below the palm's first cuts: the same.
+  std::vector<double> parted(g.begin(), g.begin() + 64);
+  EXPECT_EQ(wrist_cut(parted, 10), 60u);
+  // A forearm whose profile wobbles by less than the rise keeps its narrowest cut,
+  // even below a bump.
+  std::vector<double> wobbly = parted;
+  wobbly[50] += 6;
+  wobbly[58] = 268;
+  EXPECT_EQ(wrist_cut(wobbly, 10), 58u);
+  EXPECT_EQ(wrist_cut(std::vector<double>{300, 290, 280}, 10), 0u);  // too short to follow
+}
+
 TEST(BodyMeasurements, TheNeckAndShoulderPointsStayPutUnderTheScansNoise) {
   // Under +-0.5 mm of skin noise (two seeds) the old rules moved the neck base girth
   // by 8-9 mm and the shoulder width by 6 mm: the front neck point, the deepest sample
