@@ -4,11 +4,13 @@
 // scans (other noise, a swaying subject), and the time the automatic set takes.
 //
 //   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
-//                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR]
+//                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR | --saved DIR]
 //                     [--seed N] [--min-weight W]
 //
 // --save writes each scan's surface and the posed true body as PLY into DIR (with
-// --repeat, the second scan's surface too).
+// --repeat, the second scan's surface too). --saved DIR measures what --save kept
+// again, with today's rules, without scanning (--body names the files, --rig gives
+// the floor): a minute for six bodies instead of an hour.
 // --min-weight sets the surface's ReconstructOptions::min_relative_weight.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
@@ -22,6 +24,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -99,53 +102,42 @@ const char* mark(double diff, double allow) {
   return d <= allow / 6 ? "aim" : d <= allow / 2 ? "must" : "FAIL";
 }
 
-int run(const std::string& rig, const std::string& body, bool repeat, double sway, int every) {
-  std::printf("\n== rig %s, body %s\n", rig.c_str(), body.empty() ? "(the rig's)" : body.c_str());
-  auto t0 = Clock::now();
-  auto a = scan(rig, body, g_seed, 0, every);
-  if (!a.ok()) return std::fprintf(stderr, "scan: %s\n", a.status().message().c_str()), 1;
-  std::printf("scan job %.0f s, mesh %zu triangles\n", secs(t0), a->mesh.triangles.size());
-  const std::string stem = g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
-  if (!g_save.empty()) {
-    const Status w1 = write_ply(stem + "-scan.ply", a->mesh), w2 = write_ply(stem + "-truth.ply", a->truth);
-    if (!w1.ok() || !w2.ok()) std::fprintf(stderr, "--save: %s\n", (w1.ok() ? w2 : w1).message().c_str());
+// The rig's floor (mm): the frame's bottom tubes lie on it.
+StatusOr<double> rig_floor(const std::string& rig_name) {
+  std::string path = rig_name;
+  if (rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos) {
+    ASSIGN_OR_RETURN(path, hw::shipped_rig_path(rig_name));
   }
+  ASSIGN_OR_RETURN(hw::RigDescription desc, hw::load_rig_description(path));
+  return -0.5 * desc.frame.tube;
+}
+
+// Fixed planes, the automatic set against the truth's, and (with a second scan's
+// set) the repeatability.
+int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyMeasurements& scan_body, double floor,
+           const BodyMeasurements* second, double sway) {
   BodyMeasureOptions mo;
-  mo.floor_y = a->floor;
-  t0 = Clock::now();
-  auto truth = measure_body(a->truth, mo);
+  mo.floor_y = floor;
+  auto t0 = Clock::now();
+  auto truth = measure_body(truth_mesh, mo);
   const double t_truth = secs(t0);
   if (!truth.ok()) return std::fprintf(stderr, "truth: %s\n", truth.status().message().c_str()), 1;
   t0 = Clock::now();
-  auto again = measure_body(a->mesh, mo);
+  auto again = measure_body(mesh, mo);
   const double t_scan = secs(t0);
   std::printf("automatic set: %.3f s on the scan (%zu triangles), %.3f s on the truth (%zu triangles)\n", t_scan,
-              a->mesh.triangles.size(), t_truth, a->truth.triangles.size());
-  {
-    // The same scan surfaced on a coarser grid, about 500k triangles.
-    ReconstructOptions ro = pipeline::body_surface_options();
-    ro.hole_fairing = g_fairing;
-    ro.min_relative_weight = g_min_weight;
-    ro.voxel_size = a->voxel * 1.77f;
-    ro.normal_source = NormalSource::kCameras;
-    auto coarse = reconstruct_surface(a->cloud, ro);
-    if (coarse.ok()) {
-      t0 = Clock::now();
-      auto c = measure_body(coarse->mesh, mo);
-      std::printf("automatic set: %.3f s on the scan surfaced at %.2f mm voxels (%zu triangles)%s\n", secs(t0),
-                  ro.voxel_size, coarse->mesh.triangles.size(), c.ok() ? "" : " (failed)");
-    }
-  }
+              mesh.triangles.size(), t_truth, truth_mesh.triangles.size());
+  if (!again.ok()) return std::fprintf(stderr, "scan set: %s\n", again.status().message().c_str()), 1;
 
   // Fixed planes: horizontal girths at fractions of the stature, round the torso and
   // each leg as the truth's cut finds them.
   const double h = truth->find("stature")->value_mm;
-  BodySlicer ts(a->truth, a->floor, a->floor + h + 1, 2);
-  BodySlicer ss(a->mesh, a->floor - 5, a->floor + h + 10, 2);
+  BodySlicer ts(truth_mesh, floor, floor + h + 1, 2);
+  BodySlicer ss(mesh, floor - 5, floor + h + 10, 2);
   std::printf("\nfixed planes         height    truth     scan     diff  vs 4.5/1.5 (large) 2/0.67 (small)\n");
   double worst_fixed = 0;
   for (double f : {0.05, 0.10, 0.20, 0.30, 0.40}) {
-    const double y = a->floor + f * h;
+    const double y = floor + f * h;
     for (int s : {1, -1}) {
       const std::vector<Ring> r = ts.rings(y);
       const Ring* leg = nullptr;
@@ -165,7 +157,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
     }
   }
   for (double f : {0.50, 0.55, 0.60, 0.65, 0.70, 0.72}) {
-    const double y = a->floor + f * h;
+    const double y = floor + f * h;
     const Eigen::Vector3d c(0, y, truth->landmark("waist_back_point")->position.z() + 100);
     auto gt = ts.girth(y, c), gs = ss.girth(y, c);
     if (!gt.ok() || !gs.ok()) continue;
@@ -176,11 +168,10 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   }
   std::printf("largest fixed-plane difference %.2f mm\n", worst_fixed);
 
-  if (!again.ok()) return std::fprintf(stderr, "scan set: %s\n", again.status().message().c_str()), 1;
   std::printf("\n%-24s %6s %8s %8s %7s %6s  %s\n", "automatic set", "ISO", "truth", "scan", "diff", "allow", "");
   size_t n = 0, iso = 0, must = 0, aim = 0;
   for (const BodyMeasurement& m : truth->measurements) {
-    const BodyMeasurement* s = a->body->find(m.name);
+    const BodyMeasurement* s = scan_body.find(m.name);
     if (!s) {
       std::printf("%-24s missing on the scan\n", m.name.c_str());
       continue;
@@ -196,19 +187,14 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   }
   std::printf("%zu measurements: %zu within the ISO allowance, %zu within half, %zu within a sixth\n", n, iso, must,
               aim);
-  for (const std::string& k : a->body->skipped) std::printf("skipped on the scan: %s\n", k.c_str());
+  for (const std::string& k : scan_body.skipped) std::printf("skipped on the scan: %s\n", k.c_str());
 
-  if (repeat) {
-    auto b = scan(rig, body, g_seed + 1, sway, every);
-    if (!b.ok()) return std::fprintf(stderr, "second scan: %s\n", b.status().message().c_str()), 1;
-    if (!g_save.empty()) {
-      if (Status w = write_ply(stem + "-scan2.ply", b->mesh); !w.ok()) std::fprintf(stderr, "--save: %s\n", w.message().c_str());
-    }
+  if (second) {
     double worst = 0;
     std::string worst_name;
     std::vector<double> diffs;
-    for (const BodyMeasurement& m : a->body->measurements) {
-      const BodyMeasurement* o = b->body->find(m.name);
+    for (const BodyMeasurement& m : scan_body.measurements) {
+      const BodyMeasurement* o = second->find(m.name);
       if (!o) continue;
       const double d = std::abs(o->value_mm - m.value_mm);
       diffs.push_back(d);
@@ -217,11 +203,75 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
     std::sort(diffs.begin(), diffs.end());
     std::printf("\nrepeatability (seed +1, sway %.0f mm): %zu measurements, median %.2f mm, largest %.2f mm (%s)\n", sway,
                 diffs.size(), diffs.empty() ? 0.0 : diffs[diffs.size() / 2], worst, worst_name.c_str());
-    for (const BodyMeasurement& m : a->body->measurements)
-      if (const BodyMeasurement* o = b->body->find(m.name); o && std::abs(o->value_mm - m.value_mm) > 1.0)
+    for (const BodyMeasurement& m : scan_body.measurements)
+      if (const BodyMeasurement* o = second->find(m.name); o && std::abs(o->value_mm - m.value_mm) > 1.0)
         std::printf("  %-24s %8.1f %8.1f %+6.2f\n", m.name.c_str(), m.value_mm, o->value_mm, o->value_mm - m.value_mm);
   }
   return 0;
+}
+
+int run(const std::string& rig, const std::string& body, bool repeat, double sway, int every) {
+  std::printf("\n== rig %s, body %s\n", rig.c_str(), body.empty() ? "(the rig's)" : body.c_str());
+  auto t0 = Clock::now();
+  auto a = scan(rig, body, g_seed, 0, every);
+  if (!a.ok()) return std::fprintf(stderr, "scan: %s\n", a.status().message().c_str()), 1;
+  std::printf("scan job %.0f s, mesh %zu triangles\n", secs(t0), a->mesh.triangles.size());
+  const std::string stem = g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
+  if (!g_save.empty()) {
+    const Status w1 = write_ply(stem + "-scan.ply", a->mesh), w2 = write_ply(stem + "-truth.ply", a->truth);
+    if (!w1.ok() || !w2.ok()) std::fprintf(stderr, "--save: %s\n", (w1.ok() ? w2 : w1).message().c_str());
+  }
+  {
+    // The same scan surfaced on a coarser grid, about 500k triangles.
+    ReconstructOptions ro = pipeline::body_surface_options();
+    ro.hole_fairing = g_fairing;
+    ro.min_relative_weight = g_min_weight;
+    ro.voxel_size = a->voxel * 1.77f;
+    ro.normal_source = NormalSource::kCameras;
+    auto coarse = reconstruct_surface(a->cloud, ro);
+    if (coarse.ok()) {
+      BodyMeasureOptions mo;
+      mo.floor_y = a->floor;
+      t0 = Clock::now();
+      auto c = measure_body(coarse->mesh, mo);
+      std::printf("automatic set: %.3f s on the scan surfaced at %.2f mm voxels (%zu triangles)%s\n", secs(t0),
+                  ro.voxel_size, coarse->mesh.triangles.size(), c.ok() ? "" : " (failed)");
+    }
+  }
+  std::optional<Scan> b;
+  if (repeat) {
+    auto s = scan(rig, body, g_seed + 1, sway, every);
+    if (!s.ok()) return std::fprintf(stderr, "second scan: %s\n", s.status().message().c_str()), 1;
+    if (!g_save.empty()) {
+      if (Status w = write_ply(stem + "-scan2.ply", s->mesh); !w.ok()) std::fprintf(stderr, "--save: %s\n", w.message().c_str());
+    }
+    b = std::move(*s);
+  }
+  return report(a->truth, a->mesh, *a->body, a->floor, b ? &*b->body : nullptr, sway);
+}
+
+// What --save kept, measured again with today's rules: DIR/B-truth.ply, B-scan.ply
+// and, where there, B-scan2.ply (the repeat).
+int remeasure(const std::string& dir, const std::string& rig, const std::string& body, double sway) {
+  const std::string stem = dir + "/" + body.substr(body.find_last_of('/') + 1);
+  std::printf("\n== saved %s, rig %s\n", stem.c_str(), rig.c_str());
+  auto floor = rig_floor(rig);
+  if (!floor.ok()) return std::fprintf(stderr, "%s\n", floor.status().message().c_str()), 1;
+  auto truth = read_ply_mesh(stem + "-truth.ply");
+  auto mesh = read_ply_mesh(stem + "-scan.ply");
+  if (!truth.ok() || !mesh.ok())
+    return std::fprintf(stderr, "%s\n", (truth.ok() ? mesh.status() : truth.status()).message().c_str()), 1;
+  BodyMeasureOptions mo;
+  mo.floor_y = *floor;
+  auto a = measure_body(*mesh, mo);
+  if (!a.ok()) return std::fprintf(stderr, "scan set: %s\n", a.status().message().c_str()), 1;
+  std::optional<BodyMeasurements> b;
+  if (auto mesh2 = read_ply_mesh(stem + "-scan2.ply"); mesh2.ok()) {
+    auto m = measure_body(*mesh2, mo);
+    if (!m.ok()) return std::fprintf(stderr, "second scan set: %s\n", m.status().message().c_str()), 1;
+    b = std::move(*m);
+  }
+  return report(*truth, *mesh, *a, *floor, b ? &*b : nullptr, sway);
 }
 
 }  // namespace
@@ -229,6 +279,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
 int main(int argc, char** argv) {
   std::vector<std::string> rigs, bodies;
   bool repeat = false;
+  std::string saved;
   double sway = 3;
   int every = 1;
   for (int i = 1; i < argc; ++i) {
@@ -239,6 +290,7 @@ int main(int argc, char** argv) {
     else if (a == "--sway" && i + 1 < argc) sway = std::atof(argv[++i]);
     else if (a == "--every" && i + 1 < argc) every = std::atoi(argv[++i]);
     else if (a == "--save" && i + 1 < argc) g_save = argv[++i];
+    else if (a == "--saved" && i + 1 < argc) saved = argv[++i];
     else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--min-weight" && i + 1 < argc) g_min_weight = std::strtof(argv[++i], nullptr);
     else if (a == "--fairing" && i + 1 < argc) {
@@ -246,12 +298,14 @@ int main(int argc, char** argv) {
       g_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
     }
     else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
-                        "[--fairing membrane|thin] [--save DIR] [--seed N] [--min-weight W]\n"), 2;
+                        "[--fairing membrane|thin] [--save DIR | --saved DIR] [--seed N] [--min-weight W]\n"), 2;
   }
   if (rigs.empty()) rigs = {"thesis"};
   if (bodies.empty()) bodies = {""};
   int rc = 0;
+  if (!saved.empty() && bodies == std::vector<std::string>{""})
+    return std::fprintf(stderr, "measure_benchmark: --saved needs the bodies' names (--body B.ply)\n"), 2;
   for (const std::string& r : rigs)
-    for (const std::string& b : bodies) rc |= run(r, b, repeat, sway, every);
+    for (const std::string& b : bodies) rc |= saved.empty() ? run(r, b, repeat, sway, every) : remeasure(saved, r, b, sway);
   return rc;
 }

@@ -1,5 +1,6 @@
 #include "recon/measure/girth.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -46,6 +47,41 @@ void measure_around(const std::vector<Eigen::Vector3d>& points, const Plane& pla
   g->value_mm = closed_length(hull);
   g->tape.clear();
   for (const Eigen::Vector2d& h : hull) g->tape.push_back(plane.point + h.x() * u + h.y() * v);
+}
+
+// The loop's points in the plane's basis.
+std::vector<Eigen::Vector2d> flatten(const std::vector<Eigen::Vector3d>& loop, const Eigen::Vector3d& u,
+                                     const Eigen::Vector3d& v) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(loop.size());
+  for (const Eigen::Vector3d& p : loop) out.emplace_back(p.dot(u), p.dot(v));
+  return out;
+}
+
+// Whether two closed polygons' edges cross.
+bool loops_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
+  Eigen::AlignedBox2d ba, bb;
+  for (const Eigen::Vector2d& p : a) ba.extend(p);
+  for (const Eigen::Vector2d& p : b) bb.extend(p);
+  if (!ba.intersects(bb)) return false;
+  const Eigen::AlignedBox2d common = ba.intersection(bb);
+  // Only the edges that reach the boxes' common part can cross.
+  auto edges_in = [&](const std::vector<Eigen::Vector2d>& l) {
+    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> e;
+    for (size_t i = 0; i < l.size(); ++i) {
+      const Eigen::Vector2d& p = l[i];
+      const Eigen::Vector2d& q = l[(i + 1) % l.size()];
+      if (Eigen::AlignedBox2d(p.cwiseMin(q), p.cwiseMax(q)).intersects(common)) e.emplace_back(p, q);
+    }
+    return e;
+  };
+  const auto ea = edges_in(a), eb = edges_in(b);
+  for (const auto& [p, q] : ea)
+    for (const auto& [r, t] : eb) {
+      const double d1 = cross(p, q, r), d2 = cross(p, q, t), d3 = cross(r, t, p), d4 = cross(r, t, q);
+      if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
+    }
+  return false;
 }
 
 }  // namespace
@@ -123,6 +159,7 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
   loops.erase(std::remove_if(loops.begin(), loops.end(), [](const SectionLoop& l) { return !l.closed; }), loops.end());
   if (cut == 0) return not_found("girth: the plane does not cut the body");
   if (loops.empty()) return not_found("girth: the plane cuts only the body's open border, no closed loop to measure around");
+  const std::vector<SectionLoop> closed = loops;  // nested ones too: one may cross the loop meant
   drop_nested_loops(&loops, plane);
   size_t best = 0;
   if (near) {
@@ -156,7 +193,32 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
   g.loop = loops[best].points;
   g.loop_length_mm = closed_length(g.loop);
   g.min_confidence = *std::min_element(loops[best].confidence.begin(), loops[best].confidence.end());
-  measure_around(g.loop, plane, &g);
+  // Loops that cross the one meant are the same part: a reconstructed surface that
+  // passes through itself (a hole's fill through the skin) cuts one ankle as two
+  // overlapping loops, and the tape goes round both (drop_nested_loops may have
+  // dropped the other as lying inside it).
+  std::vector<Eigen::Vector3d> around = g.loop;
+  if (closed.size() > 1) {
+    Eigen::Vector3d u, v;
+    plane_basis(plane.normal, &u, &v);
+    std::vector<std::vector<Eigen::Vector2d>> flat(closed.size());
+    for (size_t i = 0; i < closed.size(); ++i) flat[i] = flatten(closed[i].points, u, v);
+    std::vector<bool> taken(closed.size(), false);
+    for (size_t i = 0; i < closed.size(); ++i) taken[i] = closed[i].points == g.loop;
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (size_t i = 0; i < closed.size(); ++i)
+        for (size_t j = 0; j < closed.size() && !taken[i]; ++j)
+          if (taken[j] && loops_cross(flat[j], flat[i])) taken[i] = grew = true;
+    }
+    for (size_t i = 0; i < closed.size(); ++i) {
+      if (!taken[i] || closed[i].points == g.loop) continue;
+      around.insert(around.end(), closed[i].points.begin(), closed[i].points.end());
+      g.min_confidence =
+          std::min(g.min_confidence, *std::min_element(closed[i].confidence.begin(), closed[i].confidence.end()));
+    }
+  }
+  measure_around(around, plane, &g);
   return g;
 }
 

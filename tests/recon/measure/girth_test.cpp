@@ -107,6 +107,28 @@ TEST(MeshGirth, ACavityInsideTheBodyIsNeverTheLoop) {
   EXPECT_EQ(loops.size(), 2u);
 }
 
+TEST(MeshGirth, LoopsThatCrossAreOnePartAndTheTapeGoesRoundBoth) {
+  // A reconstructed surface can pass through itself: on a thesis-rig scan of
+  // male_muscular a hole's fill ran through the right ankle, whose cut 72 mm up
+  // became two overlapping loops (heel and front), and the tape went round one:
+  // 208 mm where the true ankle is 270. Two crossing ovals here: the tape goes
+  // round both, whichever is nearer the point; a part beside them stays apart.
+  const TriangleMesh heel = prism(circle(40, {0, 0}, 360), {0, 0}, 0, 200);
+  const TriangleMesh front = prism(circle(40, {50, 0}, 360), {50, 0}, 0, 200);
+  const TriangleMesh other = prism(circle(40, {200, 0}, 360), {200, 0}, 0, 200);
+  const TriangleMesh body = merged(merged(heel, front), other);
+  const double both = 2 * M_PI * 40 + 2 * 50;  // the hull of two circles 50 apart
+  for (const Eigen::Vector3d& near : {Eigen::Vector3d(-10, 110, 0), Eigen::Vector3d(60, 110, 0)}) {
+    auto g = mesh_girth(body, horizontal(110), near);
+    ASSERT_TRUE(g.ok());
+    EXPECT_EQ(g->loops_cut, 3u);
+    EXPECT_NEAR(g->value_mm, both, 0.1) << near.transpose();
+  }
+  auto apart = mesh_girth(body, horizontal(110), Eigen::Vector3d(200, 110, 0));
+  ASSERT_TRUE(apart.ok());
+  EXPECT_NEAR(apart->value_mm, 2 * M_PI * 40, 0.1);
+}
+
 TEST(MeshGirth, ClearErrors) {
   const TriangleMesh body = prism(circle(150), {0, 0}, 0, 400);
   auto miss = mesh_girth(body, horizontal(500));
