@@ -10,7 +10,7 @@
 // --save writes each scan's surface and the posed true body as PLY into DIR (with
 // --repeat, the second scan's surface too). --saved DIR measures what --save kept
 // again, with today's rules, without scanning (--body names the files, --rig gives
-// the floor): a minute for six bodies instead of an hour.
+// the floor): about two minutes for six bodies instead of an hour.
 // --min-weight sets the surface's ReconstructOptions::min_relative_weight.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
@@ -66,12 +66,17 @@ float g_min_weight = pipeline::body_surface_options().min_relative_weight;
 std::string g_save;
 uint64_t g_seed = 1;
 
-StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64_t seed, double sway, int every) {
+// A shipped rig by name, or a description file.
+StatusOr<hw::RigDescription> rig_description(const std::string& rig_name) {
   std::string path = rig_name;
   if (rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos) {
     ASSIGN_OR_RETURN(path, hw::shipped_rig_path(rig_name));
   }
-  ASSIGN_OR_RETURN(hw::RigDescription desc, hw::load_rig_description(path));
+  return hw::load_rig_description(path);
+}
+
+StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64_t seed, double sway, int every) {
+  ASSIGN_OR_RETURN(hw::RigDescription desc, rig_description(rig_name));
   desc.simulation.seed = seed;
   desc.simulation.motion.sway_mm = sway;
   TriangleMesh subject;
@@ -102,15 +107,6 @@ const char* mark(double diff, double allow) {
   return d <= allow / 6 ? "aim" : d <= allow / 2 ? "must" : "FAIL";
 }
 
-// The rig's floor (mm): the frame's bottom tubes lie on it.
-StatusOr<double> rig_floor(const std::string& rig_name) {
-  std::string path = rig_name;
-  if (rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos) {
-    ASSIGN_OR_RETURN(path, hw::shipped_rig_path(rig_name));
-  }
-  ASSIGN_OR_RETURN(hw::RigDescription desc, hw::load_rig_description(path));
-  return -0.5 * desc.frame.tube;
-}
 
 // Fixed planes, the automatic set against the truth's, and (with a second scan's
 // set) the repeatability.
@@ -255,14 +251,15 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
 int remeasure(const std::string& dir, const std::string& rig, const std::string& body, double sway) {
   const std::string stem = dir + "/" + body.substr(body.find_last_of('/') + 1);
   std::printf("\n== saved %s, rig %s\n", stem.c_str(), rig.c_str());
-  auto floor = rig_floor(rig);
-  if (!floor.ok()) return std::fprintf(stderr, "%s\n", floor.status().message().c_str()), 1;
+  auto desc = rig_description(rig);
+  if (!desc.ok()) return std::fprintf(stderr, "%s\n", desc.status().message().c_str()), 1;
+  const double floor = -0.5 * desc->frame.tube;  // as scan() takes it
   auto truth = read_ply_mesh(stem + "-truth.ply");
   auto mesh = read_ply_mesh(stem + "-scan.ply");
   if (!truth.ok() || !mesh.ok())
     return std::fprintf(stderr, "%s\n", (truth.ok() ? mesh.status() : truth.status()).message().c_str()), 1;
   BodyMeasureOptions mo;
-  mo.floor_y = *floor;
+  mo.floor_y = floor;
   auto a = measure_body(*mesh, mo);
   if (!a.ok()) return std::fprintf(stderr, "scan set: %s\n", a.status().message().c_str()), 1;
   std::optional<BodyMeasurements> b;
@@ -271,7 +268,7 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
     if (!m.ok()) return std::fprintf(stderr, "second scan set: %s\n", m.status().message().c_str()), 1;
     b = std::move(*m);
   }
-  return report(*truth, *mesh, *a, *floor, b ? &*b : nullptr, sway);
+  return report(*truth, *mesh, *a, floor, b ? &*b : nullptr, sway);
 }
 
 }  // namespace

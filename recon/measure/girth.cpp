@@ -159,7 +159,8 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
   loops.erase(std::remove_if(loops.begin(), loops.end(), [](const SectionLoop& l) { return !l.closed; }), loops.end());
   if (cut == 0) return not_found("girth: the plane does not cut the body");
   if (loops.empty()) return not_found("girth: the plane cuts only the body's open border, no closed loop to measure around");
-  const std::vector<SectionLoop> closed = loops;  // nested ones too: one may cross the loop meant
+  std::vector<SectionLoop> closed;  // nested ones too: one may cross the loop meant
+  if (loops.size() > 1) closed = loops;
   drop_nested_loops(&loops, plane);
   size_t best = 0;
   if (near) {
@@ -197,14 +198,14 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
   // passes through itself (a hole's fill through the skin) cuts one ankle as two
   // overlapping loops, and the tape goes round both (drop_nested_loops may have
   // dropped the other as lying inside it).
-  std::vector<Eigen::Vector3d> around = g.loop;
-  if (closed.size() > 1) {
+  std::vector<Eigen::Vector3d> crossing;
+  if (!closed.empty()) {
     Eigen::Vector3d u, v;
     plane_basis(plane.normal, &u, &v);
     std::vector<std::vector<Eigen::Vector2d>> flat(closed.size());
     for (size_t i = 0; i < closed.size(); ++i) flat[i] = flatten(closed[i].points, u, v);
-    std::vector<bool> taken(closed.size(), false);
-    for (size_t i = 0; i < closed.size(); ++i) taken[i] = closed[i].points == g.loop;
+    std::vector<bool> meant(closed.size()), taken(closed.size());
+    for (size_t i = 0; i < closed.size(); ++i) meant[i] = taken[i] = closed[i].points == g.loop;
     for (bool grew = true; grew;) {
       grew = false;
       for (size_t i = 0; i < closed.size(); ++i)
@@ -212,13 +213,18 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
           if (taken[j] && loops_cross(flat[j], flat[i])) taken[i] = grew = true;
     }
     for (size_t i = 0; i < closed.size(); ++i) {
-      if (!taken[i] || closed[i].points == g.loop) continue;
-      around.insert(around.end(), closed[i].points.begin(), closed[i].points.end());
+      if (!taken[i] || meant[i]) continue;
+      crossing.insert(crossing.end(), closed[i].points.begin(), closed[i].points.end());
       g.min_confidence =
           std::min(g.min_confidence, *std::min_element(closed[i].confidence.begin(), closed[i].confidence.end()));
     }
   }
-  measure_around(around, plane, &g);
+  if (crossing.empty()) {
+    measure_around(g.loop, plane, &g);
+  } else {
+    crossing.insert(crossing.end(), g.loop.begin(), g.loop.end());
+    measure_around(crossing, plane, &g);
+  }
   return g;
 }
 

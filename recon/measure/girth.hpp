@@ -34,10 +34,10 @@ struct Girth {
 
 // The girth in `plane` around the closed section loop that encircles `near` (a
 // limb's centre), else the loop nearest it (a point picked on the skin), or without
-// `near` the loop with the longest tape (at the waist,
-// the torso rather than an arm). Loops that cross it are the same part cut twice
-// (a surface through itself): the tape goes round them too, `loop` is the one meant. Errors: the plane misses the mesh, or cuts no
-// closed loop (an open mesh's border).
+// `near` the loop with the longest tape (at the waist, the torso rather than an
+// arm). Loops that cross it are the same part cut twice (a surface through itself):
+// the tape goes round them too, and `loop` is the one meant. Errors: the plane
+// misses the mesh, or cuts no closed loop (an open mesh's border).
 StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane,
                            const std::optional<Eigen::Vector3d>& near = std::nullopt);
 // The same, cutting only `triangles` (those the plane can reach; plane_section.hpp).
