@@ -33,29 +33,26 @@ bool encloses(const std::vector<Eigen::Vector3d>& loop, const Eigen::Vector3d& p
   return inside;
 }
 
+// Points in the plane through `origin` spanned by u, v: their coordinates there.
+std::vector<Eigen::Vector2d> flatten(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& origin,
+                                     const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d q = p - origin;
+    out.emplace_back(q.dot(u), q.dot(v));
+  }
+  return out;
+}
+
 // The tape around points of one part: hull in the plane, back in 3-D.
 void measure_around(const std::vector<Eigen::Vector3d>& points, const Plane& plane, Girth* g) {
   Eigen::Vector3d u, v;
   plane_basis(plane.normal, &u, &v);
-  std::vector<Eigen::Vector2d> flat;
-  flat.reserve(points.size());
-  for (const Eigen::Vector3d& p : points) {
-    const Eigen::Vector3d q = p - plane.point;
-    flat.emplace_back(q.dot(u), q.dot(v));
-  }
-  const std::vector<Eigen::Vector2d> hull = convex_hull(flat);
+  const std::vector<Eigen::Vector2d> hull = convex_hull(flatten(points, plane.point, u, v));
   g->value_mm = closed_length(hull);
   g->tape.clear();
   for (const Eigen::Vector2d& h : hull) g->tape.push_back(plane.point + h.x() * u + h.y() * v);
-}
-
-// The loop's points in the plane's basis.
-std::vector<Eigen::Vector2d> flatten(const std::vector<Eigen::Vector3d>& loop, const Eigen::Vector3d& u,
-                                     const Eigen::Vector3d& v) {
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(loop.size());
-  for (const Eigen::Vector3d& p : loop) out.emplace_back(p.dot(u), p.dot(v));
-  return out;
 }
 
 // Whether two closed polygons' edges cross.
@@ -203,7 +200,7 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
     Eigen::Vector3d u, v;
     plane_basis(plane.normal, &u, &v);
     std::vector<std::vector<Eigen::Vector2d>> flat(closed.size());
-    for (size_t i = 0; i < closed.size(); ++i) flat[i] = flatten(closed[i].points, u, v);
+    for (size_t i = 0; i < closed.size(); ++i) flat[i] = flatten(closed[i].points, plane.point, u, v);
     std::vector<bool> meant(closed.size()), taken(closed.size());
     for (size_t i = 0; i < closed.size(); ++i) meant[i] = taken[i] = closed[i].points == g.loop;
     for (bool grew = true; grew;) {
