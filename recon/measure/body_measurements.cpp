@@ -36,6 +36,9 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // How far below a flat extreme (the neck's side) a point still counts as on it, mm.
 constexpr double kFlatBand = 3;
+// A mesh vertex at or above this confidence is measured skin; below, hole filling
+// invented it (the threshold BodyMeasurement::crosses_filled_hole uses).
+constexpr float kMeasured = 0.5f;
 // The same for the top of the shoulder, which is broad front to back: a parabola over
 // 3 mm of it is nearly flat, and its vertex moved 7-8 mm under +-0.5 mm of noise.
 constexpr double kRidgeBand = 10;
@@ -329,6 +332,23 @@ class Finder {
     for (double y = prev + step; y <= at(0.65); y += step) {
       if (merged(y)) {
         crotch_y_ = bisect(prev, y, merged);
+        // Where the thighs nearly touch no camera sees between them, and the surface
+        // bridges the gap below the real crotch (male_heavy, tiered rig: 21 mm below
+        // it, where the thighs are still 17 mm apart). The bridge is filled, the real
+        // crotch's front and back are seen: up from the first join, the first level
+        // whose midline crossings are measured skin, within 5 % of the height.
+        const auto measured = [&](double yy) {
+          const Ring* m = midline(rings(yy), xc_);
+          return m && m->crossing_confidence(xc_) >= kMeasured;
+        };
+        if (!measured(crotch_y_ + 0.5)) {
+          prefetch(crotch_y_, crotch_y_ + 0.05 * h_, 1);
+          for (double yy = crotch_y_ + 1; yy <= crotch_y_ + 0.05 * h_; yy += 1)
+            if (measured(yy)) {
+              crotch_y_ = bisect(yy - 1, yy, measured);
+              break;
+            }
+        }
         const std::vector<Ring>& r = rings(crotch_y_ + 0.5);
         double f = zc_, b = zc_;
         if (const Ring* m = midline(r, xc_)) m->crossing_z(xc_, &f, &b);

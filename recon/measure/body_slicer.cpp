@@ -23,6 +23,24 @@ bool Ring::crossing_z(double x, double* front, double* back) const {
   return any;
 }
 
+float Ring::crossing_confidence(double x) const {
+  if (confidence.size() != points.size()) return 1;
+  double front = -1e300, back = 1e300;
+  float cf = 1, cb = 1;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const size_t j = (i + 1) % points.size();
+    const Eigen::Vector3d& a = points[i];
+    const Eigen::Vector3d& b = points[j];
+    if ((a.x() < x) == (b.x() < x)) continue;
+    const double t = (x - a.x()) / (b.x() - a.x());
+    const double z = a.z() + t * (b.z() - a.z());
+    const auto c = static_cast<float>((1 - t) * confidence[i] + t * confidence[j]);
+    if (z > front) front = z, cf = c;
+    if (z < back) back = z, cb = c;
+  }
+  return std::max(cf, cb);
+}
+
 BodySlicer::BodySlicer(const TriangleMesh& mesh, double y0, double y1, double step)
     : mesh_(mesh), y0_(y0), y1_(y1), step_(step) {
   const auto n = static_cast<size_t>(std::max(1.0, std::ceil((y1 - y0) / step)));
@@ -75,6 +93,7 @@ std::vector<Ring> BodySlicer::rings(double y) const {
     r.girth = closed_length(convex_hull(std::move(flat)));
     r.min_confidence = loop.confidence.empty() ? 1.f : *std::min_element(loop.confidence.begin(), loop.confidence.end());
     r.points = std::move(loop.points);
+    r.confidence = std::move(loop.confidence);
     out.push_back(std::move(r));
   }
   return out;

@@ -21,10 +21,14 @@ struct Ring {
   double x_min = 0, x_max = 0, z_min = 0, z_max = 0;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // of the enclosed area
   float min_confidence = 1;
+  std::vector<float> confidence;  // per point (empty: all measured)
   bool spans_x(double x) const { return x_min < x && x < x_max; }
   // Where the loop crosses the vertical plane X = x: the largest and smallest Z
   // (front and back, the body facing +Z). False when it does not cross.
   bool crossing_z(double x, double* front, double* back) const;
+  // The mesh's confidence where the loop crosses X = x at its front and at its back,
+  // the higher of the two (1 where the mesh has none, or the loop does not cross).
+  float crossing_confidence(double x) const;
 };
 
 class BodySlicer {
