@@ -776,25 +776,43 @@ class Finder {
     height("hip_height", "Hip height", "", "hip_back_point", lm("hip_back_point"), "hip level above the floor");
   }
 
-  // The leg's horizontal loop on side s at height y, if any.
-  // Scraps of a cut (a toe, a fold of fill) are no leg: at least 6 % of the height round.
-  // The leg's loop at a level, when it is whole there: a leg cut in pieces (a slit
-  // a scan can leave behind the ankle splits the heel from the rest) is no level to
-  // measure at.
+  // The leg's loop on side s at a level, when it is whole there. Scraps of a cut (a
+  // toe, a fold of fill) are no leg: at least 6 % of the height round. A leg cut in
+  // pieces (a slit a scan can leave behind the ankle splits the heel from the rest)
+  // is no level to measure at.
   const Ring* leg(const std::vector<Ring>& r, int s) const {
     const Ring* l = side_ring(r, xc_, s, false, 0.06 * h_);
     return l && parts_near(r, *l, 0.06 * h_) == 0 ? l : nullptr;
   }
 
+  // The thigh's tape at a level below the crotch where hole filling bridges the
+  // gap between the thighs (bridged_part), if it is a leg's (6 % of the height round).
+  std::optional<Girth> bridged_leg(double y, int s) const {
+    if (y >= crotch_y_) return std::nullopt;
+    const std::vector<Ring>& r = rings(y);
+    const Ring* m = midline(r, xc_);
+    if (!m) return std::nullopt;
+    std::optional<Girth> g = bridged_part(*m, xc_, s);
+    if (!g || g->value_mm < 0.06 * h_) return std::nullopt;
+    g->loops_cut = r.size();
+    return g;
+  }
+
   void measure_leg(int s) {
     const std::string sd = side(s);
-    auto extreme = [&](double y0, double y1, bool largest, double* y_at) {
+    auto extreme = [&](double y0, double y1, bool largest, double* y_at, bool bridged = false) {
       std::vector<double> ys, gs;
       std::vector<Eigen::Vector3d> cs;
       prefetch(y0, y1, 2);
       for (double y = y0; y <= y1; y += 2) {
         const std::vector<Ring>& r = rings(y);
-        if (const Ring* l = leg(r, s)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
+        if (const Ring* l = leg(r, s)) {
+          ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
+        } else if (const std::optional<Girth> b = bridged ? bridged_leg(y, s) : std::nullopt) {
+          Eigen::Vector3d c = Eigen::Vector3d::Zero();
+          for (const Eigen::Vector3d& p : b->tape) c += p;
+          ys.push_back(y), gs.push_back(b->value_mm), cs.push_back(c / static_cast<double>(b->tape.size()));
+        }
       }
       if (ys.empty()) return Eigen::Vector3d(xc_ + s * 0.05 * h_, *y_at, zc_);
       const size_t k = settle(gs, arg_extreme(gs, largest), 1.0);
@@ -802,8 +820,10 @@ class Finder {
       return cs[k];
     };
     double ty = crotch_y_ - 0.02 * h_;
-    const Eigen::Vector3d tc = extreme(crotch_y_ - 0.05 * h_, crotch_y_ - 0.005 * h_, true, &ty);
-    girth("thigh_girth_" + sd, "Thigh girth (" + sd + ")", "5.3.20", level_girth(ty, tc), {"crotch"},
+    const Eigen::Vector3d tc = extreme(crotch_y_ - 0.05 * h_, crotch_y_ - 0.005 * h_, true, &ty, true);
+    const std::optional<Girth> tb = leg(rings(ty), s) ? std::nullopt : bridged_leg(ty, s);
+    girth("thigh_girth_" + sd, "Thigh girth (" + sd + ")", "5.3.20", tb ? StatusOr<Girth>(*tb) : level_girth(ty, tc),
+          {"crotch"},
           "horizontal, the largest just below the crotch");
     // Knee: the narrowest cut of the leg between calf and thigh (the joint narrows
     // it; 18-36 % of the height), the deepest local minimum if there are several;
@@ -1057,6 +1077,30 @@ size_t wrist_cut(const std::vector<double>& g, double palm_rise) {
   return static_cast<size_t>(std::min_element(g.begin() + static_cast<std::ptrdiff_t>(from),
                                               g.begin() + static_cast<std::ptrdiff_t>(palm)) -
                              g.begin());
+}
+
+std::optional<Girth> bridged_part(const Ring& ring, double xc, int side) {
+  const size_t n = ring.points.size();
+  if (n < 3 || ring.confidence.size() != n || ring.crossing_confidence(xc) >= kMeasured) return std::nullopt;
+  const double y = ring.points.front().y();
+  Girth g;
+  g.plane = Plane{Eigen::Vector3d(0, y, 0), Eigen::Vector3d::UnitY()};
+  g.loops_cut = 1;
+  std::vector<Eigen::Vector2d> flat;
+  auto kept = [&](size_t i) { return side * (ring.points[i].x() - xc) > 0 && ring.confidence[i] >= kMeasured; };
+  for (size_t i = 0; i < n; ++i) {
+    if (side * (ring.points[i].x() - xc) <= 0) continue;
+    g.min_confidence = std::min(g.min_confidence, ring.confidence[i]);
+    if (!kept(i)) continue;
+    if (kept((i + 1) % n)) g.loop_length_mm += (ring.points[(i + 1) % n] - ring.points[i]).norm();
+    g.loop.push_back(ring.points[i]);
+    flat.emplace_back(ring.points[i].x(), ring.points[i].z());
+  }
+  const std::vector<Eigen::Vector2d> hull = convex_hull(std::move(flat));
+  if (hull.size() < 3) return std::nullopt;
+  g.value_mm = closed_length(hull);
+  for (const Eigen::Vector2d& q : hull) g.tape.emplace_back(q.x(), y, q.y());
+  return g;
 }
 
 StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeasureOptions& options) {

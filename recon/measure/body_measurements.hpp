@@ -31,6 +31,8 @@
 
 #include "recon/core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
+#include "recon/measure/body_slicer.hpp"
+#include "recon/measure/girth.hpp"
 #include "recon/measure/plane_section.hpp"
 
 namespace bodyscan {
@@ -90,5 +92,15 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
 // `palm_rise` over the narrowest above them (the palm), the wrist is the narrowest
 // above that rise. measure_body passes 0.6 % of the stature.
 size_t wrist_cut(const std::vector<double>& girths, double palm_rise);
+
+// One leg's tape in a horizontal cut where hole filling has bridged the gap between
+// the thighs (`ring` spans the midline X = xc and crosses it on invented surface
+// only, mesh confidence under 0.5 front and back): round the measured skin
+// (confidence 0.5 or more) on side `side` (+1: X > xc), in the ring's plane. The
+// tape bridges the unseen inner side as a tape bridges any hollow; its
+// min_confidence is the lowest on that side, so the girth is flagged as crossing
+// the fill. Nothing where the ring crosses the midline on measured skin (the
+// trunk, above the crotch), or keeps no measured skin on that side.
+std::optional<Girth> bridged_part(const Ring& ring, double xc, int side);
 
 }  // namespace bodyscan

@@ -357,6 +357,42 @@ TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
   EXPECT_NEAR(filled->find("crotch_height")->value_mm, clean, 1.0);
 }
 
+TEST(BodyMeasurements, AThighsTapeThroughAFilledBridgeGoesRoundItsMeasuredSkin) {
+  // A cut below the crotch where hole filling joined the thighs: two thighs of
+  // radius 80 mm centred 90 mm either side of the midline, their inner faces (within
+  // 25 mm of it) unseen and a web across the gap, both invented (confidence 0).
+  // Going round the measured skin of one thigh, the tape bridges its unseen inner
+  // face with a chord: 2 pi 80 less the 71.4 deg arc where x < 25, plus its chord.
+  Ring ring;
+  auto thigh = [&](int s) {
+    for (int i = 0; i < 720; ++i) {
+      const double a = 2 * M_PI * i / 720;
+      const Eigen::Vector3d p(s * (90 + 80 * std::cos(a)), 700, 80 * std::sin(a));
+      if (s * p.x() < 15) continue;
+      ring.points.push_back(p);
+      ring.confidence.push_back(s * p.x() < 25 ? 0.f : 1.f);
+    }
+  };
+  thigh(1);
+  // (The points go round each thigh from its front inner edge; the order only
+  // matters for the crossings, which the web supplies at z = +-45.)
+  ring.points.emplace_back(0, 700, 45), ring.confidence.push_back(0.f);
+  thigh(-1);
+  ring.points.emplace_back(0, 700, -45), ring.confidence.push_back(0.f);
+  const double missing = 2 * std::acos(-65.0 / 80);  // the arc beyond x = 25
+  const double expected = 2 * M_PI * 80 - 80 * (2 * M_PI - missing) + 2 * 80 * std::sin((2 * M_PI - missing) / 2);
+  for (int s : {1, -1}) {
+    const std::optional<Girth> g = bridged_part(ring, 0, s);
+    ASSERT_TRUE(g) << "side " << s;
+    EXPECT_NEAR(g->value_mm, expected, 0.5) << "side " << s;
+    EXPECT_TRUE(g->min_confidence < 0.5f) << "side " << s;  // flagged: it crosses the fill
+    for (const Eigen::Vector3d& p : g->tape) EXPECT_GT(s * p.x(), 24.9);
+  }
+  // Where the ring crosses the midline on measured skin (the trunk) it is no bridge.
+  std::fill(ring.confidence.begin(), ring.confidence.end(), 1.f);
+  EXPECT_FALSE(bridged_part(ring, 0, 1));
+}
+
 TEST(BodyMeasurements, ALegCutInPiecesIsNoLevelToMeasureAt) {
   // A scan can leave a slit behind the ankle that cuts the heel off in the
   // horizontal cuts there; the piece nearer the midline was taken for the leg, and
