@@ -357,6 +357,39 @@ TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
   EXPECT_NEAR(filled->find("crotch_height")->value_mm, clean, 1.0);
 }
 
+TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
+  // No camera sees the top of the armpit, and hole filling can join arm and flank
+  // below it (male_average, tiered rig: 9 mm below the truth's junction). Here the
+  // true body's skin round both junctions is marked invented for 6 mm above them:
+  // the armpits rise to where it is measured again, and the chest, cut just under
+  // the lower armpit, stays below both arms' own loops. Marked for 30 mm (beyond 1 %
+  // of the height: the thesis rig sees no armpit at all) they stay at the junction.
+  const MaleAverage* body = male_average();
+  ASSERT_TRUE(body);
+  const BodyMeasurements& clean = body->measured;
+  const Eigen::Vector3d left = clean.landmark("armpit_left")->position;
+  const Eigen::Vector3d right = clean.landmark("armpit_right")->position;
+  for (double band : {6.0, 30.0}) {
+    TriangleMesh mesh = body->mesh;
+    mesh.confidence.assign(mesh.vertices.size(), 1.f);
+    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+      const Vec3f& v = mesh.vertices[i];
+      for (const Eigen::Vector3d& a : {left, right})
+        if (std::abs(v.x() - a.x()) < 25 && v.y() > a.y() - 1 && v.y() < a.y() + band) mesh.confidence[i] = 0.f;
+    }
+    auto b = measure_body(mesh);
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    const double rise = band < 17 ? band : 0;
+    for (const char* name : {"armpit_left", "armpit_right"})
+      EXPECT_NEAR(b->landmark(name)->position.y(), clean.landmark(name)->position.y() + rise, 1.0)
+          << name << ", band " << band;
+    const double chest_y = b->find("chest_girth")->path.front().y();
+    EXPECT_LT(chest_y, std::min(left.y(), right.y()));
+    // Up to 6 mm higher, about 1.2 mm of girth per mm; round an arm too, 200 mm more.
+    EXPECT_NEAR(b->find("chest_girth")->value_mm, clean.find("chest_girth")->value_mm, 10.0) << "band " << band;
+  }
+}
+
 TEST(BodyMeasurements, AThighsTapeThroughAFilledBridgeGoesRoundItsMeasuredSkin) {
   // A cut below the crotch where hole filling joined the thighs: two thighs of
   // radius 80 mm centred 90 mm either side of the midline, their inner faces (within
