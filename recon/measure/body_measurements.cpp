@@ -323,6 +323,23 @@ class Finder {
     return Status();
   }
 
+  // Up from where two parts join at height y: where the joined loop crosses the
+  // vertical plane X = x on invented surface only, front and back (hole filling's
+  // bridge across a gap no camera sees into), the first level above whose crossing,
+  // front or back, is measured skin, within `reach`, bisected. Else y: the join is
+  // measured, or the bridge reaches farther than that (wholly unseen).
+  double above_bridge(double y, double x, double reach) {
+    const auto measured = [&](double yy) {
+      const Ring* m = midline(rings(yy), xc_);
+      return !m || m->crossing_confidence(x) >= kMeasured;
+    };
+    if (measured(y + 0.5)) return y;
+    prefetch(y, y + reach, 1);
+    for (double yy = y + 1; yy <= y + reach; yy += 1)
+      if (measured(yy)) return bisect(yy - 1, yy, measured);
+    return y;
+  }
+
   Status find_crotch() {
     auto merged = [&](double y) { return midline(rings(y), xc_) != nullptr; };
     const double step = 5;
@@ -337,18 +354,7 @@ class Finder {
         // it, where the thighs are still 17 mm apart). The bridge is filled, the real
         // crotch's front and back are seen: up from the first join, the first level
         // whose midline crossings are measured skin, within 5 % of the height.
-        const auto measured = [&](double yy) {
-          const Ring* m = midline(rings(yy), xc_);
-          return m && m->crossing_confidence(xc_) >= kMeasured;
-        };
-        if (!measured(crotch_y_ + 0.5)) {
-          prefetch(crotch_y_, crotch_y_ + 0.05 * h_, 1);
-          for (double yy = crotch_y_ + 1; yy <= crotch_y_ + 0.05 * h_; yy += 1)
-            if (measured(yy)) {
-              crotch_y_ = bisect(yy - 1, yy, measured);
-              break;
-            }
-        }
+        crotch_y_ = above_bridge(crotch_y_, xc_, 0.05 * h_);
         const std::vector<Ring>& r = rings(crotch_y_ + 0.5);
         double f = zc_, b = zc_;
         if (const Ring* m = midline(r, xc_)) m->crossing_z(xc_, &f, &b);
@@ -400,22 +406,8 @@ class Finder {
     // first level above where one of those crossings is measured skin, if that is
     // within 1 % of the height. Farther up (the thesis rig's level cameras see no
     // armpit at all) the top is wholly unseen, and the armpit stays at the join.
-    {
-      const double gx = p.x();
-      const auto measured = [&](double yy) {
-        const Ring* m = midline(rings(yy), xc_);
-        return !m || m->crossing_confidence(gx) >= kMeasured;
-      };
-      if (!measured(armpit + 0.5)) {
-        prefetch(armpit, armpit + 0.01 * h_, 1);
-        for (double yy = armpit + 1; yy <= armpit + 0.01 * h_; yy += 1)
-          if (measured(yy)) {
-            armpit = bisect(yy - 1, yy, measured);
-            break;
-          }
-        p.y() = armpit;
-      }
-    }
+    armpit = above_bridge(armpit, p.x(), 0.01 * h_);
+    p.y() = armpit;
     armpit_y_[s > 0 ? 0 : 1] = armpit;
     landmark("armpit_" + side(s), p);
     return Status();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <random>
@@ -230,6 +231,19 @@ TriangleMesh with_skin_noise(const TriangleMesh& mesh, uint32_t seed) {
   return noisy;
 }
 
+// Measures the demo body under skin noise, once per seed, and hands each result
+// and the clean body's to `check`.
+template <typename Check>
+void under_skin_noise(std::initializer_list<uint32_t> seeds, const Check& check) {
+  const MaleAverage* body = male_average();
+  ASSERT_TRUE(body);
+  for (uint32_t seed : seeds) {
+    auto b = measure_body(with_skin_noise(body->mesh, seed));
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    check(*b, body->measured, seed);
+  }
+}
+
 TEST(BodyMeasurements, TheKneeStaysPutUnderTheScansNoise) {
   // The knee is the narrowest cut between calf and thigh, and the profile there is
   // shallow: its lowest sample moved 8-10 mm between two scans of one body, taking
@@ -301,17 +315,12 @@ TEST(BodyMeasurements, AShallowUnderBustFoldStaysPutUnderTheScansNoise) {
   // of under-bust girth), and 6-11 mm under +-0.5 mm of skin noise (girth 6-13 mm).
   // Refined to the vertex of a parabola it stays within 3 mm; the girth within 4 mm
   // (the noise itself widens the tape by 1-2 mm).
-  const MaleAverage* body = male_average();
-  ASSERT_TRUE(body);
-  const BodyMeasurements* clean = &body->measured;
-  for (uint32_t seed : {1u, 2u, 3u}) {
-    auto b = measure_body(with_skin_noise(body->mesh, seed));
-    ASSERT_TRUE(b.ok()) << b.status().message();
-    EXPECT_NEAR(b->landmark("underbust_front_point")->position.y(), clean->landmark("underbust_front_point")->position.y(),
+  under_skin_noise({1u, 2u, 3u}, [](const BodyMeasurements& b, const BodyMeasurements& clean, uint32_t seed) {
+    EXPECT_NEAR(b.landmark("underbust_front_point")->position.y(), clean.landmark("underbust_front_point")->position.y(),
                 3.0)
         << "seed " << seed;
-    EXPECT_NEAR(b->find("underbust_girth")->value_mm, clean->find("underbust_girth")->value_mm, 4.0) << "seed " << seed;
-  }
+    EXPECT_NEAR(b.find("underbust_girth")->value_mm, clean.find("underbust_girth")->value_mm, 4.0) << "seed " << seed;
+  });
 }
 
 TEST(BodyMeasurements, TheHipLevelStaysPutUnderTheScansNoise) {
@@ -320,14 +329,9 @@ TEST(BodyMeasurements, TheHipLevelStaysPutUnderTheScansNoise) {
   // middle put the hip 6.8 and 9.2 mm off on tiered-rig scans of female_heavy and
   // male_heavy. The vertex of a parabola over 2 % of the height either side stays
   // within 1.5 mm of the clean body's under +-0.5 mm of skin noise, three seeds.
-  const MaleAverage* body = male_average();
-  ASSERT_TRUE(body);
-  const BodyMeasurements* clean = &body->measured;
-  for (uint32_t seed : {1u, 2u, 3u}) {
-    auto b = measure_body(with_skin_noise(body->mesh, seed));
-    ASSERT_TRUE(b.ok()) << b.status().message();
-    EXPECT_NEAR(b->find("hip_height")->value_mm, clean->find("hip_height")->value_mm, 1.5) << "seed " << seed;
-  }
+  under_skin_noise({1u, 2u, 3u}, [](const BodyMeasurements& b, const BodyMeasurements& clean, uint32_t seed) {
+    EXPECT_NEAR(b.find("hip_height")->value_mm, clean.find("hip_height")->value_mm, 1.5) << "seed " << seed;
+  });
 }
 
 TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
