@@ -21,11 +21,14 @@ StatusOr<std::vector<Marker>> find_markers(const ImageView& on, const ImageView&
   const std::vector<int> label = label_components(w, h, [&](int x, int y) { return diff(x, y) >= o.threshold; }, &count);
   std::vector<Marker> blobs(static_cast<size_t>(count));
   std::vector<Eigen::Vector2d> moment(static_cast<size_t>(count), Eigen::Vector2d::Zero());
+  std::vector<Eigen::Vector4i> box(static_cast<size_t>(count), Eigen::Vector4i(w, h, -1, -1));  // x0, y0, x1, y1
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const int l = label[static_cast<size_t>(y) * w + x];
       if (l < 0) continue;
       const double d = diff(x, y);
+      Eigen::Vector4i& b = box[static_cast<size_t>(l)];
+      b = Eigen::Vector4i(std::min(b(0), x), std::min(b(1), y), std::max(b(2), x), std::max(b(3), y));
       blobs[static_cast<size_t>(l)].area += 1;
       blobs[static_cast<size_t>(l)].mass += d;
       moment[static_cast<size_t>(l)] += d * Eigen::Vector2d(x, y);
@@ -37,13 +40,6 @@ StatusOr<std::vector<Marker>> find_markers(const ImageView& on, const ImageView&
   // widened by kTail pixels, every pixel not another blob's counts with its signed
   // difference (the background's noise averages out rather than adding up).
   constexpr int kTail = 3;
-  std::vector<Eigen::Vector4i> box(static_cast<size_t>(count), Eigen::Vector4i(w, h, -1, -1));
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      if (const int l = label[static_cast<size_t>(y) * w + x]; l >= 0) {
-        Eigen::Vector4i& b = box[static_cast<size_t>(l)];
-        b = Eigen::Vector4i(std::min(b(0), x), std::min(b(1), y), std::max(b(2), x), std::max(b(3), y));
-      }
   std::vector<Marker> out;
   for (size_t i = 0; i < blobs.size(); ++i) {
     if (blobs[i].area < o.min_area || blobs[i].area > o.max_area) continue;

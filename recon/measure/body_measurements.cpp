@@ -36,9 +36,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // How far below a flat extreme (the neck's side) a point still counts as on it, mm.
 constexpr double kFlatBand = 3;
-// A mesh vertex at or above this confidence is measured skin; below, hole filling
-// invented it (the threshold BodyMeasurement::crosses_filled_hole uses).
-constexpr float kMeasured = 0.5f;
 // The same for the top of the shoulder, which is broad front to back: a parabola over
 // 3 mm of it is nearly flat, and its vertex moved 7-8 mm under +-0.5 mm of noise.
 constexpr double kRidgeBand = 10;
@@ -331,7 +328,7 @@ class Finder {
   double above_bridge(double y, double x, double reach) {
     const auto measured = [&](double yy) {
       const Ring* m = midline(rings(yy), xc_);
-      return !m || m->crossing_confidence(x) >= kMeasured;
+      return !m || m->crossing_confidence(x) >= kMeasuredConfidence;
     };
     if (measured(y + 0.5)) return y;
     prefetch(y, y + reach, 1);
@@ -1101,13 +1098,13 @@ size_t wrist_cut(const std::vector<double>& g, double palm_rise) {
 
 std::optional<Girth> bridged_part(const Ring& ring, double xc, int side) {
   const size_t n = ring.points.size();
-  if (n < 3 || ring.confidence.size() != n || ring.crossing_confidence(xc) >= kMeasured) return std::nullopt;
+  if (n < 3 || ring.confidence.size() != n || ring.crossing_confidence(xc) >= kMeasuredConfidence) return std::nullopt;
   const double y = ring.points.front().y();
   Girth g;
   g.plane = Plane{Eigen::Vector3d(0, y, 0), Eigen::Vector3d::UnitY()};
   g.loops_cut = 1;
   std::vector<Eigen::Vector2d> flat;
-  auto kept = [&](size_t i) { return side * (ring.points[i].x() - xc) > 0 && ring.confidence[i] >= kMeasured; };
+  auto kept = [&](size_t i) { return side * (ring.points[i].x() - xc) > 0 && ring.confidence[i] >= kMeasuredConfidence; };
   for (size_t i = 0; i < n; ++i) {
     if (side * (ring.points[i].x() - xc) <= 0) continue;
     g.min_confidence = std::min(g.min_confidence, ring.confidence[i]);

@@ -39,6 +39,10 @@ namespace bodyscan {
 
 inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-3";
 
+// A mesh vertex at or above this confidence is measured skin; below, hole filling
+// invented it.
+inline constexpr float kMeasuredConfidence = 0.5f;
+
 struct BodyLandmark {
   std::string name;  // e.g. "crotch", "armpit_left", "back_neck_point"
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // mm, on (or in) the body
@@ -62,7 +66,7 @@ struct BodyMeasurement {
   std::vector<std::string> landmarks;  // names used
   std::string definition;              // how it was taken, one sentence
   float min_confidence = 1;            // lowest mesh confidence along it and at its landmarks
-  bool crosses_filled_hole() const { return min_confidence < 0.5f; }
+  bool crosses_filled_hole() const { return min_confidence < kMeasuredConfidence; }
 };
 
 struct BodyMeasureOptions {

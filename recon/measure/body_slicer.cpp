@@ -23,7 +23,7 @@ bool Ring::crossing_z(double x, double* front, double* back) const {
   return any;
 }
 
-float Ring::crossing_confidence(double x, bool front_only) const {
+float Ring::crossing_confidence(double x) const {
   if (confidence.size() != points.size()) return 1;
   double front = -1e300, back = 1e300;
   float cf = 1, cb = 1;
@@ -38,7 +38,7 @@ float Ring::crossing_confidence(double x, bool front_only) const {
     if (z > front) front = z, cf = c;
     if (z < back) back = z, cb = c;
   }
-  return front_only ? cf : std::max(cf, cb);
+  return std::max(cf, cb);
 }
 
 BodySlicer::BodySlicer(const TriangleMesh& mesh, double y0, double y1, double step)

@@ -28,7 +28,7 @@ struct Ring {
   bool crossing_z(double x, double* front, double* back) const;
   // The mesh's confidence where the loop crosses X = x at its front and at its back,
   // the higher of the two (1 where the mesh has none, or the loop does not cross).
-  float crossing_confidence(double x, bool front_only = false) const;
+  float crossing_confidence(double x) const;
 };
 
 class BodySlicer {
