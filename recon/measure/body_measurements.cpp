@@ -39,6 +39,9 @@ constexpr double kFlatBand = 3;
 // The same for the top of the shoulder, which is broad front to back: a parabola over
 // 3 mm of it is nearly flat, and its vertex moved 7-8 mm under +-0.5 mm of noise.
 constexpr double kRidgeBand = 10;
+// The wrist's cut is the middle of the forearm's flat minimum: where the tape has
+// grown by this much (mm) either side (flat_bottom_middle).
+constexpr double kWristRiseMm = 3;
 // A fold under the bust shallower than this behind its chord (mm) is flat at the
 // bottom, and is refined as the front neck point; a deeper one is a crease.
 constexpr double kShallowFoldMm = 10;
@@ -139,6 +142,21 @@ size_t settle(const std::vector<double>& v, size_t k, double tol) {
   while (a > 0 && std::abs(v[a - 1] - v[k]) <= tol) --a;
   while (b + 1 < v.size() && std::abs(v[b + 1] - v[k]) <= tol) ++b;
   return (a + b) / 2;
+}
+
+// The middle of a flat minimum of v over x (x ascending) at v[k]: halfway between
+// where v first rises `rise` above v[k] on either side (interpolated between
+// samples). Nothing when either side never rises that far.
+std::optional<double> flat_bottom_middle(const std::vector<double>& x, const std::vector<double>& v, size_t k,
+                                         double rise) {
+  const double level = v[k] + rise;
+  std::optional<double> lo, hi;
+  for (size_t i = k; i > 0 && !lo; --i)
+    if (v[i - 1] >= level) lo = x[i - 1] + (level - v[i - 1]) / (v[i] - v[i - 1]) * (x[i] - x[i - 1]);
+  for (size_t i = k; i + 1 < v.size() && !hi; ++i)
+    if (v[i + 1] >= level) hi = x[i] + (level - v[i]) / (v[i + 1] - v[i]) * (x[i + 1] - x[i]);
+  if (!lo || !hi) return std::nullopt;
+  return 0.5 * (*lo + *hi);
 }
 
 // The vertex of the parabola least-squares fitted to the samples (x[i], v[i]) within
@@ -517,10 +535,12 @@ class Finder {
     if (us.size() < 4) return not_found("measure: no " + side(s) + " shoulder outline");
     // The shoulder's corner bulges above the chord from the neck to where the outline
     // is well down the arm (that end interpolated between columns), refined to the
-    // vertex of a parabola fitted to the height above the chord over 1 % of the
+    // vertex of a parabola fitted to the height above the chord over 2 % of the
     // height either side: the outline is a smooth curve there, and its highest
-    // sample above the chord moved 6-10 mm under +-0.5 mm of skin noise.
-    const auto [k, u] = refined_corner(us, tops, y_arm, 1, 0.01 * h_);
+    // sample above the chord moved 6-10 mm under +-0.5 mm of skin noise. Over 1 %
+    // the vertex still moved 9.5 mm under skin noise (male_average, one seed of
+    // five) and 4-8 mm between two scans of one body on the thesis rig.
+    const auto [k, u] = refined_corner(us, tops, y_arm, 1, 0.02 * h_);
     if (k == 0) {
       landmark("shoulder_point_" + side(s), snp);
       return Status();
@@ -954,13 +974,14 @@ class Finder {
     };
     // The wrist itself: the narrowest cut perpendicular to the forearm within 3 % of
     // the height either side of the horizontal cuts' narrowest (which an inclined
-    // forearm blurs), settled in the middle of a flat minimum.
+    // forearm blurs), in the middle of its flat minimum.
     StatusOr<Girth> wg = not_found("no loop round the wrist");
     {
       const std::vector<uint32_t> wt = triangles_near(wrist_c, 0.07 * h_);
       std::vector<double> gs;
       std::vector<Girth> cuts;
       std::vector<Eigen::Vector3d> at_cut;
+      std::vector<double> ts;
       for (double t = -0.03 * h_; t <= 0.03 * h_; t += 4) {
         const Eigen::Vector3d p = wrist_c + t * fd;
         StatusOr<Girth> g = mesh_girth(mesh_, Plane{p, fd}, p, &wt);
@@ -968,11 +989,32 @@ class Finder {
         gs.push_back(g->value_mm);
         cuts.push_back(std::move(*g));
         at_cut.push_back(p);
+        ts.push_back(t);
       }
       if (!gs.empty()) {
-        const size_t k = settle(gs, arg_extreme(gs, false), 1.0);
-        wrist_c = at_cut[k];
-        wg = std::move(cuts[k]);
+        // Along the forearm the tape is flat over 10-20 mm at its narrowest, and
+        // 1-2 mm of difference in the skin moved the narrowest cut (or the middle of
+        // the cuts within 1 mm of it) 4-5 mm along the arm between two scans of one
+        // body, and the outer arm length with it. Halfway between where the tape
+        // has grown by 3 mm either side, on the hand's steep rise and the forearm's
+        // slope, it moves about half as far.
+        std::optional<double> t = flat_bottom_middle(ts, gs, arg_extreme(gs, false), kWristRiseMm);
+        StatusOr<Girth> mid = not_found("no loop round the wrist");
+        if (t) {
+          const Eigen::Vector3d p = wrist_c + *t * fd;
+          mid = mesh_girth(mesh_, Plane{p, fd}, p, &wt);
+          if (mid.ok() && winds_round(mid->loop, p, fd) && mid->value_mm <= 0.25 * h_) {
+            wrist_c = p;
+            wg = std::move(mid);
+          } else {
+            t.reset();
+          }
+        }
+        if (!t) {
+          const size_t k = settle(gs, arg_extreme(gs, false), 1.0);
+          wrist_c = at_cut[k];
+          wg = std::move(cuts[k]);
+        }
       }
     }
     const std::vector<uint32_t> et = triangles_near(elbow_c, 0.08 * h_);
