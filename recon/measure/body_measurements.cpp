@@ -39,6 +39,9 @@ constexpr double kFlatBand = 3;
 // The same for the top of the shoulder, which is broad front to back: a parabola over
 // 3 mm of it is nearly flat, and its vertex moved 7-8 mm under +-0.5 mm of noise.
 constexpr double kRidgeBand = 10;
+// The thigh's tape is taken this far (a fraction of the height) below the crotch
+// or lower (measure_leg).
+constexpr double kThighBelowCrotch = 0.015;
 // The wrist's cut is the middle of the forearm's flat minimum: where the tape has
 // grown by this much (mm) either side (flat_bottom_middle).
 constexpr double kWristRiseMm = 3;
@@ -855,12 +858,19 @@ class Finder {
       *y_at = ys[k];
       return cs[k];
     };
+    // Thigh: the largest cut from 1.5 % of the height below the crotch (25 mm on
+    // most bodies, the tailor's "an inch below the crotch") down to 5 %. Right under
+    // the crotch the tape grows 1.5-2 mm per mm of height, and where the thighs
+    // nearly touch a surface closes their gap a few mm early (the concave corner is
+    // rounded): at 0.5 % below the crotch the thigh girths were -9.6/-9.2 mm on
+    // female_average and -4.2/-4.1 on female_heavy (tiered rig), and moved up to 5 mm
+    // between two scans of one body with the crotch.
     double ty = crotch_y_ - 0.02 * h_;
-    const Eigen::Vector3d tc = extreme(crotch_y_ - 0.05 * h_, crotch_y_ - 0.005 * h_, true, &ty, true);
+    const Eigen::Vector3d tc = extreme(crotch_y_ - 0.05 * h_, crotch_y_ - kThighBelowCrotch * h_, true, &ty, true);
     const std::optional<Girth> tb = leg(rings(ty), s) ? std::nullopt : bridged_leg(ty, s);
     girth("thigh_girth_" + sd, "Thigh girth (" + sd + ")", "5.3.20", tb ? StatusOr<Girth>(*tb) : level_girth(ty, tc),
           {"crotch"},
-          "horizontal, the largest just below the crotch");
+          "horizontal, the largest from 1.5 % of the height below the crotch down");
     // Knee: the narrowest cut of the leg between calf and thigh (the joint narrows
     // it; 18-36 % of the height), the deepest local minimum if there are several;
     // calf: the largest cut below it.
