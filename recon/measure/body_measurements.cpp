@@ -39,6 +39,9 @@ constexpr double kFlatBand = 3;
 // The same for the top of the shoulder, which is broad front to back: a parabola over
 // 3 mm of it is nearly flat, and its vertex moved 7-8 mm under +-0.5 mm of noise.
 constexpr double kRidgeBand = 10;
+// A join (the legs' at the crotch, an arm's with the flank) counts where it has
+// grown this long front to back (a fraction of the height; Finder::widened).
+constexpr double kJoinDepth = 0.015;
 // The thigh's tape is taken this far (a fraction of the height) below the crotch
 // or lower (measure_leg).
 constexpr double kThighBelowCrotch = 0.015;
@@ -358,6 +361,26 @@ class Finder {
     return y;
   }
 
+  // Up from a join at y (legs or arm and flank), the level where the midline loop's
+  // crossing of the plane X = x has grown `span` long front to back (interpolated
+  // between 1 mm cuts), within `reach`; y if it never does.
+  double widened(double y, double x, double span, double reach) {
+    const auto length = [&](double yy) {
+      double f = 0, b = 0;
+      const Ring* m = midline(rings(yy), xc_);
+      return m && m->crossing_z(x, &f, &b) ? std::abs(f - b) : 0.0;
+    };
+    prefetch(y, y + reach, 1);
+    double prev_y = y, prev = length(y + 0.5);
+    if (prev >= span) return y;
+    for (double yy = y + 1.5; yy <= y + reach; yy += 1) {
+      const double l = length(yy);
+      if (l >= span) return prev_y + 0.5 + (span - prev) / (l - prev) * (yy - prev_y - 0.5);
+      prev_y = yy - 0.5, prev = l;
+    }
+    return y;
+  }
+
   Status find_crotch() {
     auto merged = [&](double y) { return midline(rings(y), xc_) != nullptr; };
     const double step = 5;
@@ -373,6 +396,15 @@ class Finder {
         // crotch's front and back are seen: up from the first join, the first level
         // whose midline crossings are measured skin, within 5 % of the height.
         crotch_y_ = above_bridge(crotch_y_, xc_, 0.05 * h_);
+        // The surface also rounds the corner where measured thighs meet: it closes
+        // their gap a few mm below the crotch (female_average, tiered rig: 5.4 mm,
+        // where the thighs are 12 mm apart), and there the join is a narrow saddle,
+        // 5-30 mm front to back, that grows 4-10 mm per mm of height. A true
+        // crotch's floor is 15-70 mm long where the legs first meet. The crotch is
+        // where the join has grown kJoinDepth of the height long (25 mm on most
+        // bodies): on the true bodies 0.5-1.0 mm above the first join, on that scan
+        // 5.6 mm (crotch -5.4 -> -1.5 mm, thighs -6.3/-6.5 -> -2.6/-3.0).
+        crotch_y_ = widened(crotch_y_, xc_, kJoinDepth * h_, 0.02 * h_);
         const std::vector<Ring>& r = rings(crotch_y_ + 0.5);
         double f = zc_, b = zc_;
         if (const Ring* m = midline(r, xc_)) m->crossing_z(xc_, &f, &b);
@@ -425,6 +457,13 @@ class Finder {
     // within 1 % of the height. Farther up (the thesis rig's level cameras see no
     // armpit at all) the top is wholly unseen, and the armpit stays at the join.
     armpit = above_bridge(armpit, p.x(), 0.01 * h_);
+    // The chest is cut under the armpit's vault: where the join of arm and flank has
+    // grown kJoinDepth of the height long front to back, as at the crotch. A scan's
+    // join narrows to a saddle a few mm below the true armpit; how far down depends
+    // on the noise, and the chest girth moved 6 mm between two scans of one body
+    // (tiered rig, male_average; now under 1). The armpit itself stays at the join:
+    // the neck and shoulder searches start from it.
+    vault_y_[s > 0 ? 0 : 1] = widened(armpit, p.x(), kJoinDepth * h_, 0.02 * h_);
     p.y() = armpit;
     armpit_y_[s > 0 ? 0 : 1] = armpit;
     landmark("armpit_" + side(s), p);
@@ -751,7 +790,6 @@ class Finder {
   }
 
   void measure_torso() {
-    const double ya = std::min(armpit_y_[0], armpit_y_[1]);
     auto near = [&](double y) { return Eigen::Vector3d(xc_, y, zc_); };
     // Neck girth: the smallest loop round the neck over planes tilted forward and back.
     {
@@ -788,9 +826,10 @@ class Finder {
     }
     // Below where either arm's own loop ends: above it, where the armpit's top was
     // a filled bridge (find_armpit), the cut's loop holds that arm too.
-    const double chest_y = std::min(ya - 0.005 * h_, std::min(arm_apart_y_[0], arm_apart_y_[1]) - 0.5);
+    const double chest_y =
+        std::min(std::min(vault_y_[0], vault_y_[1]) - 0.005 * h_, std::min(arm_apart_y_[0], arm_apart_y_[1]) - 0.5);
     girth("chest_girth", "Chest girth", "5.3.6", level_girth(chest_y, near(chest_y)), {"armpit_left", "armpit_right"},
-          "horizontal, just under the lower armpit");
+          "horizontal, just under the lower armpit's vault (where the join of arm and flank is 1.5 % of the height deep)");
     girth("bust_girth", "Bust girth", "5.3.4", level_girth(bust_y_, near(bust_y_)), {"bust_point_left", "bust_point_right"},
           "horizontal, at the level of the chest's most forward point");
     girth("underbust_girth", "Under-bust girth", "5.3.8", level_girth(underbust_y_, near(underbust_y_)),
@@ -1120,6 +1159,7 @@ class Finder {
   mutable std::unordered_map<int64_t, std::vector<Ring>> ring_cache_;
   Eigen::Vector3d top_ = Eigen::Vector3d::Zero(), neck_c_ = Eigen::Vector3d::Zero();
   double floor_ = 0, h_ = 0, xc_ = 0, zc_ = 0;
+  double vault_y_[2] = {0, 0};  // where each armpit's join is kJoinDepth deep (the chest is cut below)
   double crotch_y_ = 0, armpit_y_[2] = {0, 0}, neck_y_ = 0, neck_tilt_ = 0;
   double arm_apart_y_[2] = {0, 0};  // where each arm's own loop ends (the armpit below a filled bridge)
   double bust_y_ = 0, underbust_y_ = 0, waist_y_ = 0, hip_y_ = 0;
