@@ -400,6 +400,20 @@ TEST(BodyMeasurements, TheThighsTapeIsWhereTheCrotchDoesNotPullIt) {
   }
 }
 
+// The true male_average with a wall 5 mm thick and 2 * half_length long front to
+// back standing between its thighs at the crotch, from `below` under it to `above`
+// over it, all marked measured (confidence 1).
+TriangleMesh with_crotch_wall(const MaleAverage& body, double half_length, double below, double above) {
+  const Eigen::Vector3d crotch = body.measured.landmark("crotch")->position;
+  std::vector<Eigen::Vector2d> wall;
+  for (const Eigen::Vector2d& p : testing::circle(1, {0, 0}, 64))
+    wall.emplace_back(crotch.x() + 2.5 * p.x(), crotch.z() + half_length * p.y());
+  TriangleMesh mesh = testing::merged(
+      body.mesh, testing::prism(wall, {crotch.x(), crotch.z()}, crotch.y() - below, crotch.y() + above));
+  mesh.confidence.assign(mesh.vertices.size(), 1.f);
+  return mesh;
+}
+
 TEST(BodyMeasurements, ANarrowSaddleUnderTheCrotchIsNoCrotch) {
   // A scan rounds the corner where measured thighs meet, closing their gap a few mm
   // below the crotch (female_average, tiered rig: 5.4 mm) in a saddle 5-30 mm long
@@ -409,15 +423,8 @@ TEST(BodyMeasurements, ANarrowSaddleUnderTheCrotchIsNoCrotch) {
   // within 1 mm of the clean body's, and the chest under the armpits' vaults too.
   const MaleAverage* body = male_average();
   ASSERT_TRUE(body);
-  const Eigen::Vector3d crotch = body->measured.landmark("crotch")->position;
   const double clean = body->measured.find("crotch_height")->value_mm;
-  std::vector<Eigen::Vector2d> saddle;
-  for (const Eigen::Vector2d& p : testing::circle(1, {0, 0}, 64))
-    saddle.emplace_back(crotch.x() + 2.5 * p.x(), crotch.z() + 8 * p.y());
-  TriangleMesh mesh = testing::merged(
-      body->mesh, testing::prism(saddle, {crotch.x(), crotch.z()}, crotch.y() - 8, crotch.y() + 1));
-  mesh.confidence.assign(mesh.vertices.size(), 1.f);
-  auto b = measure_body(mesh);
+  auto b = measure_body(with_crotch_wall(*body, 8, 8, 1));
   ASSERT_TRUE(b.ok()) << b.status().message();
   EXPECT_NEAR(b->find("crotch_height")->value_mm, clean, 1.0);
   for (const char* name : {"thigh_girth_left", "thigh_girth_right", "chest_girth"})
@@ -433,14 +440,8 @@ TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
   // fill is, the crotch stays where the skin joins.
   const MaleAverage* body = male_average();
   ASSERT_TRUE(body);
-  const Eigen::Vector3d crotch = body->measured.landmark("crotch")->position;
   const double clean = body->measured.find("crotch_height")->value_mm;
-  std::vector<Eigen::Vector2d> wall;
-  for (const Eigen::Vector2d& p : testing::circle(1, {0, 0}, 64))
-    wall.emplace_back(crotch.x() + 2.5 * p.x(), crotch.z() + 30 * p.y());
-  TriangleMesh mesh = testing::merged(
-      body->mesh, testing::prism(wall, {crotch.x(), crotch.z()}, crotch.y() - 25, crotch.y() + 5));
-  mesh.confidence.assign(mesh.vertices.size(), 1.f);
+  TriangleMesh mesh = with_crotch_wall(*body, 30, 25, 5);
   auto seen = measure_body(mesh);
   ASSERT_TRUE(seen.ok()) << seen.status().message();
   EXPECT_NEAR(seen->find("crotch_height")->value_mm, clean - 25, 1.0);
