@@ -371,12 +371,12 @@ class Finder {
       return m && m->crossing_z(x, &f, &b) ? std::abs(f - b) : 0.0;
     };
     prefetch(y, y + reach, 1);
-    double prev_y = y, prev = length(y + 0.5);
+    double at = y + 0.5, prev = length(at);
     if (prev >= span) return y;
-    for (double yy = y + 1.5; yy <= y + reach; yy += 1) {
+    for (double yy = at + 1; yy <= y + reach; yy += 1) {
       const double l = length(yy);
-      if (l >= span) return prev_y + 0.5 + (span - prev) / (l - prev) * (yy - prev_y - 0.5);
-      prev_y = yy - 0.5, prev = l;
+      if (l >= span) return at + (span - prev) / (l - prev) * (yy - at);
+      at = yy, prev = l;
     }
     return y;
   }
@@ -1029,15 +1029,13 @@ class Finder {
       const std::vector<uint32_t> wt = triangles_near(wrist_c, 0.07 * h_);
       std::vector<double> gs;
       std::vector<Girth> cuts;
-      std::vector<Eigen::Vector3d> at_cut;
-      std::vector<double> ts;
+      std::vector<double> ts;  // the cuts' offsets along the forearm from wrist_c
       for (double t = -0.03 * h_; t <= 0.03 * h_; t += 4) {
         const Eigen::Vector3d p = wrist_c + t * fd;
         StatusOr<Girth> g = mesh_girth(mesh_, Plane{p, fd}, p, &wt);
         if (!g.ok() || !winds_round(g->loop, p, fd) || g->value_mm > 0.25 * h_) continue;
         gs.push_back(g->value_mm);
         cuts.push_back(std::move(*g));
-        at_cut.push_back(p);
         ts.push_back(t);
       }
       if (!gs.empty()) {
@@ -1048,10 +1046,9 @@ class Finder {
         // has grown by 3 mm either side, on the hand's steep rise and the forearm's
         // slope, it moves about half as far.
         std::optional<double> t = flat_bottom_middle(ts, gs, arg_extreme(gs, false), kWristRiseMm);
-        StatusOr<Girth> mid = not_found("no loop round the wrist");
         if (t) {
           const Eigen::Vector3d p = wrist_c + *t * fd;
-          mid = mesh_girth(mesh_, Plane{p, fd}, p, &wt);
+          StatusOr<Girth> mid = mesh_girth(mesh_, Plane{p, fd}, p, &wt);
           if (mid.ok() && winds_round(mid->loop, p, fd) && mid->value_mm <= 0.25 * h_) {
             wrist_c = p;
             wg = std::move(mid);
@@ -1061,7 +1058,7 @@ class Finder {
         }
         if (!t) {
           const size_t k = settle(gs, arg_extreme(gs, false), 1.0);
-          wrist_c = at_cut[k];
+          wrist_c += ts[k] * fd;
           wg = std::move(cuts[k]);
         }
       }
