@@ -34,8 +34,15 @@ const BodyLandmark* BodyMeasurements::landmark(const std::string& name) const {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// How far below a flat extreme (the neck's side) a point still counts as on it, mm.
+// How far below a flat extreme a point still counts as on it, mm.
 constexpr double kFlatBand = 3;
+// The same for the neck's side at its base, flat front to back: over 3 mm the
+// parabola's vertex moved 3.7 mm under +-0.5 mm of skin noise.
+constexpr double kNeckSideBand = 5;
+// The neck's base (the side neck points) is where the front outline has flared to
+// this many times the radius of the neck's narrowest horizontal tape
+// (find_side_neck).
+constexpr double kNeckBaseWidth = 1.3;
 // The same for the top of the shoulder, which is broad front to back: a parabola over
 // 3 mm of it is nearly flat, and its vertex moved 7-8 mm under +-0.5 mm of noise.
 constexpr double kRidgeBand = 10;
@@ -221,11 +228,11 @@ Notch deepest_behind_chord(const std::vector<Eigen::Vector2d>& c, double half) {
 // `v_end`: the sample farthest from the chord from the first sample to where v
 // reaches v_end (interpolated between the last two: the last sample jumps with the
 // walk's step, and the chord's end with it), refined to the vertex of a parabola
-// fitted to that distance over `half` of x either side. `sign` +1: farthest on the
-// chord's left (above an outline); 0: either side. Returns the sample and the
-// refined x; the sample is 0 where nothing lies on that side.
+// fitted to that distance over `half` of x either side. Only samples on the
+// chord's left (above an outline) count. Returns the sample and the refined x; the
+// sample is 0 where nothing lies on that side.
 std::pair<size_t, double> refined_corner(const std::vector<double>& x, const std::vector<double>& v, double v_end,
-                                         int sign, double half) {
+                                         double half) {
   const size_t n = x.size();
   Eigen::Vector2d end(x[n - 1], v[n - 1]);
   if ((v[n - 1] - v_end) * (v[n - 2] - v_end) < 0) {
@@ -234,10 +241,7 @@ std::pair<size_t, double> refined_corner(const std::vector<double>& x, const std
   }
   const Eigen::Vector2d a(x[0], v[0]), d = (end - a).normalized();
   std::vector<double> dist;
-  for (size_t i = 0; i < n; ++i) {
-    const double signed_dist = d.x() * (v[i] - a.y()) - d.y() * (x[i] - a.x());
-    dist.push_back(sign == 0 ? std::abs(signed_dist) : sign * signed_dist);
-  }
+  for (size_t i = 0; i < n; ++i) dist.push_back(d.x() * (v[i] - a.y()) - d.y() * (x[i] - a.x()));
   const size_t k = arg_extreme(dist, true);
   return {k, parabola_vertex(x, dist, k, half, false).value_or(x[k])};
 }
@@ -501,37 +505,34 @@ class Finder {
     if (ys.empty()) return not_found("measure: no neck found between the armpits and the head");
     const size_t k = settle(gs, arg_extreme(gs, false), 1.0);
     neck_y_ = ys[k], neck_c_ = cs[k];
+    // The narrowest tape is flat over several mm, so its length holds still where
+    // its level slides.
+    neck_r_ = *std::min_element(gs.begin(), gs.end()) / (2 * M_PI);
     landmark("neck_level", neck_c_);
     return Status();
   }
 
   Status find_side_neck(int s) {
-    std::vector<double> ys, ws;  // the midline loop's half-width on side s, from the neck down
-    double w0 = -1;
+    // The neck's base on side s: the level where the front outline (the midline
+    // loop's half-width on that side) has flared to kNeckBaseWidth times the radius
+    // of the neck's narrowest horizontal tape, interpolated between cuts.
+    const double target = kNeckBaseWidth * neck_r_;
     const double ya = std::max(armpit_y_[0], armpit_y_[1]);
+    double y_prev = neck_y_, w_prev = -kInf, y_base = kInf;
     prefetch(neck_y_, ya, -2);
-    for (double y = neck_y_; y > ya; y -= 2) {
+    for (double y = neck_y_; y > ya && y_base == kInf; y -= 2) {
       const Ring* m = midline(rings(y), xc_);
       if (!m) break;
       double w = -kInf;
       for (const Eigen::Vector3d& p : m->points) w = std::max(w, s * (p.x() - xc_));
-      if (w0 < 0) w0 = w;
-      ys.push_back(y), ws.push_back(w);
-      if (w > w0 + 0.035 * h_) break;
+      if (w >= target) y_base = w_prev == -kInf ? y : y_prev + (target - w_prev) / (w - w_prev) * (y - y_prev);
+      y_prev = y, w_prev = w;
     }
-    if (ys.size() < 6) return not_found("measure: no " + side(s) + " shoulder below the neck");
-    // Where the outline turns from the neck's side onto the shoulder: the level
-    // farthest from the chord between the neck and the point where the outline has
-    // widened by 3.5 % of the height (interpolated between cuts: the walk's last cut
-    // jumped up to 10 mm wide and moved the corner with it), refined to the vertex of
-    // a parabola fitted to that distance over 1 % of the height either side. The
-    // outline is a smooth curve, and its farthest sample moved 4 mm under +-0.5 mm of
-    // skin noise.
-    const double y_turn = refined_corner(ys, ws, ws.front() + 0.035 * h_, 0, 0.01 * h_).second;
-    const Ring* m = midline(rings(y_turn), xc_);
+    if (y_base == kInf) return not_found("measure: no " + side(s) + " shoulder below the neck");
+    const Ring* m = midline(rings(y_base), xc_);
     if (!m) return not_found("measure: no " + side(s) + " side of the neck at its base");
     landmark("side_neck_point_" + side(s),
-             middle_of_extreme(m->points, {static_cast<double>(s), 0, 0}, Eigen::Vector3d::UnitZ(), kFlatBand));
+             middle_of_extreme(m->points, {static_cast<double>(s), 0, 0}, Eigen::Vector3d::UnitZ(), kNeckSideBand));
     return Status();
   }
 
@@ -582,7 +583,7 @@ class Finder {
     // sample above the chord moved 6-10 mm under +-0.5 mm of skin noise. Over 1 %
     // the vertex still moved 9.5 mm under skin noise (male_average, one seed of
     // five) and 4-8 mm between two scans of one body on the thesis rig.
-    const auto [k, u] = refined_corner(us, tops, y_arm, 1, 0.02 * h_);
+    const auto [k, u] = refined_corner(us, tops, y_arm, 0.02 * h_);
     if (k == 0) {
       landmark("shoulder_point_" + side(s), snp);
       return Status();
@@ -1157,7 +1158,7 @@ class Finder {
   Eigen::Vector3d top_ = Eigen::Vector3d::Zero(), neck_c_ = Eigen::Vector3d::Zero();
   double floor_ = 0, h_ = 0, xc_ = 0, zc_ = 0;
   double vault_y_[2] = {0, 0};  // where each armpit's join is kJoinDepth deep (the chest is cut below)
-  double crotch_y_ = 0, armpit_y_[2] = {0, 0}, neck_y_ = 0, neck_tilt_ = 0;
+  double crotch_y_ = 0, armpit_y_[2] = {0, 0}, neck_y_ = 0, neck_r_ = 0, neck_tilt_ = 0;
   double arm_apart_y_[2] = {0, 0};  // where each arm's own loop ends (the armpit below a filled bridge)
   double bust_y_ = 0, underbust_y_ = 0, waist_y_ = 0, hip_y_ = 0;
   bool underbust_fold_ = false;  // the front turns in below the bust

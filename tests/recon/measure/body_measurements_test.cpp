@@ -293,20 +293,25 @@ TEST(BodyMeasurements, TheNeckAndShoulderPointsStayPutUnderTheScansNoise) {
   // by 8-9 mm and the shoulder width by 6 mm: the front neck point, the deepest sample
   // of a profile flat over 10-15 mm, moved 6 mm; the side neck points' and the
   // acromions' corners against a chord moved 2-10 mm, and the widest or highest point
-  // slid along the neck's flat side and the shoulder's top. Now the points stay within
-  // 3 mm, the shoulder width within 2 mm and the neck base girth within 2.5 mm (2.2 at
-  // most: the neck's level and the side neck walk are sampled every 2 mm from the
-  // armpit up, and a fraction of a mm there still moves the side neck corner).
+  // slid along the neck's flat side and the shoulder's top. The side neck corner
+  // still moved 1.5 mm and the neck base girth 2.2 mm: the outline flares smoothly
+  // from the neck onto the shoulder, and the farthest point from a chord anchored at
+  // the neck's level moved with where the neck was sampled. At the level where the
+  // outline has flared to 1.3 times the narrowest tape's radius, the side neck points
+  // stay within 0.6 mm and the neck base girth within 1.1 (five seeds); the other
+  // points within 3 mm and the shoulder width within 2.
   const MaleAverage* body = male_average();
   ASSERT_TRUE(body);
   const BodyMeasurements* clean = &body->measured;
-  for (uint32_t seed : {1u, 2u}) {
+  for (uint32_t seed : {1u, 2u, 3u}) {
     auto b = measure_body(with_skin_noise(body->mesh, seed));
     ASSERT_TRUE(b.ok()) << b.status().message();
     for (const char* name : {"side_neck_point_left", "side_neck_point_right", "front_neck_point", "back_neck_point",
-                             "shoulder_point_left", "shoulder_point_right"})
-      EXPECT_LT((b->landmark(name)->position - clean->landmark(name)->position).norm(), 3.0) << name << ", seed " << seed;
-    EXPECT_NEAR(b->find("neck_base_girth")->value_mm, clean->find("neck_base_girth")->value_mm, 2.5) << "seed " << seed;
+                             "shoulder_point_left", "shoulder_point_right"}) {
+      const double moved = (b->landmark(name)->position - clean->landmark(name)->position).norm();
+      EXPECT_LT(moved, std::string(name).rfind("side_neck", 0) == 0 ? 1.0 : 3.0) << name << ", seed " << seed;
+    }
+    EXPECT_NEAR(b->find("neck_base_girth")->value_mm, clean->find("neck_base_girth")->value_mm, 1.5) << "seed " << seed;
     EXPECT_NEAR(b->find("shoulder_width")->value_mm, clean->find("shoulder_width")->value_mm, 2.0) << "seed " << seed;
   }
 }
