@@ -5,12 +5,15 @@
 //
 //   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR | --saved DIR]
-//                     [--seed N] [--min-weight W]
+//                     [--resurface] [--seed N] [--min-weight W]
 //
-// --save writes each scan's surface and the posed true body as PLY into DIR (with
-// --repeat, the second scan's surface too). --saved DIR measures what --save kept
-// again, with today's rules, without scanning (--body names the files, --rig gives
-// the floor): about two minutes for six bodies instead of an hour.
+// --save writes each scan's surface, its point cloud and the posed true body as PLY
+// into DIR (with --repeat, the second scan's surface and cloud too). --saved DIR
+// measures what --save kept again, with today's rules, without scanning (--body
+// names the files, --rig gives the floor): about two minutes for six bodies instead
+// of an hour. With --resurface it first builds each surface again from the saved
+// cloud with today's reconstruction (as the scan job does, half a minute a scan),
+// so a change to the surface is judged on the same scans.
 // --min-weight sets the surface's ReconstructOptions::min_relative_weight.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
@@ -23,6 +26,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <string>
@@ -64,6 +68,7 @@ struct Scan {
 HoleFairing g_fairing = pipeline::body_surface_options().hole_fairing;
 float g_min_weight = pipeline::body_surface_options().min_relative_weight;
 std::string g_save;
+bool g_resurface = false;
 uint64_t g_seed = 1;
 
 // A shipped rig by name, or a description file.
@@ -214,8 +219,9 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   std::printf("scan job %.0f s, mesh %zu triangles\n", secs(t0), a->mesh.triangles.size());
   const std::string stem = g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
   if (!g_save.empty()) {
-    const Status w1 = write_ply(stem + "-scan.ply", a->mesh), w2 = write_ply(stem + "-truth.ply", a->truth);
-    if (!w1.ok() || !w2.ok()) std::fprintf(stderr, "--save: %s\n", (w1.ok() ? w2 : w1).message().c_str());
+    for (const Status& w : {write_ply(stem + "-scan.ply", a->mesh), write_ply(stem + "-truth.ply", a->truth),
+                            write_ply(stem + "-cloud.ply", a->cloud)})
+      if (!w.ok()) std::fprintf(stderr, "--save: %s\n", w.message().c_str());
   }
   {
     // The same scan surfaced on a coarser grid, about 500k triangles.
@@ -239,11 +245,29 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
     auto s = scan(rig, body, g_seed + 1, sway, every);
     if (!s.ok()) return std::fprintf(stderr, "second scan: %s\n", s.status().message().c_str()), 1;
     if (!g_save.empty()) {
-      if (Status w = write_ply(stem + "-scan2.ply", s->mesh); !w.ok()) std::fprintf(stderr, "--save: %s\n", w.message().c_str());
+      for (const Status& w : {write_ply(stem + "-scan2.ply", s->mesh), write_ply(stem + "-cloud2.ply", s->cloud)})
+        if (!w.ok()) std::fprintf(stderr, "--save: %s\n", w.message().c_str());
     }
     b = std::move(*s);
   }
   return report(a->truth, a->mesh, *a->body, a->floor, b ? &*b->body : nullptr, sway);
+}
+
+// A saved scan's surface: B-scanN.ply, or with --resurface one built again from
+// B-cloudN.ply as the scan job builds it.
+StatusOr<TriangleMesh> saved_surface(const std::string& stem, const std::string& n) {
+  if (!g_resurface) return read_ply_mesh(stem + "-scan" + n + ".ply");
+  ASSIGN_OR_RETURN(PlyData ply, read_ply(stem + "-cloud" + n + ".ply"));
+  PointCloud& cloud = ply.cloud;
+  ReconstructOptions ro = pipeline::body_surface_options();
+  ro.hole_fairing = g_fairing;
+  ro.min_relative_weight = g_min_weight;
+  ro = pipeline::with_scan_normals(ro, cloud);
+  const auto t0 = Clock::now();
+  ASSIGN_OR_RETURN(ReconstructResult r, reconstruct_surface(cloud, ro));
+  std::printf("surfaced again from %s-cloud%s.ply: %zu triangles, %.0f s\n", stem.c_str(), n.c_str(),
+              r.mesh.triangles.size(), secs(t0));
+  return std::move(r.mesh);
 }
 
 // What --save kept, measured again with today's rules: DIR/B-truth.ply, B-scan.ply
@@ -255,7 +279,7 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
   if (!desc.ok()) return std::fprintf(stderr, "%s\n", desc.status().message().c_str()), 1;
   const double floor = -0.5 * desc->frame.tube;  // as scan() takes it
   auto truth = read_ply_mesh(stem + "-truth.ply");
-  auto mesh = read_ply_mesh(stem + "-scan.ply");
+  auto mesh = saved_surface(stem, "");
   if (!truth.ok() || !mesh.ok())
     return std::fprintf(stderr, "%s\n", (truth.ok() ? mesh.status() : truth.status()).message().c_str()), 1;
   BodyMeasureOptions mo;
@@ -263,7 +287,8 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
   auto a = measure_body(*mesh, mo);
   if (!a.ok()) return std::fprintf(stderr, "scan set: %s\n", a.status().message().c_str()), 1;
   std::optional<BodyMeasurements> b;
-  if (auto mesh2 = read_ply_mesh(stem + "-scan2.ply"); mesh2.ok()) {
+  const bool has_second = std::ifstream(stem + (g_resurface ? "-cloud2.ply" : "-scan2.ply")).good();
+  if (auto mesh2 = has_second ? saved_surface(stem, "2") : StatusOr<TriangleMesh>(not_found("")); mesh2.ok()) {
     auto m = measure_body(*mesh2, mo);
     if (!m.ok()) return std::fprintf(stderr, "second scan set: %s\n", m.status().message().c_str()), 1;
     b = std::move(*m);
@@ -288,6 +313,7 @@ int main(int argc, char** argv) {
     else if (a == "--every" && i + 1 < argc) every = std::atoi(argv[++i]);
     else if (a == "--save" && i + 1 < argc) g_save = argv[++i];
     else if (a == "--saved" && i + 1 < argc) saved = argv[++i];
+    else if (a == "--resurface") g_resurface = true;
     else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--min-weight" && i + 1 < argc) g_min_weight = std::strtof(argv[++i], nullptr);
     else if (a == "--fairing" && i + 1 < argc) {
@@ -295,7 +321,7 @@ int main(int argc, char** argv) {
       g_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
     }
     else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
-                        "[--fairing membrane|thin] [--save DIR | --saved DIR] [--seed N] [--min-weight W]\n"), 2;
+                        "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W]\n"), 2;
   }
   if (rigs.empty()) rigs = {"thesis"};
   if (bodies.empty()) bodies = {""};

@@ -17,28 +17,41 @@ uint32_t find_root(std::vector<uint32_t>& parent, uint32_t x) {
 
 MeshComponents label_components(const TriangleMesh& mesh) {
   MeshComponents c;
-  const size_t nv = mesh.vertices.size();
-  std::vector<uint32_t> parent(nv);
+  const size_t nv = mesh.vertices.size(), nt = mesh.triangles.size();
+  // Each vertex's triangles (counting sort), to find the triangles across each edge.
+  std::vector<uint32_t> first(nv + 1, 0), around(3 * nt);
+  for (const Triangle& t : mesh.triangles)
+    for (uint32_t v : t) ++first[v + 1];
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+  for (size_t i = 0; i < nt; ++i)
+    for (uint32_t v : mesh.triangles[i]) around[fill[v]++] = static_cast<uint32_t>(i);
+  std::vector<uint32_t> parent(nt);
   std::iota(parent.begin(), parent.end(), 0u);
-  for (const Triangle& t : mesh.triangles) {
-    const uint32_t a = find_root(parent, t[0]);
-    for (int k = 1; k < 3; ++k) {
-      const uint32_t b = find_root(parent, t[k]);
-      if (a != b) parent[b] = a;
+  for (size_t i = 0; i < nt; ++i) {
+    const Triangle& t = mesh.triangles[i];
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = t[k], b = t[(k + 1) % 3];
+      for (uint32_t j = first[a]; j < first[a + 1]; ++j) {
+        const Triangle& o = mesh.triangles[around[j]];
+        if (around[j] == i || (o[0] != b && o[1] != b && o[2] != b)) continue;
+        const uint32_t ra = find_root(parent, static_cast<uint32_t>(i)), rb = find_root(parent, around[j]);
+        if (ra != rb) parent[rb] = ra;
+      }
     }
   }
   // Count triangles per root, then number roots by decreasing size.
-  std::vector<size_t> count(nv, 0);
-  c.triangle_label.resize(mesh.triangles.size());
-  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-    c.triangle_label[i] = find_root(parent, mesh.triangles[i][0]);
+  std::vector<size_t> count(nt, 0);
+  c.triangle_label.resize(nt);
+  for (size_t i = 0; i < nt; ++i) {
+    c.triangle_label[i] = find_root(parent, static_cast<uint32_t>(i));
     ++count[c.triangle_label[i]];
   }
   std::vector<uint32_t> roots;
-  for (uint32_t v = 0; v < nv; ++v)
+  for (uint32_t v = 0; v < nt; ++v)
     if (count[v] > 0) roots.push_back(v);
   std::stable_sort(roots.begin(), roots.end(), [&](uint32_t a, uint32_t b) { return count[a] > count[b]; });
-  std::vector<uint32_t> rank(nv, 0);
+  std::vector<uint32_t> rank(nt, 0);
   for (size_t r = 0; r < roots.size(); ++r) {
     rank[roots[r]] = static_cast<uint32_t>(r);
     c.triangle_count.push_back(count[roots[r]]);

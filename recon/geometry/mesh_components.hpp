@@ -1,4 +1,7 @@
-// Connected components of a triangle mesh (triangles joined by shared vertices).
+// Connected components of a triangle mesh: triangles joined by shared edges, as
+// analyze_topology() counts them. A piece that touches the rest at a single
+// vertex (a small closed blob the hole filling left in an eye socket) is a
+// component of its own, so that remove_small_components() drops it.
 #pragma once
 
 #include <cstdint>

@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace bodyscan {
 
@@ -23,7 +24,7 @@ std::vector<float> density_sigma(const NeighborGraph& graph, size_t k) {
 std::vector<Kernel> adapt_kernels(const std::vector<Vec3f>& points, const LocalFrames& frames,
                                   const std::vector<float>& sigma_density,
                                   const CurvatureResult* curvature,
-                                  const std::vector<float>& mean_curvature,
+                                  const std::vector<ShapeOperator>& shape,
                                   const std::vector<float>& confidence,
                                   const AdaptKernelsOptions& options) {
   const size_t n = points.size();
@@ -52,10 +53,24 @@ std::vector<Kernel> adapt_kernels(const std::vector<Vec3f>& points, const LocalF
       k.sigma_t2 = std::max(floor, sd * (options.sigma_user - options.sharpening * c[1] * sd));
     }
     k.sigma_n = options.normal_scale * sd;
-    if (options.curvature_compensation && !mean_curvature.empty()) {
+    if (options.curvature_compensation && !shape.empty()) {
+      const ShapeOperator& s = shape[i];
+      float b1 = s.s11, b2 = s.s22;
+      if (k.sigma_t1 == k.sigma_t2) {
+        // A round kernel turns freely: along the principal directions its
+        // paraboloid is the surface's, cross term and all.
+        const float theta = 0.5f * std::atan2(2.f * s.s12, s.s11 - s.s22);
+        const float c = std::cos(theta), sn = std::sin(theta);
+        const Vec3f t1 = c * k.t1 + sn * k.t2, t2 = c * k.t2 - sn * k.t1;
+        k.t1 = t1;
+        k.t2 = t2;
+        b1 = c * c * s.s11 + 2.f * sn * c * s.s12 + sn * sn * s.s22;
+        b2 = sn * sn * s.s11 - 2.f * sn * c * s.s12 + c * c * s.s22;
+      }
       const float limit = options.max_bend / std::max(k.sigma_t1, k.sigma_t2);
-      k.bend = std::clamp(mean_curvature[i], -limit, limit);
-      k.center -= (k.bend * options.noise_sigma * options.noise_sigma) * k.n;
+      k.bend1 = std::clamp(b1, -limit, limit);
+      k.bend2 = std::clamp(b2, -limit, limit);
+      k.center -= (0.5f * (k.bend1 + k.bend2) * options.noise_sigma * options.noise_sigma) * k.n;
     }
     k.weight = std::min(w, 1.f);
     k.band = options.band;

@@ -32,8 +32,9 @@ struct AdaptKernelsOptions {
   float normal_scale = 0.5f;     // sigma_n in units of sigma_density
   float sharpening = 0.f;        // s; 0 = no curvature adaptation
   float min_sigma_fraction = 0.25f;
-  // Bend kernels by the local mean curvature (implicit_field.hpp), clamped so that
-  // |bend| sigma_t <= max_bend.
+  // Bend kernels by the surface's normal curvatures along their axes
+  // (implicit_field.hpp), each clamped so that |bend| sigma_t <= max_bend. A round
+  // kernel (sigma_t1 = sigma_t2) first turns its axes to the principal directions.
   bool curvature_compensation = true;
   float max_bend = 0.7f;
   // Per-axis noise of the points (the cloud's unit). Noise along a curved surface
@@ -50,13 +51,13 @@ struct AdaptKernelsOptions {
 std::vector<float> density_sigma(const NeighborGraph& graph, size_t k);
 
 // Builds one kernel per point. frames: oriented (normals outward). curvature: may
-// be null when options.sharpening == 0. mean_curvature: one per point, or empty
-// when options.curvature_compensation is off. confidence: empty (all 1) or one per point;
+// be null when options.sharpening == 0. shape: one per point (in the frames'
+// tangents), or empty when options.curvature_compensation is off. confidence: empty (all 1) or one per point;
 // points with confidence <= 0 are dropped.
 std::vector<Kernel> adapt_kernels(const std::vector<Vec3f>& points, const LocalFrames& frames,
                                   const std::vector<float>& sigma_density,
                                   const CurvatureResult* curvature,
-                                  const std::vector<float>& mean_curvature,
+                                  const std::vector<ShapeOperator>& shape,
                                   const std::vector<float>& confidence,
                                   const AdaptKernelsOptions& options);
 

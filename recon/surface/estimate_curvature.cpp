@@ -164,14 +164,14 @@ LocalQuadric fit_local_quadric(const std::vector<Vec3f>& points, size_t i, const
 
 namespace {
 
-// Mean curvature from how the (already smooth, wide-PCA) normals turn across the
-// neighbourhood: the shape operator S (2x2, symmetric, in the tangent plane) is
-// fitted by least squares to n_j - n_i = S d_ij over the tangential offsets d_ij,
-// and H = trace(S) / 2. Unlike a height-field fit this is not flattened by noise:
-// a noisy shell's nearest neighbours sit at similar heights, which biases fitted
-// heights (and so curvature) low, but barely moves the normals' turning.
-float shape_operator_mean_curvature(const std::vector<Vec3f>& points, size_t i, const uint32_t* nb,
-                                    size_t count, const LocalFrames& frames) {
+// The shape operator from how the (already smooth, wide-PCA) normals turn across
+// the neighbourhood: S (2x2, symmetric, in the tangent plane) is fitted by least
+// squares to n_j - n_i = S d_ij over the tangential offsets d_ij. Unlike a
+// height-field fit this is not flattened by noise: a noisy shell's nearest
+// neighbours sit at similar heights, which biases fitted heights (and so
+// curvature) low, but barely moves the normals' turning.
+ShapeOperator fit_shape_operator(const std::vector<Vec3f>& points, size_t i, const uint32_t* nb, size_t count,
+                                 const LocalFrames& frames) {
   const Vec3f &t1 = frames.tangent1[i], &t2 = frames.tangent2[i], &ni = frames.normals[i];
   // Unknowns (s11, s12, s22); each neighbour gives two equations:
   //   dn1 = s11 u + s12 v,   dn2 = s12 u + s22 v.
@@ -187,20 +187,38 @@ float shape_operator_mean_curvature(const std::vector<Vec3f>& points, size_t i, 
     atb += r1 * dn1 + r2 * dn2;
   }
   const Eigen::Vector3d sol = ata.ldlt().solve(atb);
-  if (!sol.allFinite()) return 0.f;
-  return static_cast<float>(0.5 * (sol[0] + sol[2]));
+  if (!sol.allFinite()) return {};
+  return {static_cast<float>(sol[0]), static_cast<float>(sol[1]), static_cast<float>(sol[2])};
+}
+
+// Neighbour j's operator read in point i's frame: j's tangent axes are carried into
+// i's tangent plane by the smallest rotation taking n_j to n_i (parallel transport
+// to first order), so that a cylinder's neighbours add their curvature along the
+// same axis instead of losing cos^2 of their frames' tilt.
+Eigen::Matrix2f transported(const ShapeOperator& s, const LocalFrames& f, size_t j, size_t i) {
+  const Vec3f &nj = f.normals[j], &ni = f.normals[i];
+  const float c = nj.dot(ni);
+  Eigen::Matrix2f m;
+  m << s.s11, s.s12, s.s12, s.s22;
+  if (c <= -0.99f) return m;  // opposite sides of a thin sheet: nothing to carry
+  const Vec3f axis = nj + ni;
+  auto carry = [&](const Vec3f& v) -> Vec3f { return v - (ni.dot(v) / (1.f + c)) * axis; };
+  const Vec3f u1 = carry(f.tangent1[j]), u2 = carry(f.tangent2[j]);
+  Eigen::Matrix2f r;  // rows: i's axes; columns: j's carried axes
+  r << f.tangent1[i].dot(u1), f.tangent1[i].dot(u2), f.tangent2[i].dot(u1), f.tangent2[i].dot(u2);
+  return r * m * r.transpose();
 }
 
 }  // namespace
 
-std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, const KnnIndex& index,
-                                           const NeighborGraph& graph, const LocalFrames& frames,
-                                           const MeanCurvatureOptions& options) {
+std::vector<ShapeOperator> estimate_shape_operators(const std::vector<Vec3f>& points, const KnnIndex& index,
+                                                    const NeighborGraph& graph, const LocalFrames& frames,
+                                                    const MeanCurvatureOptions& options) {
   const size_t n = points.size();
-  std::vector<float> h(n, 0.f);
+  std::vector<ShapeOperator> s(n);
   if (options.k <= graph.k) {
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-      h[i] = shape_operator_mean_curvature(points, i, graph.row(i), options.k, frames);
+      s[i] = fit_shape_operator(points, i, graph.row(i), options.k, frames);
     });
   } else {
     const size_t k = std::min(options.k, n - 1);
@@ -212,23 +230,35 @@ std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, con
         size_t m = 0;
         for (size_t j = 0; j < got; ++j)
           if (idx[j] != i) idx[m++] = idx[j];
-        h[i] = shape_operator_mean_curvature(points, i, idx.data(), std::min(m, k), frames);
+        s[i] = fit_shape_operator(points, i, idx.data(), std::min(m, k), frames);
       }
     });
   }
   // Plain neighbour averages: the estimate's noise falls with every pass while a
-  // curvature that varies slowly over a few spacings is kept.
+  // curvature that varies slowly over a few spacings is kept. Neighbours' frames
+  // differ, so each neighbour's operator is carried into the point's frame first.
   const size_t sk = std::min(options.smoothing_k, graph.k);
-  std::vector<float> tmp(n);
+  std::vector<ShapeOperator> tmp(n);
   for (int pass = 0; pass < options.smoothing_passes && sk > 0; ++pass) {
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-      double sum = h[i];
+      Eigen::Matrix2f sum;
+      sum << s[i].s11, s[i].s12, s[i].s12, s[i].s22;
       const uint32_t* nb = graph.row(i);
-      for (size_t j = 0; j < sk; ++j) sum += h[nb[j]];
-      tmp[i] = static_cast<float>(sum / static_cast<double>(sk + 1));
+      for (size_t j = 0; j < sk; ++j) sum += transported(s[nb[j]], frames, nb[j], i);
+      sum /= static_cast<float>(sk + 1);
+      tmp[i] = {sum(0, 0), 0.5f * (sum(0, 1) + sum(1, 0)), sum(1, 1)};
     });
-    h.swap(tmp);
+    s.swap(tmp);
   }
+  return s;
+}
+
+std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, const KnnIndex& index,
+                                           const NeighborGraph& graph, const LocalFrames& frames,
+                                           const MeanCurvatureOptions& options) {
+  const std::vector<ShapeOperator> s = estimate_shape_operators(points, index, graph, frames, options);
+  std::vector<float> h(s.size());
+  for (size_t i = 0; i < s.size(); ++i) h[i] = s[i].mean();
   return h;
 }
 

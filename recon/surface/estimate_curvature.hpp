@@ -63,6 +63,16 @@ struct LocalQuadric {
 LocalQuadric fit_local_quadric(const std::vector<Vec3f>& points, size_t i, const uint32_t* neighbours,
                                size_t count, const LocalFrames& frames);
 
+// A point's shape operator in its own frame: the normal turns by dn = S d for a
+// small step d in the tangent plane, S = [[s11, s12], [s12, s22]] in (tangent1,
+// tangent2) coordinates. s11 and s22 are the normal curvatures along tangent1 and
+// tangent2, positive where the surface bends away from the normal; the mean
+// curvature is (s11 + s22) / 2 and the principal curvatures are S's eigenvalues.
+struct ShapeOperator {
+  float s11 = 0.f, s12 = 0.f, s22 = 0.f;
+  float mean() const { return 0.5f * (s11 + s22); }
+};
+
 struct MeanCurvatureOptions {
   // Neighbours per quadric fit. Up to graph.k they come from the graph; more are
   // queried from the index (a noisy cloud needs fits as wide as its kernels).
@@ -71,9 +81,15 @@ struct MeanCurvatureOptions {
   size_t smoothing_k = 10;
 };
 
-// Signed mean curvature per point (1 / length unit) from the turning of the
-// normals over each neighbourhood (a least-squares shape operator), smoothed over
-// the neighbour graph. frames must be oriented (the sign follows the normals).
+// Each point's shape operator (1 / length unit) from the turning of the normals
+// over its neighbourhood (least squares), smoothed over the neighbour graph: the
+// operators are averaged as 3-D tensors and each average is read back in the
+// point's own frame. frames must be oriented (the signs follow the normals).
+std::vector<ShapeOperator> estimate_shape_operators(const std::vector<Vec3f>& points, const KnnIndex& index,
+                                                    const NeighborGraph& graph, const LocalFrames& frames,
+                                                    const MeanCurvatureOptions& options = {});
+
+// Signed mean curvature per point: the trace of estimate_shape_operators() / 2.
 std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, const KnnIndex& index,
                                            const NeighborGraph& graph, const LocalFrames& frames,
                                            const MeanCurvatureOptions& options = {});

@@ -27,8 +27,8 @@ constexpr int kMaxCoord = (1 << kCoordBits) - 1;
 // band when that is narrower, widened by the bend's largest sag. Each visited node
 // is then tested against the true (bent) support |z| < r:
 //   p  = b1 z1^2 + b2 z2^2                   (the paraboloid's sag, sigma_n units)
-//   z3 = z3u + p * 2 / (1 + sqrt(1 - min(1, kx p)))   (the osculating sphere's sag;
-// kx p = bend^2 r^2, r the tangential distance).
+//   x  = c1 z1^2 + c2 z2^2                   (bend1^2 t1^2 + bend2^2 t2^2, world)
+//   z3 = z3u + p * 2 / (1 + sqrt(1 - min(1, x)))   (the circle's sag).
 struct Prepared {
   Eigen::Matrix3f m;   // rows t1/s1, t2/s2, n/sn
   // The visited region lies inside the ellipsoid (x - c)^T A (x - c) <= 2 r^2,
@@ -40,8 +40,8 @@ struct Prepared {
   float weight;
   float slab;
   float b1, b2;
-  float kx;  // 2 bend sigma_n
-  bool exact;  // the support reaches x = bend^2 r^2 > 1/4 (splat_row_body)
+  float c1, c2;  // bend_a^2 sigma_t_a^2
+  bool exact;  // the support reaches x > 1/4 (splat_row_body)
 };
 
 // The sag of a sphere of curvature |bend| at tangential distance r (world units),
@@ -54,7 +54,7 @@ float sphere_sag(float bend, float r) {
 
 Prepared prepare(const Kernel& k, float r) {
   Prepared p;
-  const float sag = sphere_sag(k.bend, r * std::max(k.sigma_t1, k.sigma_t2));
+  const float sag = sphere_sag(std::max(std::abs(k.bend1), std::abs(k.bend2)), r * std::max(k.sigma_t1, k.sigma_t2));
   const float normal_reach = k.band > 0.f ? std::min(k.band, r * k.sigma_n) : r * k.sigma_n;
   const float slab_mm = normal_reach + sag;
   p.m.row(0) = k.t1.transpose() / k.sigma_t1;
@@ -73,11 +73,11 @@ Prepared prepare(const Kernel& k, float r) {
   p.yy = a(1, 1) - a(0, 1) * a(0, 1) / a(0, 0);
   p.yz = a(1, 2) - a(0, 1) * a(0, 2) / a(0, 0);
   p.zz = a(2, 2) - a(0, 2) * a(0, 2) / a(0, 0);
-  p.b1 = 0.5f * k.bend * k.sigma_t1 * k.sigma_t1 / k.sigma_n;
-  p.b2 = 0.5f * k.bend * k.sigma_t2 * k.sigma_t2 / k.sigma_n;
-  p.kx = 2.f * k.bend * k.sigma_n;
-  const float reach = r * std::max(k.sigma_t1, k.sigma_t2);
-  p.exact = k.bend * k.bend * reach * reach > 0.25f;
+  p.b1 = 0.5f * k.bend1 * k.sigma_t1 * k.sigma_t1 / k.sigma_n;
+  p.b2 = 0.5f * k.bend2 * k.sigma_t2 * k.sigma_t2 / k.sigma_n;
+  p.c1 = k.bend1 * k.bend1 * k.sigma_t1 * k.sigma_t1;
+  p.c2 = k.bend2 * k.bend2 * k.sigma_t2 * k.sigma_t2;
+  p.exact = std::max(p.c1, p.c2) * r * r > 0.25f;
   return p;
 }
 
@@ -118,15 +118,16 @@ __attribute__((always_inline)) inline float exp_nonpositive(float x) {
 // (whole 8-node chunks, so the vector loop needs no scalar tail) without changing
 // a single value.
 //
-// The sphere's sag from the paraboloid's: sag * 2 / (1 + sqrt(1 - x)), x = kx sag =
-// bend^2 r^2 <= 1. Kernels whose support keeps x <= 1/4 (every kernel of a densely
+// The circle's sag from the paraboloid's: sag * 2 / (1 + sqrt(1 - x)), x =
+// c1 z1^2 + c2 z2^2 <= 1. Kernels whose support keeps x <= 1/4 (every kernel of a densely
 // sampled surface) use that factor's series sum_n Catalan(n) (x / 4)^n to the fifth
 // term (relative error < 6e-5 there), which costs four multiply-adds instead of a
 // square root and a division.
 template <bool kExact>
 __attribute__((always_inline)) inline void splat_row_body(float* __restrict f, float* __restrict w, int t0, int n,
                                                           float zx, float zy, float zz, float dx, float dy, float dz,
-                                                          float b1, float b2, float kx, float weight, float r2,
+                                                          float b1, float b2, float c1, float c2, float weight,
+                                                          float r2,
                                                           float slab2) {
   for (int t = 0; t < n; ++t) {
     const float tf = static_cast<float>(t0 + t);
@@ -135,10 +136,10 @@ __attribute__((always_inline)) inline void splat_row_body(float* __restrict f, f
     const float sag = b1 * z1s + b2 * z2s;
     float z3;
     if constexpr (kExact) {
-      const float x = std::min(kx * sag, 1.f);
+      const float x = std::min(c1 * z1s + c2 * z2s, 1.f);
       z3 = z3u + sag * 2.f / (1.f + std::sqrt(1.f - x));
     } else {
-      const float y = 0.25f * kx * sag;
+      const float y = 0.25f * (c1 * z1s + c2 * z2s);
       z3 = z3u + sag * (1.f + y * (1.f + y * (2.f + y * (5.f + y * 14.f))));
     }
     const float q = z1s + z2s + z3 * z3;
@@ -152,14 +153,14 @@ __attribute__((always_inline)) inline void splat_row_body(float* __restrict f, f
 
 __attribute__((target_clones("arch=haswell", "default"))) void splat_row_series(
     float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx, float dy,
-    float dz, float b1, float b2, float kx, float weight, float r2, float slab2) {
-  splat_row_body<false>(f, w, t0, n, zx, zy, zz, dx, dy, dz, b1, b2, kx, weight, r2, slab2);
+    float dz, float b1, float b2, float c1, float c2, float weight, float r2, float slab2) {
+  splat_row_body<false>(f, w, t0, n, zx, zy, zz, dx, dy, dz, b1, b2, c1, c2, weight, r2, slab2);
 }
 
 __attribute__((target_clones("arch=haswell", "default"))) void splat_row_exact(
     float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx, float dy,
-    float dz, float b1, float b2, float kx, float weight, float r2, float slab2) {
-  splat_row_body<true>(f, w, t0, n, zx, zy, zz, dx, dy, dz, b1, b2, kx, weight, r2, slab2);
+    float dz, float b1, float b2, float c1, float c2, float weight, float r2, float slab2) {
+  splat_row_body<true>(f, w, t0, n, zx, zy, zz, dx, dy, dz, b1, b2, c1, c2, weight, r2, slab2);
 }
 
 struct Pair {
@@ -218,9 +219,10 @@ void ImplicitField::evaluate(const std::vector<Kernel>& kernels, float epsilon, 
     const double z1 = d.dot(k.t1.cast<double>()) / k.sigma_t1;
     const double z2 = d.dot(k.t2.cast<double>()) / k.sigma_t2;
     const double z3u = d.dot(k.n.cast<double>()) / k.sigma_n;
-    const double r2t = z1 * z1 * k.sigma_t1 * k.sigma_t1 + z2 * z2 * k.sigma_t2 * k.sigma_t2;
-    const double parabola = 0.5 * k.bend * r2t;
-    const double x = std::min(1.0, static_cast<double>(k.bend) * k.bend * r2t);
+    const double u2 = z1 * z1 * k.sigma_t1 * k.sigma_t1, v2 = z2 * z2 * k.sigma_t2 * k.sigma_t2;
+    const double b1 = k.bend1, b2 = k.bend2;
+    const double parabola = 0.5 * (b1 * u2 + b2 * v2);
+    const double x = std::min(1.0, b1 * b1 * u2 + b2 * b2 * v2);
     const double z3 = z3u + parabola * 2.0 / (1.0 + std::sqrt(1.0 - x)) / k.sigma_n;
     const double q = z1 * z1 + z2 * z2 + z3 * z3;
     if (q >= r2 || std::abs(z3u) >= slab) continue;
@@ -453,7 +455,7 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
               const size_t b = static_cast<size_t>(brick_of[bx - xmin]);
               const size_t idx = b * per + static_cast<size_t>(row_offset + first);
               (p.exact ? splat_row_exact : splat_row_series)(field.values_.data() + idx, field.weights_.data() + idx, brick_x + first - lo.x(),
-                        last - first + 1, z0.x(), z0.y(), z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.kx, p.weight, r2,
+                        last - first + 1, z0.x(), z0.y(), z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.c1, p.c2, p.weight, r2,
                         p.slab * p.slab);
               gx = seg_end + 1;
             }

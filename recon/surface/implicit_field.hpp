@@ -15,10 +15,18 @@
 // point's tangent plane, and on a curved surface the neighbours' tangent planes all
 // pass outside a convex point, pushing the summed zero set out by about
 // H sigma_t^2 (H the mean curvature) - the bias that dominates the thesis's sparse
-// sphere cells. A kernel may therefore carry its local mean curvature `bend` and
-// measure its normal coordinate from the osculating paraboloid instead of the
-// plane, n' = n + bend (t1^2 + t2^2) / 2, which removes that bias to first order
-// (for equal tangential sigmas only the mean curvature enters the bias).
+// sphere cells. A kernel may therefore carry the surface's normal curvatures along
+// its two axes, `bend1` and `bend2`, and measure its normal coordinate from the
+// osculating paraboloid instead of the plane, n' = n + (bend1 t1^2 + bend2 t2^2) / 2,
+// which removes that bias to first order. With the axes along the principal
+// directions the paraboloid is the surface's own. A single mean-curvature bend is
+// enough only where the neighbours surround a point evenly: on a limb sampled by
+// stripes across it, the kernels on either side along the stripe (bent by half the
+// limb's curvature) outweigh those along the limb (bent where the limb is
+// straight), and the limb comes out too thick.
+// Past the paraboloid's second order, the sag grows as a circle's would,
+// sag * 2 / (1 + sqrt(1 - x)) with x = bend1^2 t1^2 + bend2^2 t2^2: exact for a
+// sphere and for a cylinder along either axis.
 //
 // Support: a kernel is cut where its Gaussian falls below the error tolerance
 // epsilon, i.e. the ellipsoid |(t1/s1, t2/s2, n/sn)| < sqrt(-2 ln epsilon): eq.
@@ -45,9 +53,10 @@ struct Kernel {
   Vec3f t1, t2, n;  // n points out of the surface
   float sigma_t1 = 1.f, sigma_t2 = 1.f, sigma_n = 1.f;
   float weight = 1.f;  // confidence, > 0
-  // Mean curvature (1 / length), positive where the surface bends away from n.
-  // 0 = the thesis's flat kernel. Callers keep |bend| sigma_t well below 1.
-  float bend = 0.f;
+  // Normal curvatures (1 / length) along t1 and t2, positive where the surface
+  // bends away from n. 0 = the thesis's flat kernel. Callers keep |bend_a| sigma_t_a
+  // well below 1.
+  float bend1 = 0.f, bend2 = 0.f;
   // If > 0, the kernel reaches at most this far along its normal (before the
   // bend), the points' unit. Marching cubes only needs the field within a few
   // voxels of the surface, and every kernel that matters there has its plane that

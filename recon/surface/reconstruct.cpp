@@ -193,9 +193,9 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
                       ? options.voxel_size
                       : 0.7f * st.median_density_sigma * std::min(1.f, st.normal_scale);
   ko.band = options.band_voxels > 0.f ? options.band_voxels * st.voxel_size + 3.f * st.noise_sigma : 0.f;
-  std::vector<float> mean_curvature;
+  std::vector<ShapeOperator> shape;
   if (options.curvature_compensation) {
-    mean_curvature = estimate_mean_curvature(pts, index, graph, frames, {.k = 20});
+    shape = estimate_shape_operators(pts, index, graph, frames, {.k = 20});
   }
   // Isolated points (a floor sample, a speck of dust far from the body) would get
   // kernels as wide as the gap to their neighbours, and the field's grid with them.
@@ -210,7 +210,7 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
     }
   }
   const std::vector<Kernel> kernels = adapt_kernels(
-      pts, frames, sigma_density, options.sharpening != 0.f ? &curvature : nullptr, mean_curvature, confidence, ko);
+      pts, frames, sigma_density, options.sharpening != 0.f ? &curvature : nullptr, shape, confidence, ko);
   st.t_kernels = seconds_since(t0);
 
   t0 = Clock::now();

@@ -2,6 +2,7 @@
 // cylinders, planes and paraboloids.
 #include "recon/surface/estimate_curvature.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -238,6 +239,48 @@ INSTANTIATE_TEST_SUITE_P(Spheres, MeanCurvatureSphere,
                            return "R" + std::to_string(static_cast<int>(info.param.radius)) +
                                   (info.param.noise_in_spacings > 0 ? "_noisy" : "_clean");
                          });
+
+TEST(EstimateShapeOperators, ASparseCylinderKeepsItsCurvatureAcrossTheAxis) {
+  // A limb sampled as a scanner's stripes sample a forearm, but coarser: rings 2.6
+  // apart along the axis of a radius-10 cylinder, 24 points around each (0.26 rad
+  // apart). The smoothing's ten neighbours reach two points round the ring, whose
+  // frames are turned by up to half a radian: averaged as plain tensors in the
+  // point's frame they would keep only cos^2 of that; carried into the frame they
+  // keep the cylinder's 1/R across the axis and 0 along it.
+  const double radius = 10.0;
+  const int around = 24;
+  std::vector<Vec3f> pts, truth;
+  for (int j = -12; j <= 12; ++j) {
+    for (int i = 0; i < around; ++i) {
+      const double a = 2 * std::numbers::pi * (i + 0.5 * (j & 1)) / around;
+      pts.emplace_back(radius * std::cos(a), radius * std::sin(a), 2.6 * j);
+      truth.emplace_back(std::cos(a), std::sin(a), 0.f);
+    }
+  }
+  const KnnIndex index(pts);
+  const NeighborGraph g = knn_graph(index, pts, 20);
+  const LocalFrames f = oriented_frames(pts, truth, index, g, 20);
+  const std::vector<ShapeOperator> s = estimate_shape_operators(pts, index, g, f);
+  std::vector<double> across, along, axis_error;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (std::abs(pts[i].z()) > 2.6 * 8) continue;  // away from the open ends
+    const Eigen::Matrix2f m{{s[i].s11, s[i].s12}, {s[i].s12, s[i].s22}};
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2f> es(m);
+    across.push_back(es.eigenvalues()[1] * radius);
+    along.push_back(es.eigenvalues()[0] * radius);
+    const Eigen::Vector2f e = es.eigenvectors().col(0);  // the flat direction
+    const Vec3f dir = e[0] * f.tangent1[i] + e[1] * f.tangent2[i];
+    axis_error.push_back(1.0 - std::abs(dir.z()));
+  }
+  // Carried: median 0.975 R, 2nd percentile 0.938. Projected instead: 0.83 and 0.81.
+  EXPECT_NEAR(percentile(across, 0.5), 1.0, 0.04);
+  EXPECT_NEAR(percentile(across, 0.02), 1.0, 0.08);
+  EXPECT_NEAR(percentile(along, 0.5), 0.0, 0.03);
+  EXPECT_LT(percentile(axis_error, 0.98), 0.01);
+  // The mean curvature is half the trace.
+  const std::vector<float> h = estimate_mean_curvature(pts, index, g, f);
+  for (size_t i = 0; i < h.size(); ++i) ASSERT_FLOAT_EQ(h[i], s[i].mean());
+}
 
 TEST(EstimateMeanCurvature, SignFollowsTheNormals) {
   const PointCloud c = fibonacci_sphere(2000, 1.0);

@@ -47,7 +47,7 @@ double min_q(const std::vector<Kernel>& ks, const Vec3d& x, double* max_q_inside
     const double z1 = d.dot(k.t1.cast<double>()) / k.sigma_t1;
     const double z2 = d.dot(k.t2.cast<double>()) / k.sigma_t2;
     const double z3 = (d.dot(k.n.cast<double>()) +
-                       0.5 * k.bend * (std::pow(z1 * k.sigma_t1, 2) + std::pow(z2 * k.sigma_t2, 2))) /
+                       0.5 * (k.bend1 * std::pow(z1 * k.sigma_t1, 2) + k.bend2 * std::pow(z2 * k.sigma_t2, 2))) /
                       k.sigma_n;
     const double q = z1 * z1 + z2 * z2 + z3 * z3;
     best = std::min(best, q);
@@ -122,7 +122,7 @@ TEST(ImplicitFieldEvaluate, BentKernelZeroSetIsTheOsculatingSphere) {
   k.n = Vec3f::UnitZ();
   k.sigma_t1 = k.sigma_t2 = 0.5f;
   k.sigma_n = 0.1f;
-  k.bend = 0.8f;
+  k.bend1 = k.bend2 = 0.8f;
   double v, w;
   for (double u : {-0.6, -0.2, 0.3, 0.7, 1.3}) {
     const double r2 = u * u * 1.09;  // the point below is at (u, 0.3 u)

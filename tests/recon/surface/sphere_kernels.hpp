@@ -22,7 +22,7 @@ inline std::vector<Kernel> sphere_kernels(size_t n, double radius, const Vec3f& 
     k.t2 = k.n.cross(k.t1);
     k.sigma_t1 = k.sigma_t2 = sigma_t;
     k.sigma_n = sigma_n;
-    k.bend = bend;
+    k.bend1 = k.bend2 = bend;
   }
   return ks;
 }
