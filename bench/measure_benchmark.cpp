@@ -288,7 +288,9 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
   if (!a.ok()) return std::fprintf(stderr, "scan set: %s\n", a.status().message().c_str()), 1;
   std::optional<BodyMeasurements> b;
   const bool has_second = std::ifstream(stem + (g_resurface ? "-cloud2.ply" : "-scan2.ply")).good();
-  if (auto mesh2 = has_second ? saved_surface(stem, "2") : StatusOr<TriangleMesh>(not_found("")); mesh2.ok()) {
+  if (has_second) {
+    auto mesh2 = saved_surface(stem, "2");
+    if (!mesh2.ok()) return std::fprintf(stderr, "second scan: %s\n", mesh2.status().message().c_str()), 1;
     auto m = measure_body(*mesh2, mo);
     if (!m.ok()) return std::fprintf(stderr, "second scan set: %s\n", m.status().message().c_str()), 1;
     b = std::move(*m);
