@@ -65,8 +65,9 @@ struct Scan {
   double floor = 0;
 };
 
-HoleFairing g_fairing = pipeline::body_surface_options().hole_fairing;
-float g_min_weight = pipeline::body_surface_options().min_relative_weight;
+// The scan job's surface options with --fairing and --min-weight applied: every
+// surface here (the scans', the coarse one, --resurface's) is built with them.
+ReconstructOptions g_surface = pipeline::body_surface_options();
 std::string g_save;
 bool g_resurface = false;
 uint64_t g_seed = 1;
@@ -92,8 +93,7 @@ StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64
                                           : hw::sim::SimulatedRig::create(desc, subject));
   pipeline::ScanJobOptions o;
   o.every = every;
-  o.surface.hole_fairing = g_fairing;
-  o.surface.min_relative_weight = g_min_weight;
+  o.surface = g_surface;
   ASSIGN_OR_RETURN(pipeline::ScanJobResult r, pipeline::run_scan_job(pipeline::rig_handle(*sim), o));
   if (!r.surface_error.empty()) return internal_error("surface: " + r.surface_error);
   Scan s;
@@ -225,9 +225,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   }
   {
     // The same scan surfaced on a coarser grid, about 500k triangles.
-    ReconstructOptions ro = pipeline::body_surface_options();
-    ro.hole_fairing = g_fairing;
-    ro.min_relative_weight = g_min_weight;
+    ReconstructOptions ro = g_surface;
     ro.voxel_size = a->voxel * 1.77f;
     ro.normal_source = NormalSource::kCameras;
     auto coarse = reconstruct_surface(a->cloud, ro);
@@ -259,10 +257,7 @@ StatusOr<TriangleMesh> saved_surface(const std::string& stem, const std::string&
   if (!g_resurface) return read_ply_mesh(stem + "-scan" + n + ".ply");
   ASSIGN_OR_RETURN(PlyData ply, read_ply(stem + "-cloud" + n + ".ply"));
   PointCloud& cloud = ply.cloud;
-  ReconstructOptions ro = pipeline::body_surface_options();
-  ro.hole_fairing = g_fairing;
-  ro.min_relative_weight = g_min_weight;
-  ro = pipeline::with_scan_normals(ro, cloud);
+  const ReconstructOptions ro = pipeline::with_scan_normals(g_surface, cloud);
   const auto t0 = Clock::now();
   ASSIGN_OR_RETURN(ReconstructResult r, reconstruct_surface(cloud, ro));
   std::printf("surfaced again from %s-cloud%s.ply: %zu triangles, %.0f s\n", stem.c_str(), n.c_str(),
@@ -317,10 +312,10 @@ int main(int argc, char** argv) {
     else if (a == "--saved" && i + 1 < argc) saved = argv[++i];
     else if (a == "--resurface") g_resurface = true;
     else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
-    else if (a == "--min-weight" && i + 1 < argc) g_min_weight = std::strtof(argv[++i], nullptr);
+    else if (a == "--min-weight" && i + 1 < argc) g_surface.min_relative_weight = std::strtof(argv[++i], nullptr);
     else if (a == "--fairing" && i + 1 < argc) {
       const std::string f = argv[++i];
-      g_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
+      g_surface.hole_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
     }
     else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
                         "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W]\n"), 2;

@@ -82,9 +82,10 @@ struct MeanCurvatureOptions {
 };
 
 // Each point's shape operator (1 / length unit) from the turning of the normals
-// over its neighbourhood (least squares), smoothed over the neighbour graph: the
-// operators are averaged as 3-D tensors and each average is read back in the
-// point's own frame. frames must be oriented (the signs follow the normals).
+// over its neighbourhood (least squares), smoothed over the neighbour graph: each
+// neighbour's operator is carried into the point's frame (the smallest rotation
+// taking its normal onto the point's) before the average. frames must be oriented
+// (the signs follow the normals).
 std::vector<ShapeOperator> estimate_shape_operators(const std::vector<Vec3f>& points, const KnnIndex& index,
                                                     const NeighborGraph& graph, const LocalFrames& frames,
                                                     const MeanCurvatureOptions& options = {});
