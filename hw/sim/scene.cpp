@@ -129,13 +129,17 @@ bool Scene::moves() const {
   return rt_->subject && (m.sway_mm > 0 || m.breathing_mm > 0);
 }
 
+Vec3d subject_sway(const SubjectMotion& m, double time_s) {
+  const double w = 2 * M_PI * m.sway_hz * time_s;
+  return {m.sway_mm * std::sin(w), 0, 0.5 * m.sway_mm * std::sin(w + 1.3)};
+}
+
 void Scene::set_time(double time_s) {
   if (time_s == time_ && time_s != 0) return;
   time_ = time_s;
   if (!moves()) return;
   const SubjectMotion& m = rig_.simulation.motion;
-  const double w = 2 * M_PI * m.sway_hz * time_s;
-  const Vec3d sway(m.sway_mm * std::sin(w), 0, 0.5 * m.sway_mm * std::sin(w + 1.3));
+  const Vec3d sway = subject_sway(m, time_s);
   const double breath = 0.5 * m.breathing_mm * (1 - std::cos(2 * M_PI * m.breathing_hz * time_s));
   auto* vb = static_cast<float*>(rtcGetGeometryBufferData(rt_->subject, RTC_BUFFER_TYPE_VERTEX, 0));
   for (size_t i = 0; i < rest_.vertices.size(); ++i) {

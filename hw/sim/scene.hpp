@@ -21,6 +21,11 @@ struct Hit {
   Vec3d normal = Vec3d::Zero();  // unit, facing the ray's origin
 };
 
+// The subject's sway at `time_s` (mm): side to side (X) by sway_mm, front to back
+// (Z) by half that, 1.3 rad ahead, both at sway_hz. The scene poses the
+// subject with it; benchmarks hold a scan's estimated sway against it.
+Vec3d subject_sway(const SubjectMotion& motion, double time_s);
+
 class Scene {
  public:
   // Builds the scene for a rig. `subject` may be empty (an empty rig); it is stood

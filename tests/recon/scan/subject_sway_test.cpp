@@ -101,21 +101,29 @@ TEST_F(SubjectSway, FindsTheSwayBetweenSweepsAndUndoesIt) {
   // Where the sweeps meet, they agree once the sway is undone.
   EXPECT_GT(sway->rms_before_mm, 1.5);
   EXPECT_LT(sway->rms_after_mm, 0.5);
-  // The path, both taken to mean zero over the scan: 2.6 mm RMS of true sway.
-  const int frames = 4 * 351;
+  // The path at the points' moments (each point counts once), both taken to mean
+  // zero over them: 2.5 mm RMS of true sway.
   Eigen::Vector3d mean_true = Eigen::Vector3d::Zero(), mean_est = Eigen::Vector3d::Zero();
-  for (int f = 0; f < frames; ++f) mean_true += true_sway(f), mean_est += sway->at(f);
-  mean_true /= frames;
-  mean_est /= frames;
-  double err = 0, amplitude = 0;
-  for (int f = 0; f < frames; ++f) {
-    err += ((sway->at(f) - mean_est) - (true_sway(f) - mean_true)).squaredNorm();
+  for (int f : cloud.frame) mean_true += true_sway(f), mean_est += sway->at(f);
+  const double points = static_cast<double>(cloud.size());
+  mean_true /= points;
+  mean_est /= points;
+  double err = 0, err_x = 0, amplitude = 0;
+  for (int f : cloud.frame) {
+    const Eigen::Vector3d e = (sway->at(f) - mean_est) - (true_sway(f) - mean_true);
+    err += e.squaredNorm();
+    err_x += e.x() * e.x();
     amplitude += (true_sway(f) - mean_true).squaredNorm();
   }
-  err = std::sqrt(err / frames);
-  amplitude = std::sqrt(amplitude / frames);
+  err = std::sqrt(err / points);
+  err_x = std::sqrt(err_x / points);
+  amplitude = std::sqrt(amplitude / points);
   EXPECT_GT(amplitude, 2.4);
-  EXPECT_LT(err, 0.45 * amplitude) << "path error " << err << " mm against " << amplitude << " mm of sway";
+  // 0.77 mm (0.75 of it sideways: the pairs see sideways sway only where skin faces
+  // sideways, and the weight on the sway's size holds it short; docs/scan-processing.md,
+  // "What limits the path"). Front to back: 0.19 mm.
+  EXPECT_LT(err, 0.35 * amplitude) << "path error " << err << " mm against " << amplitude << " mm of sway";
+  EXPECT_LT(std::sqrt(err * err - err_x * err_x), 0.12 * amplitude) << "front-to-back path error";
   // The body's shape comes back: the points lie on the still body.
   const double before = testing::rms_distance_after_shift(cloud, *distance_);
   undo_sway(cloud, *sway);
