@@ -149,16 +149,19 @@ TEST(SimulatedRig, ShippedRigsTakeAStandingAdultOfTwoMetres) {
   }
 }
 
+// The thesis rig with one small camera, its subject moving as `motion` says.
+StatusOr<std::unique_ptr<SimulatedRig>> small_thesis_rig(const SubjectMotion& motion) {
+  ASSIGN_OR_RETURN(const std::string path, shipped_rig_path("thesis"));
+  ASSIGN_OR_RETURN(RigDescription desc, load_rig_description(path));
+  desc.simulation.motion = motion;
+  desc.cameras.resize(1);
+  desc.cameras[0].width = 64;
+  desc.cameras[0].height = 64;
+  return SimulatedRig::create(desc);
+}
+
 TEST(SimulatedRig, SubjectStandsOnTheFloorAndBreathes) {
-  auto path = shipped_rig_path("thesis");
-  auto desc = load_rig_description(*path);
-  ASSERT_TRUE(desc.ok());
-  desc->simulation.motion.breathing_mm = 6;
-  desc->simulation.motion.breathing_hz = 0.5;
-  desc->cameras.resize(1);
-  desc->cameras[0].width = 64;
-  desc->cameras[0].height = 64;
-  auto rig = SimulatedRig::create(*desc);
+  auto rig = small_thesis_rig({.breathing_mm = 6, .breathing_hz = 0.5});
   ASSERT_TRUE(rig.ok()) << rig.status().message();
   const Scene& s = (*rig)->scene();
   float min_y = 1e9f;
@@ -176,34 +179,26 @@ TEST(SimulatedRig, SubjectStandsOnTheFloorAndBreathes) {
 // a scan's estimated sway against: every vertex moves by it, and it is what the
 // description asks (sideways by sway_mm, front to back by half, at sway_hz).
 TEST(SimulatedRig, ASwayingSubjectMovesBySubjectSway) {
-  auto path = shipped_rig_path("thesis");
-  ASSERT_TRUE(path.ok());
-  auto desc = load_rig_description(*path);
-  ASSERT_TRUE(desc.ok());
-  desc->simulation.motion.sway_mm = 3;
-  desc->simulation.motion.sway_hz = 0.25;
-  desc->cameras.resize(1);
-  desc->cameras[0].width = 64;
-  desc->cameras[0].height = 64;
-  auto rig = SimulatedRig::create(*desc);
+  const SubjectMotion motion{.sway_mm = 3, .sway_hz = 0.25};
+  auto rig = small_thesis_rig(motion);
   ASSERT_TRUE(rig.ok()) << rig.status().message();
   Scene& s = const_cast<Scene&>((*rig)->scene());
   s.set_time(0.5);  // away from rest
   const TriangleMesh rest = s.subject();
-  const Vec3d at_rest = subject_sway(desc->simulation.motion, 0.5);
+  const Vec3d at_rest = subject_sway(motion, 0.5);
   for (double t : {1.0, 2.0, 3.7}) {
     s.set_time(t);
-    const Vec3d moved = subject_sway(desc->simulation.motion, t) - at_rest;
+    const Vec3d moved = subject_sway(motion, t) - at_rest;
     double worst = 0;
     for (size_t i = 0; i < rest.vertices.size(); i += 97)
       worst = std::max(worst, ((s.subject().vertices[i] - rest.vertices[i]).cast<double>() - moved).norm());
     EXPECT_LT(worst, 1e-3) << "at " << t << " s";
   }
   // One second is a quarter period: sideways from 0 to the full 3 mm.
-  EXPECT_NEAR(subject_sway(desc->simulation.motion, 1.0).x(), 3.0, 1e-9);
-  EXPECT_NEAR(subject_sway(desc->simulation.motion, 0.0).x(), 0.0, 1e-9);
-  EXPECT_NEAR(subject_sway(desc->simulation.motion, 1.0).z(), 1.5 * std::sin(M_PI / 2 + 1.3), 1e-9);
-  EXPECT_EQ(subject_sway(desc->simulation.motion, 1.0).y(), 0.0);
+  EXPECT_NEAR(subject_sway(motion, 1.0).x(), 3.0, 1e-9);
+  EXPECT_NEAR(subject_sway(motion, 0.0).x(), 0.0, 1e-9);
+  EXPECT_NEAR(subject_sway(motion, 1.0).z(), 1.5 * std::sin(M_PI / 2 + 1.3), 1e-9);
+  EXPECT_EQ(subject_sway(motion, 1.0).y(), 0.0);
 }
 
 }  // namespace
