@@ -294,7 +294,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
       for (const Status& w : {write_ply(stem + "-scan2.ply", s->mesh), write_ply(stem + "-cloud2.ply", s->cloud)})
         if (!w.ok()) std::fprintf(stderr, "--save: %s\n", w.message().c_str());
     }
-    std::printf("second scan's sway, as estimated: %s\n", s->sway.c_str());
+    if (!s->sway.empty()) std::printf("second scan's sway, as estimated: %s\n", s->sway.c_str());
     b = std::move(*s);
   }
   return report(a->truth, a->mesh, *a->body, a->floor, b ? &*b->body : nullptr, sway);
