@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <numeric>
 #include <tbb/parallel_for.h>
 
 #include "recon/spatial/knn_index.hpp"
@@ -23,6 +25,7 @@ struct Pair {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   double r0 = 0;      // the distance as measured, mm
   double weight = 1;  // confidence
+  int fold = 0;       // the block of space the anchor lies in, for cross-validation
   std::vector<std::pair<int, double>> knots;  // (knot, weight): +point, -plane
 };
 
@@ -168,6 +171,19 @@ bool local_height(const PointCloud& cloud, const std::vector<Vec3f>& moved, size
   return true;
 }
 
+// Which of the cross-validation folds a point's pairs go to: space cut into cubes
+// of cv_block_mm, the cubes dealt out to the folds by a hash of their index (so a
+// fold is skin spread over the whole body, and the skin next to a held-out cube is
+// usually in another fold).
+int fold_of(const Vec3f& p, const SwayOptions& o) {
+  if (o.cv_folds < 2) return 0;
+  const auto cell = [&](float v) { return static_cast<int64_t>(std::floor(v / o.cv_block_mm)); };
+  uint64_t h = static_cast<uint64_t>(cell(p.x())) * 73856093ULL ^ static_cast<uint64_t>(cell(p.y())) * 19349663ULL ^
+               static_cast<uint64_t>(cell(p.z())) * 83492791ULL;
+  h ^= h >> 29, h *= 0xbf58476d1ce4e5b9ULL, h ^= h >> 32;
+  return static_cast<int>(h % static_cast<uint64_t>(o.cv_folds));
+}
+
 // The pairs at the current sway: each anchor against the other sweeps' points among
 // `candidates` (every point, or an even share of a dense cloud).
 std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& moved, const std::vector<size_t>& anchors,
@@ -199,6 +215,7 @@ std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& 
         Pair p;
         if (local_height(cloud, moved, i, other, b, e, radius, knots, x, p)) {
           p.weight *= has_conf ? cloud.confidence[i] : 1.f;
+          p.fold = fold_of(cloud.positions[i], o);
           if (p.weight > 0) found[a].push_back(std::move(p));
         }
       }
@@ -209,6 +226,74 @@ std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& 
   for (auto& f : found)
     for (Pair& p : f) pairs.push_back(std::move(p));
   return pairs;
+}
+
+// The normal equations of the pairs (one fold's, or all of them), and their
+// weight: in all, and along each axis the path moves in.
+struct System {
+  Eigen::MatrixXd ata;
+  Eigen::VectorXd atb;
+  double total = 0;
+  std::vector<double> axis;
+  System(size_t unknowns, size_t dims)
+      : ata(Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(unknowns), static_cast<Eigen::Index>(unknowns))),
+        atb(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(unknowns))),
+        axis(dims, 0.0) {}
+  void add(const System& o, double sign) {
+    ata += sign * o.ata, atb += sign * o.atb, total += sign * o.total;
+    for (size_t d = 0; d < axis.size(); ++d) axis[d] += sign * o.axis[d];
+  }
+};
+
+// The path that best explains the pairs under the smoothness, the mean-zero and the
+// size terms of `reg`.
+StatusOr<std::vector<Eigen::Vector3d>> solve_path(const System& s, const SwayRegularization& reg, const SwayOptions& o,
+                                                  size_t m, const std::vector<int>& axes) {
+  const size_t dims = axes.size();
+  Eigen::MatrixXd ata = s.ata;
+  const double per_knot = s.total / static_cast<double>(m);
+  for (size_t d = 0; d < dims; ++d) {
+    // Per knot, the pairs' weight in all, or what they see along this axis.
+    const double scale = reg.per_axis ? s.axis[d] / static_cast<double>(m) : per_knot;
+    const double lambda = o.smoothness * scale;
+    for (size_t k = 1; k + 1 < m; ++k) {
+      const std::array<Eigen::Index, 3> idx = {static_cast<Eigen::Index>((k - 1) * dims + d),
+                                               static_cast<Eigen::Index>(k * dims + d),
+                                               static_cast<Eigen::Index>((k + 1) * dims + d)};
+      const std::array<double, 3> c = {1, -2, 1};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) ata(idx[a], idx[b]) += lambda * c[a] * c[b];
+    }
+    // Mean zero (the scan cannot tell where the body stands on average), and a
+    // small weight on the sway itself, which holds the directions the pairs cannot
+    // see (and knots nothing constrains) near zero instead of letting them drift.
+    for (size_t a = 0; a < m; ++a) {
+      for (size_t b = 0; b < m; ++b)
+        ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(b * dims + d)) += per_knot / static_cast<double>(m);
+      ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(a * dims + d)) +=
+          o.ridge * reg.ridge_scale * scale;
+    }
+    if (reg.slow_scale > 0) {
+      // The slow part: each knot's mean over the window around it.
+      const int half = std::max(1, o.slow_frames / o.knot_frames / 2);
+      Eigen::MatrixXd box = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
+      for (size_t k = 0; k < m; ++k) {
+        const int b = std::max(0, static_cast<int>(k) - half), e = std::min(static_cast<int>(m) - 1, static_cast<int>(k) + half);
+        for (int j = b; j <= e; ++j) box(static_cast<Eigen::Index>(k), j) = 1.0 / (e - b + 1);
+      }
+      const Eigen::MatrixXd btb = box.transpose() * box;
+      for (size_t a = 0; a < m; ++a)
+        for (size_t b = 0; b < m; ++b)
+          ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(b * dims + d)) +=
+              o.ridge * reg.slow_scale * scale * btb(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+    }
+  }
+  const Eigen::VectorXd sol = ata.ldlt().solve(s.atb);
+  if (!sol.allFinite()) return internal_error("sway: the path's least-squares system is singular");
+  std::vector<Eigen::Vector3d> x(m, Eigen::Vector3d::Zero());
+  for (size_t k = 0; k < m; ++k)
+    for (size_t d = 0; d < dims; ++d) x[k][axes[d]] = sol[static_cast<Eigen::Index>(k * dims + d)];
+  return x;
 }
 
 }  // namespace
@@ -223,7 +308,8 @@ Eigen::Vector3d SwayEstimate::at(double frame) const {
   return (1 - a) * knots[k] + a * knots[k + 1];
 }
 
-StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions& o) {
+StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions& options) {
+  const SwayOptions& o = options;
   const size_t n = cloud.size();
   if (cloud.frame.size() != n || cloud.laser.size() != n)
     return invalid_argument("sway: the cloud needs each point's frame and laser");
@@ -278,52 +364,83 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
     pairs = find_pairs(cloud, moved, anchors, candidates, knots, o, radius, x);
     if (it == 0) est.rms_before_mm = pair_rms(pairs, x, o.max_residual_mm);  // x is zero: as measured
     if (pairs.empty()) break;
-    // Robust weights at the current sway; then the normal equations.
-    Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(unknowns), static_cast<Eigen::Index>(unknowns));
-    Eigen::VectorXd atb = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(unknowns));
-    double total = 0;
+    // Robust weights at the current sway; then the normal equations, fold by fold.
+    const size_t folds = o.cv_folds >= 2 ? static_cast<size_t>(o.cv_folds) : 1;
+    std::vector<System> sys(folds, System(unknowns, dims));
+    std::vector<double> weight(pairs.size(), 0.0);
     std::vector<std::pair<Eigen::Index, double>> row;
-    for (const Pair& p : pairs) {
+    for (size_t q = 0; q < pairs.size(); ++q) {
+      const Pair& p = pairs[q];
       const double r = std::abs(residual(p, x));
       if (r > o.max_residual_mm) continue;
       const double w = p.weight * (r <= o.huber_mm ? 1.0 : o.huber_mm / r);
-      total += w;
+      weight[q] = w;
+      System& f = sys[folds > 1 ? static_cast<size_t>(p.fold) : 0];
+      f.total += w;
+      for (size_t d = 0; d < dims; ++d) f.axis[d] += w * p.normal[axes[d]] * p.normal[axes[d]];
       row.clear();
       for (const auto& [k, a] : p.knots)
         for (size_t d = 0; d < dims; ++d)
           row.emplace_back(static_cast<Eigen::Index>(static_cast<size_t>(k) * dims + d), a * p.normal[axes[d]]);
       for (const auto& [ri, rv] : row) {
-        atb[ri] += w * rv * p.r0;
-        for (const auto& [ci, cv] : row) ata(ri, ci) += w * rv * cv;
+        f.atb[ri] += w * rv * p.r0;
+        for (const auto& [ci, cv] : row) f.ata(ri, ci) += w * rv * cv;
       }
     }
-    if (total <= 0) break;
-    const double per_knot = total / static_cast<double>(m);
-    const double lambda = o.smoothness * per_knot;
-    for (size_t k = 1; k + 1 < m; ++k) {
-      for (size_t d = 0; d < dims; ++d) {
-        const std::array<Eigen::Index, 3> idx = {static_cast<Eigen::Index>((k - 1) * dims + d),
-                                                 static_cast<Eigen::Index>(k * dims + d),
-                                                 static_cast<Eigen::Index>((k + 1) * dims + d)};
-        const std::array<double, 3> c = {1, -2, 1};
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) ata(idx[a], idx[b]) += lambda * c[a] * c[b];
+    System all(unknowns, dims);
+    for (const System& f : sys) all.add(f, 1);
+    if (all.total <= 0) break;
+    // Which of the regularisations explains the pairs of skin it was not fitted
+    // to best (when there is a choice).
+    SwayRegularization chosen = o.regularizations.empty() ? SwayRegularization{} : o.regularizations.front();
+    if (folds > 1 && o.regularizations.size() > 1) {
+      // Each candidate's mean squared distance over each fold's pairs, with the
+      // path fitted to the other folds.
+      std::vector<std::vector<double>> err(o.regularizations.size(), std::vector<double>(folds, 0.0));
+      std::vector<double> fold_weight(folds, 0.0);
+      for (size_t q = 0; q < pairs.size(); ++q) fold_weight[static_cast<size_t>(pairs[q].fold)] += weight[q];
+      for (size_t c = 0; c < o.regularizations.size(); ++c) {
+        for (size_t f = 0; f < folds; ++f) {
+          System train = all;
+          train.add(sys[f], -1);
+          if (train.total <= 0 || fold_weight[f] <= 0) continue;
+          auto fit = solve_path(train, o.regularizations[c], o, m, axes);
+          if (!fit.ok()) return fit.status();
+          for (size_t q = 0; q < pairs.size(); ++q) {
+            if (weight[q] <= 0 || static_cast<size_t>(pairs[q].fold) != f) continue;
+            const double r = residual(pairs[q], *fit);
+            err[c][f] += weight[q] * r * r / fold_weight[f];
+          }
+        }
       }
+      // The lowest mean error; then, the candidates being listed from the strongest
+      // hold to the weakest, the first whose excess over it is within one standard
+      // error of the folds' differences (a weaker hold must earn its place).
+      const auto mean = [&](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / folds; };
+      size_t best = 0;
+      for (size_t c = 1; c < err.size(); ++c)
+        if (mean(err[c]) < mean(err[best])) best = c;
+      size_t take = best;
+      for (size_t c = 0; c < best; ++c) {
+        std::vector<double> d(folds);
+        for (size_t f = 0; f < folds; ++f) d[f] = err[c][f] - err[best][f];
+        const double md = mean(d);
+        double var = 0;
+        for (double v : d) var += (v - md) * (v - md);
+        const double se = std::sqrt(var / static_cast<double>(folds - 1) / static_cast<double>(folds));
+        if (md <= se) {
+          take = c;
+          break;
+        }
+      }
+      chosen = o.regularizations[take];
+      est.held_out_rms_mm.clear();
+      for (const std::vector<double>& e : err) est.held_out_rms_mm.push_back(std::sqrt(mean(e)));
     }
-    // Mean zero (the scan cannot tell where the body stands on average), and a
-    // small weight on the sway itself, which holds the directions the pairs cannot
-    // see (and knots nothing constrains) near zero instead of letting them drift.
-    for (size_t d = 0; d < dims; ++d)
-      for (size_t a = 0; a < m; ++a)
-        for (size_t b = 0; b < m; ++b)
-          ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(b * dims + d)) += per_knot / static_cast<double>(m);
-    ata.diagonal().array() += o.ridge * per_knot;
-    const Eigen::VectorXd sol = ata.ldlt().solve(atb);
-    if (!sol.allFinite()) return internal_error("sway: the path's least-squares system is singular");
-    for (size_t k = 0; k < m; ++k) {
-      x[k].setZero();
-      for (size_t d = 0; d < dims; ++d) x[k][axes[d]] = sol[static_cast<Eigen::Index>(k * dims + d)];
-    }
+    est.regularization = chosen;
+    auto fit = solve_path(all, chosen, o, m, axes);
+    if (!fit.ok()) return fit.status();
+    x = std::move(*fit);
     est.knots = x;
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
       moved[i] = cloud.frame[i] >= 0 ? (cloud.positions[i].cast<double>() - est.at(cloud.frame[i])).cast<float>()

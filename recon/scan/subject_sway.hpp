@@ -32,6 +32,21 @@
 
 namespace bodyscan {
 
+// How firmly the path is held: its smoothness and its size, against the pairs.
+struct SwayRegularization {
+  double ridge_scale = 1;  // the size's weight, times SwayOptions::ridge
+  // The smoothness and the size weigh against what the pairs see along each axis
+  // (their weight times the normals' squared x or z) rather than all of their
+  // weight: sideways, which the pairs see only on skin facing sideways, is then held
+  // less firmly, and the path follows the sideways sway within a sweep more fully.
+  bool per_axis = false;
+  // An extra weight (times SwayOptions::ridge) on the path's slow part, its mean
+  // over SwayOptions::slow_frames. A sweep-long offset between the front and the back
+  // sweeps thins or thickens the body and hardly shows in the pairs; this keeps it
+  // held when the rest is let go.
+  double slow_scale = 0;
+};
+
 struct SwayOptions {
   int knot_frames = 20;         // knot spacing of the sway's path, frames (1/3 s at 60 Hz)
   // Neighbourhood in which a point meets another sweep's skin: at least this, and at
@@ -51,6 +66,22 @@ struct SwayOptions {
   // Stripes farther apart than this (a scan of every 5th step or coarser on the
   // thesis rig) leave too little overlap to tell sway from shape: not estimated.
   double max_stripe_spacing_mm = 16;
+  // The candidate holds, firmest first. With two or more and cv_folds >= 2, the
+  // pairs are dealt out to folds by where their skin is; each candidate's path is
+  // fitted without each fold in turn and scored on that fold's pairs. The firmest
+  // candidate whose score is within one standard error of the best one's is
+  // taken: a looser hold must explain skin it was not fitted to clearly better. A
+  // still body's sweeps disagree a little (calibration, grazing views) in ways a
+  // loose path would take for sway; that disagreement is local, and does not carry
+  // over to other skin, while a sway does.
+  std::vector<SwayRegularization> regularizations = {
+      {1, false, 0},   // every pair's weight, as firm as before
+      {1, true, 10},   // per axis, the slow part held
+      {0.3, true, 10}, // and the size's weight a third
+  };
+  int cv_folds = 5;
+  float cv_block_mm = 150;  // the cubes of space dealt out to the folds
+  int slow_frames = 600;    // the slow part's window (10 s at 60 Hz: longer than a sway, about two sweeps)
 };
 
 struct SwayEstimate {
@@ -62,6 +93,8 @@ struct SwayEstimate {
   double stripe_spacing_mm = 0;          // median distance between a sweep's neighbouring stripes
   double rms_before_mm = 0, rms_after_mm = 0;  // of those pairs' distances (robust RMS)
   double peak_mm = 0;                    // largest |sway| over the knots
+  SwayRegularization regularization;     // the hold taken
+  std::vector<double> held_out_rms_mm;   // each candidate's RMS over the held-out pairs (empty: no choice made)
   std::string not_estimated;             // when empty(): why (nothing to compare, stripes too far apart)
 
   // The sway at `frame` (linear between knots, constant beyond the ends).

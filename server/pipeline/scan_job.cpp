@@ -169,6 +169,10 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
                  {"pair_rms_after_mm", w.rms_after_mm},
                  {"first_frame", w.first_frame},
                  {"knot_frames", w.knot_frames},
+                 {"hold", {{"per_axis", w.regularization.per_axis},
+                           {"ridge_scale", w.regularization.ridge_scale},
+                           {"slow_scale", w.regularization.slow_scale},
+                           {"held_out_rms_mm", w.held_out_rms_mm}}},
                  {"path_mm", path}};
   } else if (!r.scan.sway_not_estimated.empty()) {
     j["sway_not_estimated"] = r.scan.sway_not_estimated;

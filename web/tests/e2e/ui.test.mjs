@@ -216,9 +216,11 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
 
     await page.fill('input[name=name]', 'Grace Hopper');
     await page.click('#start-scan');
-    await page.locator('#job .job-state[data-stage=scan]').waitFor({ timeout: 60000 });
+    // Generous waits: under CI's parallel tests the first step's frames (and the
+    // step the cancel lands after) can take tens of seconds to render.
+    await page.locator('#job .job-state[data-stage=scan]').waitFor({ timeout: 180000 });
     await page.click('#job button:has-text("Cancel")');
-    await page.locator('#job .job-state[data-state=cancelled]').waitFor({ timeout: 60000 });
+    await page.locator('#job .job-state[data-state=cancelled]').waitFor({ timeout: 120000 });
     assert.match(page.url(), /\/station$/, 'a cancelled scan does not open');
     // Once the job has ended the rig reports every laser off.
     await page.waitForFunction(() => [...document.querySelectorAll('#rig-status .laser')].every((l) => l.classList.contains('off')), null, { timeout: 30000 });
