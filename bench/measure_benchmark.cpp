@@ -106,9 +106,11 @@ std::string sway_error(const SwayEstimate& est, const std::vector<int32_t>& fram
   Eigen::Vector3d axis;
   double truth = 0;
   error(best, &axis, &truth);
-  char line[200];
-  std::snprintf(line, sizeof line, "%.2f mm RMS off the simulator's %.2f mm RMS (x %.2f, z %.2f; frame offset %.1f)",
-                axis.norm(), truth, axis.x(), axis.z(), best);
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "%.2f mm RMS off the simulator's %.2f mm RMS (x %.2f, z %.2f; frame offset %.1f); hold %s, size x%.2g%s",
+                axis.norm(), truth, axis.x(), axis.z(), best, est.regularization.per_axis ? "per axis" : "on all pairs",
+                est.regularization.ridge_scale, est.regularization.slow_scale > 0 ? ", slow part held" : "");
   return line;
 }
 

@@ -76,8 +76,8 @@ struct SwayOptions {
   // over to other skin, while a sway does.
   std::vector<SwayRegularization> regularizations = {
       {1, false, 0},   // every pair's weight, as firm as before
-      {1, true, 10},   // per axis, the slow part held
-      {0.3, true, 10}, // and the size's weight a third
+      {1, true, 30},   // per axis, the slow part held
+      {0.3, true, 30}, // and the size's weight a third
   };
   int cv_folds = 5;
   float cv_block_mm = 150;  // the cubes of space dealt out to the folds
