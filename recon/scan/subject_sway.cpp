@@ -7,7 +7,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <numeric>
 #include <tbb/parallel_for.h>
 
@@ -308,13 +307,16 @@ Eigen::Vector3d SwayEstimate::at(double frame) const {
   return (1 - a) * knots[k] + a * knots[k + 1];
 }
 
-StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions& options) {
-  const SwayOptions& o = options;
+StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions& o) {
   const size_t n = cloud.size();
   if (cloud.frame.size() != n || cloud.laser.size() != n)
     return invalid_argument("sway: the cloud needs each point's frame and laser");
   if (o.knot_frames < 1 || o.radius_mm <= 0 || o.min_frame_gap < 1 || o.iterations < 1 || o.min_group < 3)
     return invalid_argument("sway: bad options");
+  if (o.regularizations.empty() || (o.cv_folds >= 2 && !(o.cv_block_mm > 0)) || o.slow_frames < 1)
+    return invalid_argument("sway: bad options (no hold to try, or no cubes to fold by)");
+  for (const SwayRegularization& r : o.regularizations)
+    if (!(r.ridge_scale >= 0) || !(r.slow_scale >= 0)) return invalid_argument("sway: a hold's weights must be >= 0");
   SwayEstimate est;
   est.knot_frames = o.knot_frames;
   int fmin = INT32_MAX, fmax = INT32_MIN;
@@ -392,24 +394,24 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
     if (all.total <= 0) break;
     // Which of the regularisations explains the pairs of skin it was not fitted
     // to best (when there is a choice).
-    SwayRegularization chosen = o.regularizations.empty() ? SwayRegularization{} : o.regularizations.front();
+    SwayRegularization chosen = o.regularizations.front();
     if (folds > 1 && o.regularizations.size() > 1) {
       // Each candidate's mean squared distance over each fold's pairs, with the
       // path fitted to the other folds.
+      std::vector<std::vector<size_t>> in_fold(folds);
+      for (size_t q = 0; q < pairs.size(); ++q)
+        if (weight[q] > 0) in_fold[static_cast<size_t>(pairs[q].fold)].push_back(q);
       std::vector<std::vector<double>> err(o.regularizations.size(), std::vector<double>(folds, 0.0));
-      std::vector<double> fold_weight(folds, 0.0);
-      for (size_t q = 0; q < pairs.size(); ++q) fold_weight[static_cast<size_t>(pairs[q].fold)] += weight[q];
       for (size_t c = 0; c < o.regularizations.size(); ++c) {
         for (size_t f = 0; f < folds; ++f) {
           System train = all;
           train.add(sys[f], -1);
-          if (train.total <= 0 || fold_weight[f] <= 0) continue;
+          if (train.total <= 0 || sys[f].total <= 0) continue;
           auto fit = solve_path(train, o.regularizations[c], o, m, axes);
           if (!fit.ok()) return fit.status();
-          for (size_t q = 0; q < pairs.size(); ++q) {
-            if (weight[q] <= 0 || static_cast<size_t>(pairs[q].fold) != f) continue;
+          for (size_t q : in_fold[f]) {
             const double r = residual(pairs[q], *fit);
-            err[c][f] += weight[q] * r * r / fold_weight[f];
+            err[c][f] += weight[q] * r * r / sys[f].total;
           }
         }
       }

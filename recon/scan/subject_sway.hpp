@@ -18,7 +18,10 @@
 // What the scan cannot tell: a sway that moves every pair of overlapping moments
 // alike (e.g. one sweep alone moving sideways along a flat patch), and any sway
 // between moments whose sweeps see no common skin. A small weight on the sway itself
-// holds those near zero, and the smoothness term carries the path across;
+// holds those near zero, and the smoothness term carries the path across. How
+// firmly (one weight for all the pairs, or per axis, where sideways sway shows
+// only on skin facing sideways) is chosen per scan: the firmest hold that explains
+// pairs it was not fitted to about as well as any (cross-validation by place).
 // docs/scan-processing.md ("The subject's sway") has the figures.
 #pragma once
 

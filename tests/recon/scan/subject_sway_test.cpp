@@ -238,5 +238,24 @@ TEST(SubjectSwayInput, NeedsEachPointsFrameAndLaser) {
   EXPECT_TRUE(none->empty());
 }
 
+TEST(SubjectSwayInput, RefusesHoldsItCannotTry) {
+  PointCloud c;
+  c.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0)};
+  c.frame = {0, 100};
+  c.laser = {0, 1};
+  SwayOptions none;
+  none.regularizations.clear();
+  auto r = estimate_sway(c, none);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("no hold"), std::string::npos) << r.status().message();
+  SwayOptions negative;
+  negative.regularizations = {{1, false, 0}, {-0.5, true, 30}};
+  EXPECT_EQ(estimate_sway(c, negative).status().code(), StatusCode::kInvalidArgument);
+  SwayOptions no_cubes;
+  no_cubes.cv_block_mm = 0;
+  EXPECT_EQ(estimate_sway(c, no_cubes).status().code(), StatusCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace bodyscan
