@@ -244,10 +244,22 @@ struct System {
   }
 };
 
+// The path's slow part squared: B'B, B taking each of the m knots to its mean over
+// the window of SwayOptions::slow_frames around it.
+Eigen::MatrixXd slow_part(size_t m, const SwayOptions& o) {
+  const int half = std::max(1, o.slow_frames / o.knot_frames / 2);
+  Eigen::MatrixXd box = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
+  for (size_t k = 0; k < m; ++k) {
+    const int b = std::max(0, static_cast<int>(k) - half), e = std::min(static_cast<int>(m) - 1, static_cast<int>(k) + half);
+    for (int j = b; j <= e; ++j) box(static_cast<Eigen::Index>(k), j) = 1.0 / (e - b + 1);
+  }
+  return box.transpose() * box;
+}
+
 // The path that best explains the pairs under the smoothness, the mean-zero and the
-// size terms of `reg`.
+// size terms of `reg` (`slow` is slow_part()).
 StatusOr<std::vector<Eigen::Vector3d>> solve_path(const System& s, const SwayRegularization& reg, const SwayOptions& o,
-                                                  size_t m, const std::vector<int>& axes) {
+                                                  size_t m, const std::vector<int>& axes, const Eigen::MatrixXd& slow) {
   const size_t dims = axes.size();
   Eigen::MatrixXd ata = s.ata;
   const double per_knot = s.total / static_cast<double>(m);
@@ -273,18 +285,10 @@ StatusOr<std::vector<Eigen::Vector3d>> solve_path(const System& s, const SwayReg
           o.ridge * reg.ridge_scale * scale;
     }
     if (reg.slow_scale > 0) {
-      // The slow part: each knot's mean over the window around it.
-      const int half = std::max(1, o.slow_frames / o.knot_frames / 2);
-      Eigen::MatrixXd box = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
-      for (size_t k = 0; k < m; ++k) {
-        const int b = std::max(0, static_cast<int>(k) - half), e = std::min(static_cast<int>(m) - 1, static_cast<int>(k) + half);
-        for (int j = b; j <= e; ++j) box(static_cast<Eigen::Index>(k), j) = 1.0 / (e - b + 1);
-      }
-      const Eigen::MatrixXd btb = box.transpose() * box;
       for (size_t a = 0; a < m; ++a)
         for (size_t b = 0; b < m; ++b)
           ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(b * dims + d)) +=
-              o.ridge * reg.slow_scale * scale * btb(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+              o.ridge * reg.slow_scale * scale * slow(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
     }
   }
   const Eigen::VectorXd sol = ata.ldlt().solve(s.atb);
@@ -331,6 +335,7 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   const size_t m = static_cast<size_t>(knots.count);
   std::vector<int> axes = o.vertical ? std::vector<int>{0, 1, 2} : std::vector<int>{0, 2};
   const size_t dims = axes.size(), unknowns = m * dims;
+  const Eigen::MatrixXd slow = slow_part(m, o);
 
   std::vector<size_t> anchors;
   const size_t stride = std::max<size_t>(1, (n + o.max_anchors - 1) / std::max<size_t>(1, o.max_anchors));
@@ -402,12 +407,12 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
       for (size_t q = 0; q < pairs.size(); ++q)
         if (weight[q] > 0) in_fold[static_cast<size_t>(pairs[q].fold)].push_back(q);
       std::vector<std::vector<double>> err(o.regularizations.size(), std::vector<double>(folds, 0.0));
-      for (size_t c = 0; c < o.regularizations.size(); ++c) {
-        for (size_t f = 0; f < folds; ++f) {
-          System train = all;
-          train.add(sys[f], -1);
-          if (train.total <= 0 || sys[f].total <= 0) continue;
-          auto fit = solve_path(train, o.regularizations[c], o, m, axes);
+      for (size_t f = 0; f < folds; ++f) {
+        System train = all;
+        train.add(sys[f], -1);
+        if (train.total <= 0 || sys[f].total <= 0) continue;
+        for (size_t c = 0; c < o.regularizations.size(); ++c) {
+          auto fit = solve_path(train, o.regularizations[c], o, m, axes, slow);
           if (!fit.ok()) return fit.status();
           for (size_t q : in_fold[f]) {
             const double r = residual(pairs[q], *fit);
@@ -440,7 +445,7 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
       for (const std::vector<double>& e : err) est.held_out_rms_mm.push_back(std::sqrt(mean(e)));
     }
     est.regularization = chosen;
-    auto fit = solve_path(all, chosen, o, m, axes);
+    auto fit = solve_path(all, chosen, o, m, axes, slow);
     if (!fit.ok()) return fit.status();
     x = std::move(*fit);
     est.knots = x;
