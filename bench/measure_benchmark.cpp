@@ -8,6 +8,7 @@
 //   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR | --saved DIR]
 //                     [--resurface] [--seed N] [--min-weight W]
+//   measure_benchmark --noise-study N [--noise-rms MM] --body BODY.ply...
 //
 // --save writes each scan's surface, its point cloud and the posed true body as PLY
 // into DIR (with --repeat, the second scan's surface and cloud too). --saved DIR
@@ -17,6 +18,10 @@
 // cloud with today's reconstruction (as the scan job does, half a minute a scan),
 // so a change to the surface is judged on the same scans.
 // --min-weight sets the surface's ReconstructOptions::min_relative_weight.
+// --noise-study N measures each body's own mesh N times under smooth skin noise
+// (hw/sim/skin_noise.hpp: fields at 40 and 10 mm, each --noise-rms RMS, default
+// 0.25 mm) and ranks the measurements and landmarks by how far they move: no scan,
+// a few seconds a body.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
 // 9 mm off on large girths, 4 mm on small girths and heights, 5 mm on lengths. The
@@ -38,6 +43,7 @@
 #include "recon/measure/body_measurements.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "hw/sim/scene.hpp"
+#include "recon/geometry/skin_noise.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/rig_backend.hpp"
 
@@ -344,6 +350,59 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
   return report(*truth, *mesh, *a, floor, b ? &*b : nullptr, sway);
 }
 
+
+// How far each rule of the automatic set moves when the skin moves a little: the
+// body's true mesh with a smooth random field added along its normals (two scales,
+// 40 and 10 mm, each `rms_mm` RMS: a scan's surface errs so, not vertex by vertex),
+// measured `n` times. Prints, per measurement, the RMS and the largest difference
+// from the clean body's value, largest first; the rules that move most are those a
+// second scan moves most.
+int noise_study(const std::string& body, int n, double rms_mm) {
+  auto mesh = read_ply_mesh(body);
+  if (!mesh.ok()) return std::fprintf(stderr, "%s\n", mesh.status().message().c_str()), 1;
+  auto clean = measure_body(*mesh);
+  if (!clean.ok()) return std::fprintf(stderr, "clean: %s\n", clean.status().message().c_str()), 1;
+  std::map<std::string, std::vector<double>> diffs;
+  std::map<std::string, std::vector<Eigen::Vector3d>> moves;
+  for (int s = 1; s <= n; ++s) {
+    const TriangleMesh noisy = with_smooth_skin_noise(*mesh, rms_mm, s);
+    auto m = measure_body(noisy);
+    if (!m.ok()) {
+      std::printf("seed %d: %s\n", s, m.status().message().c_str());
+      continue;
+    }
+    for (const BodyMeasurement& c : clean->measurements)
+      if (const BodyMeasurement* x = m->find(c.name)) diffs[c.name].push_back(x->value_mm - c.value_mm);
+    for (const BodyLandmark& c : clean->landmarks)
+      if (const BodyLandmark* x = m->landmark(c.name)) moves[c.name].push_back(x->position - c.position);
+  }
+  std::vector<std::pair<double, std::string>> order;
+  for (const auto& [name, d] : diffs) {
+    double mx = 0;
+    for (double x : d) mx = std::max(mx, std::abs(x));
+    order.emplace_back(mx, name);
+  }
+  std::sort(order.rbegin(), order.rend());
+  std::printf("\n== %s: %d fields of %.2f mm RMS at 40 mm and at 10 mm\n%-24s %8s %8s %8s %8s\n", body.c_str(), n,
+              rms_mm, "measurement", "value", "mean", "rms", "largest");
+  for (const auto& [mx, name] : order) {
+    const std::vector<double>& d = diffs[name];
+    double ss = 0, sum = 0;
+    for (double x : d) ss += x * x, sum += x;
+    std::printf("%-24s %8.1f %+8.2f %8.2f %8.2f\n", name.c_str(), clean->find(name)->value_mm, sum / d.size(),
+                std::sqrt(ss / d.size()), mx);
+  }
+  std::printf("\n%-26s %8s %8s %8s %8s\n", "landmark", "rms x", "rms y", "rms z", "largest");
+  for (const auto& [name, d] : moves) {
+    Eigen::Vector3d ss = Eigen::Vector3d::Zero();
+    double mx = 0;
+    for (const Eigen::Vector3d& x : d) ss += x.cwiseProduct(x), mx = std::max(mx, x.norm());
+    ss = (ss / d.size()).cwiseSqrt();
+    std::printf("%-26s %8.2f %8.2f %8.2f %8.2f\n", name.c_str(), ss.x(), ss.y(), ss.z(), mx);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -351,7 +410,8 @@ int main(int argc, char** argv) {
   bool repeat = false;
   std::string saved;
   double sway = 3;
-  int every = 1;
+  int every = 1, noise_fields = 0;
+  double noise_rms = 0.25;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
@@ -362,6 +422,8 @@ int main(int argc, char** argv) {
     else if (a == "--save" && i + 1 < argc) g_save = argv[++i];
     else if (a == "--saved" && i + 1 < argc) saved = argv[++i];
     else if (a == "--resurface") g_resurface = true;
+    else if (a == "--noise-study" && i + 1 < argc) noise_fields = std::atoi(argv[++i]);
+    else if (a == "--noise-rms" && i + 1 < argc) noise_rms = std::atof(argv[++i]);
     else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--min-weight" && i + 1 < argc) g_surface.min_relative_weight = std::strtof(argv[++i], nullptr);
     else if (a == "--fairing" && i + 1 < argc) {
@@ -369,7 +431,14 @@ int main(int argc, char** argv) {
       g_surface.hole_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
     }
     else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
-                        "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W]\n"), 2;
+                        "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W]\n"
+                        "       measure_benchmark --noise-study N [--noise-rms MM] --body B...\n"), 2;
+  }
+  if (noise_fields > 0) {
+    if (bodies.empty()) return std::fprintf(stderr, "measure_benchmark: --noise-study needs --body B.ply\n"), 2;
+    int rc = 0;
+    for (const std::string& b : bodies) rc |= noise_study(b, noise_fields, noise_rms);
+    return rc;
   }
   if (rigs.empty()) rigs = {"thesis"};
   if (bodies.empty()) bodies = {""};

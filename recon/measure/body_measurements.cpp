@@ -56,6 +56,9 @@ constexpr double kThighBelowCrotch = 0.015;
 // between where the tape has grown by this much (mm) either side
 // (flat_bottom_middle).
 constexpr double kFlatRiseMm = 3;
+// The waist is the centroid of the torso's girth profile where it dips below its
+// narrowest + this (mm): minimum_centroid.
+constexpr double kWaistDepthMm = 6;
 // A fold under the bust shallower than this behind its chord (mm) is flat at the
 // bottom, and is refined as the front neck point; a deeper one is a crease.
 constexpr double kShallowFoldMm = 10;
@@ -131,6 +134,42 @@ Eigen::Vector3d middle_of_extreme(const std::vector<Eigen::Vector3d>& pts, const
   return best;
 }
 
+
+// Where the ray from `origin` along `dir` last leaves a closed loop lying in a plane
+// through `origin` that holds `dir` and `across`: the loop's outermost crossing of
+// that line. On a limb's round side the middle of the flattest stretch slides round
+// with a few tenths of a millimetre of skin noise (an elbow's outer point moved 5 mm
+// round the arm, and the outer arm length 4 mm); the crossing moves only as far as
+// the skin does. Empty when the ray never crosses the loop.
+std::optional<Eigen::Vector3d> ray_exit(const std::vector<Eigen::Vector3d>& loop, const Eigen::Vector3d& origin,
+                                        const Eigen::Vector3d& dir, const Eigen::Vector3d& across) {
+  std::optional<Eigen::Vector3d> out;
+  double far = 0;
+  for (size_t i = 0, n = loop.size(); i < n; ++i) {
+    const Eigen::Vector3d& a = loop[i];
+    const Eigen::Vector3d& b = loop[(i + 1) % n];
+    const double va = (a - origin).dot(across), vb = (b - origin).dot(across);
+    if ((va < 0) == (vb < 0) || va == vb) continue;
+    const double f = va / (va - vb);
+    const Eigen::Vector3d q = a + f * (b - a);
+    if (const double t = (q - origin).dot(dir); t > far) far = t, out = q;
+  }
+  return out;
+}
+
+// The centre of a closed loop's outline: its edges' midpoints weighted by their
+// lengths (unlike the vertices' mean, indifferent to where the cut samples densely).
+Eigen::Vector3d loop_centre(const std::vector<Eigen::Vector3d>& loop) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double len = 0;
+  for (size_t i = 0, n = loop.size(); i < n; ++i) {
+    const Eigen::Vector3d& a = loop[i];
+    const Eigen::Vector3d& b = loop[(i + 1) % n];
+    const double l = (b - a).norm();
+    sum += 0.5 * l * (a + b), len += l;
+  }
+  return len > 0 ? (sum / len).eval() : (loop.empty() ? Eigen::Vector3d::Zero() : loop.front());
+}
 
 // Least-squares line through points: (centre, unit direction with y >= 0).
 std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Vector3d>& p, size_t b, size_t e,
@@ -732,7 +771,17 @@ class Finder {
     double lo = std::max(hip_y_ + 0.04 * h_, at(0.55)),
            hi = underbust_fold_ ? std::min(underbust_y_ - 0.02 * h_, at(0.70)) : at(0.70);
     if (lo >= hi) lo = hip_y_ + 0.04 * h_, hi = underbust_y_ - 0.02 * h_;
-    waist_y_ = profile(lo, hi, [](const Ring& m) { return m.girth; }, false, 2.0, 0.5 * (lo + hi));
+    // The level is the centroid of the girth profile's dip kWaistDepthMm deep: the
+    // middle of the run within 2 mm of the narrowest cut moved up to 5 mm under a
+    // quarter of a millimetre of skin noise, in 2 mm steps (measure_benchmark
+    // --noise-study: female_average's waist height 2.1 mm RMS, now 0.75).
+    {
+      std::vector<double> ys, vs;
+      prefetch(lo, hi, 2);
+      for (double y = lo; y <= hi; y += 2)
+        if (const Ring* m = midline(rings(y), xc_)) ys.push_back(y), vs.push_back(m->girth);
+      waist_y_ = ys.empty() ? 0.5 * (lo + hi) : minimum_centroid(ys, vs, arg_extreme(vs, false), kWaistDepthMm);
+    }
     double f = zc_, b = zc_;
     const std::vector<Ring>& rr = rings(waist_y_);
     if (const Ring* m = midline(rr, xc_)) m->crossing_z(xc_, &f, &b);
@@ -1023,11 +1072,18 @@ class Finder {
       if (s * o.x() < 0) o = -o;
       return o.normalized().eval();
     };
-    // The cut's outermost point, in the middle of its flat side (middle_of_extreme):
-    // the outermost sample alone sat 5.7 mm along a wrist's flat outer face from
-    // the true body's (tiered rig, male_average), now 3.7.
+    // The cut's outer point: where the ray from its centre straight out leaves it.
+    // Until session 24 it was the middle of the cut's flat outer side
+    // (middle_of_extreme), which slides round a limb's round side with the skin's
+    // noise: under a quarter of a millimetre (measure_benchmark --noise-study) an
+    // elbow's outer point moved up to 5.7 mm round the arm, and the outer arm length
+    // up to 4 mm with it (male_average: the elbow 3.7 mm RMS front to back, now 0.3;
+    // the outer arm length 2.7 mm RMS, now 1.6-2.0). The ray's crossing moves as far
+    // as the skin does. The flat side's middle stays for a cut the ray misses.
     auto outer_point = [&](const Girth& gg, const Eigen::Vector3d& axis, const Eigen::Vector3d& out) {
-      return middle_of_extreme(gg.loop, out, axis.cross(out).normalized(), kFlatBand);
+      const Eigen::Vector3d across = axis.cross(out).normalized();
+      if (std::optional<Eigen::Vector3d> p = ray_exit(gg.loop, loop_centre(gg.loop), out, across)) return *p;
+      return middle_of_extreme(gg.loop, out, across, kFlatBand);
     };
     // The wrist itself: the narrowest cut perpendicular to the forearm within 3 % of
     // the height either side of the horizontal cuts' narrowest (which an inclined
@@ -1073,8 +1129,10 @@ class Finder {
     }
     const std::vector<uint32_t> et = triangles_near(elbow_c, 0.08 * h_);
     StatusOr<Girth> eg = mesh_girth(mesh_, Plane{elbow_c, ud}, elbow_c, &et);
-    const Eigen::Vector3d wrist_p = wg.ok() && !wg->loop.empty() ? outer_point(*wg, fd, outward(fd)) : wrist_c;
-    const Eigen::Vector3d elbow_p = eg.ok() && !eg->loop.empty() ? outer_point(*eg, ud, outward(ud)) : elbow_c;
+    const Eigen::Vector3d wrist_p =
+        wg.ok() && !wg->loop.empty() ? outer_point(*wg, fd, outward(fd)) : wrist_c;
+    const Eigen::Vector3d elbow_p =
+        eg.ok() && !eg->loop.empty() ? outer_point(*eg, ud, outward(ud)) : elbow_c;
     landmark("wrist_point_" + sd, wrist_p);
     landmark("elbow_point_" + sd, elbow_p);
     girth("wrist_girth_" + sd, "Wrist girth (" + sd + ")", "5.3.19", wg, {"wrist_point_" + sd},
@@ -1172,6 +1230,26 @@ class Finder {
 };
 
 }  // namespace
+
+double minimum_centroid(const std::vector<double>& x, const std::vector<double>& v, size_t k, double depth) {
+  const double level = v[k] + depth;
+  size_t a = k, b = k;
+  while (a > 0 && v[a - 1] < level) --a;
+  while (b + 1 < v.size() && v[b + 1] < level) ++b;
+  // Segments [i, i + 1] from the one rising out on the left to the one on the right.
+  const size_t first = a > 0 ? a - 1 : 0, last = b + 1 < v.size() ? b + 1 : b;
+  double area = 0, moment = 0;
+  for (size_t i = first; i < last; ++i) {
+    double x0 = x[i], x1 = x[i + 1], f0 = level - v[i], f1 = level - v[i + 1];
+    // Clip the segment to where it lies under the level.
+    if (f0 < 0) x0 = x0 + (x1 - x0) * (-f0) / (f1 - f0), f0 = 0;
+    if (f1 < 0) x1 = x1 - (x1 - x0) * (-f1) / (f0 - f1), f1 = 0;
+    const double dx = x1 - x0;
+    area += 0.5 * (f0 + f1) * dx;
+    moment += dx / 6 * (2 * x0 * f0 + x0 * f1 + x1 * f0 + 2 * x1 * f1);
+  }
+  return area != 0 ? moment / area : x[k];
+}
 
 size_t wrist_cut(const std::vector<double>& g, double palm_rise) {
   const size_t n = g.size();

@@ -97,6 +97,15 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
 // above that rise. measure_body passes 0.6 % of the stature.
 size_t wrist_cut(const std::vector<double>& girths, double palm_rise);
 
+// The centre of a dip in a profile v sampled over x (x monotonic), around its lowest
+// sample k: the centroid of the area between v, taken as linear between samples,
+// and the level v[k] + depth, over the stretch round k that stays below that level
+// (a side that never rises to it ends at the last sample). Unlike the lowest sample
+// or the middle of the samples near it, it moves smoothly as the profile does,
+// which a flat bottom's noise otherwise carries from sample to sample. The waist's
+// level (measure_body).
+double minimum_centroid(const std::vector<double>& x, const std::vector<double>& v, size_t k, double depth);
+
 // One leg's tape in a horizontal cut where hole filling has bridged the gap between
 // the thighs (`ring` spans the midline X = xc and crosses it on invented surface
 // only, mesh confidence under 0.5 front and back): round the measured skin
