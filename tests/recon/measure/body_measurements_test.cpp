@@ -438,7 +438,7 @@ TEST(BodyMeasurements, TheCentreOfADipMovesWithTheProfile) {
   EXPECT_NEAR(minimum_centroid(x, falling, x.size() - 1, 2.4), 60 - 12 / 3.0, 1e-9);
 }
 
-TEST(BodyMeasurements, TheElbowAndTheWaistStayPutUnderSmoothSkinNoise) {
+TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNoise) {
   // A scan's surface errs in gentle swells (recon/geometry/skin_noise.hpp): here two
   // fields, at 40 and 10 mm, each 0.25 mm RMS, eight seeds. The elbow's outer point
   // was the middle of the flattest stretch of the cut's outer side, and slid round
@@ -469,6 +469,12 @@ TEST(BodyMeasurements, TheElbowAndTheWaistStayPutUnderSmoothSkinNoise) {
         }
       }
       EXPECT_LT(diff("waist_height"), male ? 1.0 : 2.0) << body << ", seed " << seed;
+      // female_average's under-bust is a crease, its level the deepest of the
+      // profile's 2 mm samples until session 24, and the tape, steep across the
+      // crease, jumped up to 3.3 mm; now the centroid of the crease's bottom.
+      if (!male) {
+        EXPECT_LT(diff("underbust_girth"), 2.5) << body << ", seed " << seed;
+      }
       EXPECT_LT(diff("back_neck_to_waist"), 1.5) << body << ", seed " << seed;
     }
   }
