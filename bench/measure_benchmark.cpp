@@ -19,7 +19,7 @@
 // so a change to the surface is judged on the same scans.
 // --min-weight sets the surface's ReconstructOptions::min_relative_weight.
 // --noise-study N measures each body's own mesh N times under smooth skin noise
-// (hw/sim/skin_noise.hpp: fields at 40 and 10 mm, each --noise-rms RMS, default
+// (recon/geometry/skin_noise.hpp: fields at 40 and 10 mm, each --noise-rms RMS, default
 // 0.25 mm) and ranks the measurements and landmarks by how far they move: no scan,
 // a few seconds a body.
 //
@@ -39,11 +39,11 @@
 #include <string>
 #include <vector>
 
+#include "recon/geometry/skin_noise.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_measurements.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "hw/sim/scene.hpp"
-#include "recon/geometry/skin_noise.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/rig_backend.hpp"
 
@@ -349,7 +349,6 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
   }
   return report(*truth, *mesh, *a, floor, b ? &*b : nullptr, sway);
 }
-
 
 // How far each rule of the automatic set moves when the skin moves a little: the
 // body's true mesh with a smooth random field added along its normals (two scales,

@@ -1138,10 +1138,8 @@ class Finder {
     }
     const std::vector<uint32_t> et = triangles_near(elbow_c, 0.08 * h_);
     StatusOr<Girth> eg = mesh_girth(mesh_, Plane{elbow_c, ud}, elbow_c, &et);
-    const Eigen::Vector3d wrist_p =
-        wg.ok() && !wg->loop.empty() ? outer_point(*wg, fd, outward(fd)) : wrist_c;
-    const Eigen::Vector3d elbow_p =
-        eg.ok() && !eg->loop.empty() ? outer_point(*eg, ud, outward(ud)) : elbow_c;
+    const Eigen::Vector3d wrist_p = wg.ok() && !wg->loop.empty() ? outer_point(*wg, fd, outward(fd)) : wrist_c;
+    const Eigen::Vector3d elbow_p = eg.ok() && !eg->loop.empty() ? outer_point(*eg, ud, outward(ud)) : elbow_c;
     landmark("wrist_point_" + sd, wrist_p);
     landmark("elbow_point_" + sd, elbow_p);
     girth("wrist_girth_" + sd, "Wrist girth (" + sd + ")", "5.3.19", wg, {"wrist_point_" + sd},
