@@ -12,7 +12,7 @@
 
 namespace bodyscan {
 
-// A smooth random field over space, about unit variance: value noise on a cubic
+// A smooth random field over space: value noise on a cubic
 // lattice of `spacing` mm, standard normal values at the nodes (hashed from `seed`
 // and the node), smoothstep interpolation between them. The same seed gives the
 // same field.
