@@ -29,19 +29,33 @@ const Truth kBodies[] = {
     {"female_average.ply", 1588.0, 1344, 1261, 1090, 970, 813, 445, 650, 939},
 };
 
+// A shipped body (hw/sim/bodies/FILE), read and measured once, for the tests that
+// check it, or change it and compare. Null when it cannot be read or measured.
+struct ShippedBody {
+  TriangleMesh mesh;
+  BodyMeasurements measured;
+};
+const ShippedBody* shipped_body(const std::string& file) {
+  static std::map<std::string, std::optional<ShippedBody>> cache;
+  auto it = cache.find(file);
+  if (it == cache.end()) {
+    std::optional<ShippedBody> body;
+    if (auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/" + file); mesh.ok())
+      if (auto measured = measure_body(*mesh); measured.ok()) body = ShippedBody{std::move(*mesh), std::move(*measured)};
+    it = cache.emplace(file, std::move(body)).first;
+  }
+  return it->second ? &*it->second : nullptr;
+}
+// The demo body.
+const ShippedBody* male_average() { return shipped_body("male_average.ply"); }
+
 class BodyMeasurementsTest : public ::testing::TestWithParam<Truth> {
  protected:
   static const BodyMeasurements& measured(const std::string& file) {
-    static std::map<std::string, BodyMeasurements> cache;
-    auto it = cache.find(file);
-    if (it == cache.end()) {
-      auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/" + file);
-      EXPECT_TRUE(mesh.ok());
-      auto body = measure_body(*mesh);
-      EXPECT_TRUE(body.ok()) << body.status().message();
-      it = cache.emplace(file, *body).first;
-    }
-    return it->second;
+    const ShippedBody* body = shipped_body(file);
+    EXPECT_TRUE(body) << file;
+    static const BodyMeasurements none;
+    return body ? body->measured : none;
   }
   static double value(const BodyMeasurements& b, const std::string& name) {
     const BodyMeasurement* m = b.find(name);
@@ -130,24 +144,8 @@ TEST_P(BodyMeasurementsTest, GirthsAgreeWithTheManifestAndAreSymmetric) {
 
 INSTANTIATE_TEST_SUITE_P(ShippedBodies, BodyMeasurementsTest, ::testing::ValuesIn(kBodies));
 
-// The demo body, read and measured once, for the tests that change it and compare.
-struct MaleAverage {
-  TriangleMesh mesh;
-  BodyMeasurements measured;
-};
-const MaleAverage* male_average() {
-  static const std::optional<MaleAverage> body = []() -> std::optional<MaleAverage> {
-    auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
-    if (!mesh.ok()) return std::nullopt;
-    auto measured = measure_body(*mesh);
-    if (!measured.ok()) return std::nullopt;
-    return MaleAverage{std::move(*mesh), std::move(*measured)};
-  }();
-  return body ? &*body : nullptr;
-}
-
 TEST(BodyMeasurements, DoNotDependOnWhereTheBodyStands) {
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const TriangleMesh* mesh = &body->mesh;
   const BodyMeasurements* a = &body->measured;
@@ -172,7 +170,7 @@ TEST(BodyMeasurements, AStrayFoldBesideTheFlankDoesNotEndTheArm) {
   // Scans sometimes keep a small fold of surface against the flank, below the
   // armpit, a loop of its own in the cuts there. The arm's track must run past it to
   // the hand: it once stopped there and put the wrist halfway up the arm.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const TriangleMesh* mesh = &body->mesh;
   const BodyMeasurements* clean = &body->measured;
@@ -201,7 +199,7 @@ TEST(BodyMeasurements, AScrapBesideTheHipIsNoArm) {
   // a small loop of its own in a few cuts above the crotch. The armpit search once
   // took it for the arm and put the armpit at the hip; the bust, under-bust and
   // waist then followed it down, and the waist girth came out 23 cm large.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const TriangleMesh* mesh = &body->mesh;
   const BodyMeasurements* clean = &body->measured;
@@ -237,7 +235,7 @@ TriangleMesh with_skin_noise(const TriangleMesh& mesh, uint32_t seed) {
 // and the clean body's to `check`.
 template <typename Check>
 void under_skin_noise(std::initializer_list<uint32_t> seeds, const Check& check) {
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   for (uint32_t seed : seeds) {
     auto b = measure_body(with_skin_noise(body->mesh, seed));
@@ -251,7 +249,7 @@ TEST(BodyMeasurements, TheKneeStaysPutUnderTheScansNoise) {
   // shallow: its lowest sample moved 8-10 mm between two scans of one body, taking
   // the knee height and the mid-thigh girth with it. Skin noise of +-0.5 mm along the
   // normals, two seeds: the knee stays within 2 mm of the clean body's.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const TriangleMesh* mesh = &body->mesh;
   const BodyMeasurements* clean = &body->measured;
@@ -302,7 +300,7 @@ TEST(BodyMeasurements, TheNeckAndShoulderPointsStayPutUnderTheScansNoise) {
   // outline has flared to 1.3 times the narrowest tape's radius, the side neck points
   // stayed within 0.6 mm and the neck base girth within 1.1 over five seeds (three
   // run here); the other points within 3 mm and the shoulder width within 2.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const BodyMeasurements* clean = &body->measured;
   for (uint32_t seed : {1u, 2u, 3u}) {
@@ -339,7 +337,7 @@ TEST(BodyMeasurements, TheNeckLevelFollowsATaperSmoothly) {
   // samples within 1 mm of the narrowest a whole 2 mm step, and the tilted neck
   // girth 3.3 mm with it. The middle of the flat minimum (where the tape has grown
   // 3 mm either side) moves 0.7 mm and the girth 1.2.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const Eigen::Vector3d c = body->measured.landmark("neck_level")->position;
   for (double slope : {-0.06, 0.06}) {
@@ -381,10 +379,10 @@ TEST(BodyMeasurements, TheBustLevelStaysPutUnderTheScansNoise) {
   // low on a tiered-rig scan of female_average, where the tape grows 3 mm per mm
   // (bust girth -8.6 mm). The vertex of a parabola over 1 % of the height either
   // side stays within 1 mm of the clean body's under +-0.5 mm of skin noise.
-  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/female_average.ply");
-  ASSERT_TRUE(mesh.ok());
-  auto clean = measure_body(*mesh);
-  ASSERT_TRUE(clean.ok()) << clean.status().message();
+  const ShippedBody* body = shipped_body("female_average.ply");
+  ASSERT_TRUE(body);
+  const TriangleMesh* mesh = &body->mesh;
+  const BodyMeasurements* clean = &body->measured;
   for (uint32_t seed : {1u, 2u, 3u}) {
     auto b = measure_body(with_skin_noise(*mesh, seed));
     ASSERT_TRUE(b.ok()) << b.status().message();
@@ -448,10 +446,10 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
   // and moved up to 3.4 mm on female_average (back neck to waist 2.7); it is now the
   // centroid of the girth profile's dip.
   for (const char* body : {"male_average", "female_average"}) {
-    auto mesh = read_ply_mesh(std::string(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/") + body + ".ply");
-    ASSERT_TRUE(mesh.ok()) << body;
-    auto clean = measure_body(*mesh);
-    ASSERT_TRUE(clean.ok()) << clean.status().message();
+    const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
+    ASSERT_TRUE(shipped) << body;
+    const TriangleMesh* mesh = &shipped->mesh;
+    const BodyMeasurements* clean = &shipped->measured;
     const bool male = std::string(body) == "male_average";
     for (uint64_t seed = 1; seed <= 8; ++seed) {
       auto b = measure_body(with_smooth_skin_noise(*mesh, 0.25, seed));
@@ -488,10 +486,10 @@ TEST(BodyMeasurements, TheThighsTapeIsWhereTheCrotchDoesNotPullIt) {
   // tape grows 1.6 mm per mm of height (male_average 0.6). An inch below it (1.5 %
   // of the height) it grows 1.1 mm per mm (0.4).
   for (const char* body : {"female_average", "male_average"}) {
-    auto mesh = read_ply_mesh(std::string(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/") + body + ".ply");
-    ASSERT_TRUE(mesh.ok()) << body;
-    auto b = measure_body(*mesh);
-    ASSERT_TRUE(b.ok()) << b.status().message();
+    const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
+    ASSERT_TRUE(shipped) << body;
+    const TriangleMesh* mesh = &shipped->mesh;
+    const BodyMeasurements* b = &shipped->measured;
     const double crotch = b->landmark("crotch")->position.y();
     const double stature = b->find("stature")->value_mm;
     const BodySlicer slicer(*mesh, crotch - 200, crotch);
@@ -514,7 +512,7 @@ TEST(BodyMeasurements, TheThighsTapeIsWhereTheCrotchDoesNotPullIt) {
 // The true male_average with a wall 5 mm thick and 2 * half_length long front to
 // back standing between its thighs at the crotch, from `below` under it to `above`
 // over it, all marked measured (confidence 1).
-TriangleMesh with_crotch_wall(const MaleAverage& body, double half_length, double below, double above) {
+TriangleMesh with_crotch_wall(const ShippedBody& body, double half_length, double below, double above) {
   const Eigen::Vector3d crotch = body.measured.landmark("crotch")->position;
   std::vector<Eigen::Vector2d> wall;
   for (const Eigen::Vector2d& p : testing::circle(1, {0, 0}, 64))
@@ -532,7 +530,7 @@ TEST(BodyMeasurements, ANarrowSaddleUnderTheCrotchIsNoCrotch) {
   // Here measured skin 16 mm long and 8 mm tall joins the true body's thighs under
   // its crotch: the crotch is still where the join is 1.5 % of the height long,
   // within 1 mm of the clean body's, and the chest under the armpits' vaults too.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const double clean = body->measured.find("crotch_height")->value_mm;
   auto b = measure_body(with_crotch_wall(*body, 8, 8, 1));
@@ -549,7 +547,7 @@ TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
   // 5 mm above the crotch, inside the trunk. Marked measured, it is taken for the
   // crotch (the legs join at its foot); marked invented by hole filling, as a scan's
   // fill is, the crotch stays where the skin joins.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const double clean = body->measured.find("crotch_height")->value_mm;
   TriangleMesh mesh = with_crotch_wall(*body, 30, 25, 5);
@@ -570,7 +568,7 @@ TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
   // the armpits rise to where it is measured again, and the chest, cut just under
   // the lower armpit, stays below both arms' own loops. Marked for 30 mm (beyond 1 %
   // of the height: the thesis rig sees no armpit at all) they stay at the junction.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const BodyMeasurements& clean = body->measured;
   const Eigen::Vector3d left = clean.landmark("armpit_left")->position;
@@ -637,7 +635,7 @@ TEST(BodyMeasurements, ALegCutInPiecesIsNoLevelToMeasureAt) {
   // horizontal cuts there; the piece nearer the midline was taken for the leg, and
   // the minimum leg girth came out 33 mm small (male_muscular, left). A loop beside
   // the ankle, inside it, stands for that piece.
-  const MaleAverage* body = male_average();
+  const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const TriangleMesh* mesh = &body->mesh;
   const BodyMeasurements* clean = &body->measured;
