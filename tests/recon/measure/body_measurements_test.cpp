@@ -444,7 +444,8 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
   // with it. It is now where the ray from the cut's centre straight out leaves it.
   // The waist was the middle of the run of 2 mm cuts within 2 mm of the narrowest,
   // and moved up to 3.4 mm on female_average (back neck to waist 2.7); it is now the
-  // centroid of the girth profile's dip.
+  // centroid of the girth profile's dip. The elbow's centre was the cut where the
+  // arm's axis bends; it is now where the axes of upper arm and forearm meet.
   for (const char* body : {"male_average", "female_average"}) {
     const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
     ASSERT_TRUE(shipped) << body;
@@ -458,13 +459,12 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
         return (b->landmark(name)->position - clean->landmark(name)->position).norm();
       };
       auto diff = [&](const std::string& name) { return std::abs(b->find(name)->value_mm - clean->find(name)->value_mm); };
-      // female_average's elbow bends gently, and where along the arm it bends moves
-      // 4-5 mm under this noise with either rule: only male_average's is checked.
-      if (male) {
-        for (const char* side : {"left", "right"}) {
-          const std::string elbow = std::string("elbow_point_") + side;
-          EXPECT_LT(moved(elbow), 1.5) << body << " " << elbow << ", seed " << seed;
-        }
+      // female_average's elbow bends gently, and where along the arm it bends moved
+      // up to 4.5 mm under this noise while the elbow's centre was the bend's cut
+      // (3 mm apart); where the axes of upper arm and forearm meet, 2.1 at most.
+      for (const char* side : {"left", "right"}) {
+        const std::string elbow = std::string("elbow_point_") + side;
+        EXPECT_LT(moved(elbow), male ? 1.5 : 2.5) << body << " " << elbow << ", seed " << seed;
       }
       EXPECT_LT(diff("waist_height"), male ? 1.0 : 2.0) << body << ", seed " << seed;
       // female_average's under-bust is a crease, its level the deepest of the
