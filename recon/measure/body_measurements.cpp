@@ -65,6 +65,9 @@ constexpr double kShallowFoldMm = 10;
 // The least bend (radians) between upper arm and forearm at which the elbow is
 // where their axes meet (measure_arm).
 constexpr double kMinElbowBend = 10 * M_PI / 180;
+// A second narrowing of the forearm's cuts nearer the hand, past a rise of more
+// than this (mm) and within this of the narrowest, is the wrist (wrist_cut).
+constexpr double kSecondNarrowMm = 2;
 // A deeper fold is a crease: its level is the centroid of its bottom this deep (mm).
 constexpr double kCreaseDepthMm = 2;
 
@@ -1287,10 +1290,22 @@ size_t wrist_cut(const std::vector<double>& g, double palm_rise) {
     if (g[i] < g[low]) low = i;
     if (g[i] - g[low] > rise) rise = g[i] - g[low], palm = i;
   }
-  if (rise <= palm_rise) return w;
-  return static_cast<size_t>(std::min_element(g.begin() + static_cast<std::ptrdiff_t>(from),
-                                              g.begin() + static_cast<std::ptrdiff_t>(palm)) -
-                             g.begin());
+  if (rise > palm_rise)
+    w = static_cast<size_t>(std::min_element(g.begin() + static_cast<std::ptrdiff_t>(from),
+                                             g.begin() + static_cast<std::ptrdiff_t>(palm)) -
+                            g.begin());
+  // A heavy forearm narrows twice above the hand, 25-30 mm apart and within 1-2 mm
+  // of each other: the narrowest flipped between them with the skin's noise
+  // (female_heavy), and the forearm's axis, fitted down to it, with it, moving the
+  // elbow up to 17 mm. A second narrow nearer the hand, past a rise of more than
+  // kSecondNarrowMm and within that of the first, before the palm, is the wrist.
+  size_t second = w;
+  bool rose = false;
+  for (size_t k = w + 1; k + 3 < n && g[k] - g[w] <= palm_rise; ++k) {
+    rose = rose || g[k] - g[w] > kSecondNarrowMm;
+    if (rose && g[k] - g[w] <= kSecondNarrowMm && (second == w || g[k] < g[second])) second = k;
+  }
+  return second;
 }
 
 std::optional<Girth> bridged_part(const Ring& ring, double xc, int side) {

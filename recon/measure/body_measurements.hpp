@@ -94,7 +94,10 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
 // scan can fuse the fingers, so that the arm's track runs on past the palm into
 // them, and they are narrower than the wrist. Where the cuts widen by more than
 // `palm_rise` over the narrowest above them (the palm), the wrist is the narrowest
-// above that rise. measure_body passes 0.6 % of the stature.
+// above that rise. Where the forearm narrows a second time nearer the hand, past a
+// rise of more than 2 mm and to within 2 mm of the narrowest (a heavy forearm, and
+// the narrowest flips between the two with a scan's noise), that second narrow.
+// measure_body passes 0.6 % of the stature.
 size_t wrist_cut(const std::vector<double>& girths, double palm_rise);
 
 // The centre of a dip in a profile v sampled over x (x monotonic), around its lowest

@@ -283,8 +283,22 @@ TEST(BodyMeasurements, TheWristIsAboveThePalmWhenAScanFusesTheFingers) {
   // even below a bump.
   std::vector<double> wobbly = parted;
   wobbly[50] += 6;
-  wobbly[58] = 268;
+  wobbly[58] = 266;
   EXPECT_EQ(wrist_cut(wobbly, 10), 58u);
+  // A heavy forearm narrows twice, 27 mm apart (female_heavy's, under smooth skin
+  // noise): a bump of 4-5 mm between, the second narrow within 2 mm of the first.
+  // Whichever of the two is narrower, the wrist is the second, nearer the hand.
+  for (double first : {259.0, 261.0, 262.0}) {
+    std::vector<double> twice;
+    for (int i = 0; i <= 60; ++i) twice.push_back(330 - (330 - first) * i / 60.0);
+    for (double v : {264.0, 265.0, 266.0, 266.0, 265.0, 263.0, 262.0, 261.0, 261.5, 265.0, 270.0, 276.0, 280.0})
+      twice.push_back(v);
+    EXPECT_EQ(wrist_cut(twice, 10), 68u) << first;
+    // A second narrow 3 mm wider than the first is not the wrist.
+    std::vector<double> wider = twice;
+    for (size_t i = 61; i < wider.size(); ++i) wider[i] = std::max(wider[i], first + 3);
+    EXPECT_EQ(wrist_cut(wider, 10), 60u) << first;
+  }
   EXPECT_EQ(wrist_cut(std::vector<double>{300, 290, 280}, 10), 0u);  // too short to follow
 }
 
