@@ -65,6 +65,9 @@ constexpr double kShallowFoldMm = 10;
 // The least bend (radians) between upper arm and forearm at which the elbow is
 // where their axes meet (measure_arm).
 constexpr double kMinElbowBend = 10 * M_PI / 180;
+// Knees whose levels lie within this (mm) of each other are level: the mid-thigh
+// takes their mean (measure_leg).
+constexpr double kLevelKneesMm = 10;
 // A second narrowing of the forearm's cuts nearer the hand, past a rise of more
 // than this (mm) and within this of the narrowest, is the wrist (wrist_cut).
 constexpr double kSecondNarrowMm = 2;
@@ -339,6 +342,7 @@ class Finder {
     find_torso_levels();
     measure_heights();
     measure_torso();
+    for (int s : {1, -1}) knee_[s > 0 ? 0 : 1] = find_knee(s);
     for (int s : {1, -1}) measure_leg(s);
     for (int s : {1, -1}) measure_arm(s);
     measure_lengths();
@@ -948,6 +952,46 @@ class Finder {
     return g;
   }
 
+  // The knee's level and the leg's centre there: the narrowest cut of the leg between
+  // calf and thigh (the joint narrows it; 18-36 % of the height), the deepest local
+  // minimum if there are several. Nothing when the leg is not followed there.
+  struct Knee {
+    double y = 0;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  };
+  std::optional<Knee> find_knee(int s) {
+    std::vector<double> ys, gs;
+    std::vector<Eigen::Vector3d> cs;
+    prefetch(at(0.18), at(0.36), 2);
+    for (double y = at(0.18); y <= at(0.36); y += 2) {
+      const std::vector<Ring>& r = rings(y);
+      if (const Ring* l = leg(r, s)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
+    }
+    if (gs.size() < 10) return std::nullopt;
+    size_t kk = 0;
+    double deepest = kInf;
+    for (size_t i = 0; i < gs.size(); ++i) {
+      // A local minimum over +-10 mm.
+      bool minimum = true;
+      for (size_t j = i >= 5 ? i - 5 : 0; j < std::min(gs.size(), i + 6); ++j) minimum = minimum && gs[j] >= gs[i];
+      if (minimum && i > 0 && i + 1 < gs.size() && gs[i] < deepest) deepest = gs[i], kk = i;
+    }
+    if (!(deepest < kInf)) kk = arg_extreme(gs, false);
+    // The knee's profile is shallow: its lowest sample wanders with the scan's noise
+    // (8-10 mm between two scans of one body). The vertex of a parabola fitted over
+    // 2 % of the height either side does not.
+    double ky = ys[kk];
+    Eigen::Vector3d kc = cs[kk];
+    if (const std::optional<double> v = parabola_vertex(ys, gs, kk, 0.02 * h_, true)) {
+      ky = *v;
+      size_t near = kk;
+      for (size_t i = 0; i < ys.size(); ++i)
+        if (std::abs(ys[i] - ky) < std::abs(ys[near] - ky)) near = i;
+      kc = cs[near];
+    }
+    return Knee{ky, kc};
+  }
+
   void measure_leg(int s) {
     const std::string sd = side(s);
     auto extreme = [&](double y0, double y1, bool largest, double* y_at, bool bridged = false) {
@@ -982,41 +1026,13 @@ class Finder {
     girth("thigh_girth_" + sd, "Thigh girth (" + sd + ")", "5.3.20", tb ? StatusOr<Girth>(*tb) : level_girth(ty, tc),
           {"crotch"},
           "horizontal, the largest from 1.5 % of the height below the crotch down");
-    // Knee: the narrowest cut of the leg between calf and thigh (the joint narrows
-    // it; 18-36 % of the height), the deepest local minimum if there are several;
-    // calf: the largest cut below it.
-    std::vector<double> ys, gs;
-    std::vector<Eigen::Vector3d> cs;
-    prefetch(at(0.18), at(0.36), 2);
-    for (double y = at(0.18); y <= at(0.36); y += 2) {
-      const std::vector<Ring>& r = rings(y);
-      if (const Ring* l = leg(r, s)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
-    }
-    if (gs.size() < 10) {
+    const std::optional<Knee>& knee = knee_[s > 0 ? 0 : 1];
+    if (!knee) {
       skip("knee_girth_" + sd, "no " + sd + " leg at knee height");
       return;
     }
-    size_t kk = 0;
-    double deepest = kInf;
-    for (size_t i = 0; i < gs.size(); ++i) {
-      // A local minimum over +-10 mm.
-      bool minimum = true;
-      for (size_t j = i >= 5 ? i - 5 : 0; j < std::min(gs.size(), i + 6); ++j) minimum = minimum && gs[j] >= gs[i];
-      if (minimum && i > 0 && i + 1 < gs.size() && gs[i] < deepest) deepest = gs[i], kk = i;
-    }
-    if (!(deepest < kInf)) kk = arg_extreme(gs, false);
-    // The knee's profile is shallow: its lowest sample wanders with the scan's noise
-    // (8-10 mm between two scans of one body). The vertex of a parabola fitted over
-    // 2 % of the height either side does not.
-    double ky = ys[kk];
-    Eigen::Vector3d kc = cs[kk];
-    if (const std::optional<double> v = parabola_vertex(ys, gs, kk, 0.02 * h_, true)) {
-      ky = *v;
-      size_t near = kk;
-      for (size_t i = 0; i < ys.size(); ++i)
-        if (std::abs(ys[i] - ky) < std::abs(ys[near] - ky)) near = i;
-      kc = cs[near];
-    }
+    const double ky = knee->y;
+    const Eigen::Vector3d kc = knee->centre;
     double cy = at(0.2);
     const Eigen::Vector3d cc = extreme(at(0.10), ky, true, &cy);
     {
@@ -1028,12 +1044,22 @@ class Finder {
            "knee level above the floor");
     girth("knee_girth_" + sd, "Knee girth (" + sd + ")", "5.3.22", level_girth(ky, kc), {"knee_" + sd},
           "horizontal, the narrowest cut of the leg between calf and thigh (18-36 % of the height)");
-    const double my = 0.5 * (crotch_y_ + ky);
+    // Mid-thigh: halfway between the crotch and the knees' level. Standing, the knees
+    // are level; each knee's own level moves 1-2.5 mm RMS with the skin's noise (a
+    // shallow profile's bottom), the two independently (tiered male_average, two
+    // scans: +1.67 and -1.77 mm), so both knees' mean is taken where they lie within
+    // kLevelKneesMm of each other, and the leg's own where they do not.
+    const std::optional<Knee>& other = knee_[s > 0 ? 1 : 0];
+    const bool level_knees = other && std::abs(other->y - ky) <= kLevelKneesMm;
+    const double my = 0.5 * (crotch_y_ + (level_knees ? 0.5 * (ky + other->y) : ky));
     const std::vector<Ring>& mr = rings(my);
     const Ring* ml = leg(mr, s);
+    std::vector<std::string> mid_landmarks = {"crotch", "knee_" + sd};
+    if (level_knees) mid_landmarks.push_back("knee_" + side(-s));
     girth("mid_thigh_girth_" + sd, "Mid-thigh girth (" + sd + ")", "5.3.21",
-          ml ? level_girth(my, ml->centroid) : StatusOr<Girth>(not_found("no leg at mid-thigh")), {"crotch", "knee_" + sd},
-          "horizontal, halfway between crotch and kneecap");
+          ml ? level_girth(my, ml->centroid) : StatusOr<Girth>(not_found("no leg at mid-thigh")), mid_landmarks,
+          level_knees ? "horizontal, halfway between crotch and the knees' mean level"
+                      : "horizontal, halfway between crotch and kneecap");
     girth("calf_girth_" + sd, "Calf girth (" + sd + ")", "5.3.24", level_girth(cy, cc), {"knee_" + sd},
           "horizontal, the largest between ankle and knee");
     double ay = at(0.06);
@@ -1248,6 +1274,7 @@ class Finder {
   Eigen::Vector3d top_ = Eigen::Vector3d::Zero(), neck_c_ = Eigen::Vector3d::Zero();
   double floor_ = 0, h_ = 0, xc_ = 0, zc_ = 0;
   double vault_y_[2] = {0, 0};  // where each armpit's join is kJoinDepth deep (the chest is cut below)
+  std::optional<Knee> knee_[2];  // left, right
   double crotch_y_ = 0, armpit_y_[2] = {0, 0}, neck_y_ = 0, neck_r_ = 0, neck_tilt_ = 0;
   double arm_apart_y_[2] = {0, 0};  // where each arm's own loop ends (the armpit below a filled bridge)
   double bust_y_ = 0, underbust_y_ = 0, waist_y_ = 0, hip_y_ = 0;

@@ -492,6 +492,54 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
   }
 }
 
+TEST(BodyMeasurements, TheMidThighIsHalfwayToTheKneesMeanLevelWhereTheKneesAreLevel) {
+  // Each knee's level is a shallow profile's bottom and moves 1-2.5 mm RMS with a
+  // scan's noise, the two knees independently (tiered male_average, two scans: +1.67
+  // and -1.77 mm), and the mid-thigh's tape, halfway to it, 0.6-1.1 mm per mm of
+  // height with it. Standing, the knees are level: the mean of both is the level.
+  const ShippedBody* shipped = shipped_body("male_average.ply");
+  ASSERT_TRUE(shipped);
+  auto level = [](const BodyMeasurements& b, const std::string& side) {
+    const BodyMeasurement* m = b.find("mid_thigh_girth_" + side);
+    return m && m->plane ? m->plane->point.y() : std::nan("");
+  };
+  auto knee = [](const BodyMeasurements& b, const std::string& side) {
+    return b.landmark("knee_" + side)->position.y();
+  };
+  auto uses = [](const BodyMeasurements& b, const std::string& side, const std::string& lmk) {
+    const std::vector<std::string>& l = b.find("mid_thigh_girth_" + side)->landmarks;
+    return std::find(l.begin(), l.end(), lmk) != l.end();
+  };
+  const BodyMeasurements& clean = shipped->measured;
+  const double crotch = clean.landmark("crotch")->position.y();
+  for (const char* side : {"left", "right"}) {
+    EXPECT_NEAR(level(clean, side), 0.5 * (crotch + 0.5 * (knee(clean, "left") + knee(clean, "right"))), 1e-6) << side;
+    EXPECT_TRUE(uses(clean, side, "knee_left") && uses(clean, side, "knee_right")) << side;
+  }
+  // Under smooth skin noise the level moves by half the crotch's move and half the
+  // knees' mean move: never more than the crotch and either knee would move it.
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    auto b = measure_body(with_smooth_skin_noise(shipped->mesh, 0.25, seed));
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    const double c = b->landmark("crotch")->position.y();
+    for (const char* side : {"left", "right"})
+      EXPECT_NEAR(level(*b, side), 0.5 * (c + 0.5 * (knee(*b, "left") + knee(*b, "right"))), 1e-6) << side << seed;
+  }
+  // One leg's lower half squeezed up (a knee bent, or a foot on a step): its knee
+  // rises 10 mm and more above the other, and each leg then keeps its own knee.
+  TriangleMesh bent = shipped->mesh;
+  const double x_mid = clean.landmark("crotch")->position.x(), top = crotch - 100;
+  for (Vec3f& v : bent.vertices)
+    if (v.x() > x_mid + 20 && v.y() < top) v.y() = static_cast<float>(top - (top - v.y()) * 0.93);
+  auto b = measure_body(bent);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  ASSERT_GT(knee(*b, "left") - knee(*b, "right"), 10);
+  for (const char* side : {"left", "right"}) {
+    EXPECT_NEAR(level(*b, side), 0.5 * (b->landmark("crotch")->position.y() + knee(*b, side)), 1e-6) << side;
+    EXPECT_FALSE(uses(*b, side, std::string("knee_") + (std::string(side) == "left" ? "right" : "left"))) << side;
+  }
+}
+
 TEST(BodyMeasurements, TheThighsTapeIsWhereTheCrotchDoesNotPullIt) {
   // Right under the crotch a thigh's tape grows 1.5-2 mm per mm of height, and a
   // scan closes the gap between thighs that nearly touch a few mm early (the
