@@ -65,6 +65,9 @@ constexpr double kShallowFoldMm = 10;
 // The least bend (radians) between upper arm and forearm at which the elbow is
 // where their axes meet (measure_arm).
 constexpr double kMinElbowBend = 10 * M_PI / 180;
+// The shoulder's corner: the fit's weights reach zero this far either side of its
+// vertex, as a fraction of the stature (find_shoulder).
+constexpr double kCornerHalf = 0.04;
 // Knees whose levels lie within this (mm) of each other are level: the mid-thigh
 // takes their mean (measure_leg).
 constexpr double kLevelKneesMm = 10;
@@ -120,9 +123,13 @@ double bisect(double lo, double hi, const std::function<bool(double)>& pred, dou
 // parabola least-squares fitted to their heights, or to the middle of their span
 // where the fit does not open downwards or its vertex falls outside. The highest
 // point alone slides from end to end of a flat side (a neck's, the top of a
-// shoulder) with the scan's noise; so, less, does the span's middle.
+// shoulder) with the scan's noise; so, less, does the span's middle. With
+// `between`, the point at that middle itself, interpolated between the nearest
+// points either side of it along `across` (for points on one arch, such as a
+// section's top): a mesh's section has a point every few mm (5-10 on the true
+// bodies), and the nearest one jumps from one to the next.
 Eigen::Vector3d middle_of_extreme(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& dir,
-                                  const Eigen::Vector3d& across, double band) {
+                                  const Eigen::Vector3d& across, double band, bool between = false) {
   double top = -kInf;
   for (const Eigen::Vector3d& p : pts) top = std::max(top, p.dot(dir));
   double lo = kInf, hi = -kInf;
@@ -140,8 +147,19 @@ Eigen::Vector3d middle_of_extreme(const std::vector<Eigen::Vector3d>& pts, const
   if (c.x() < 0 && -c.y() / (2 * c.x()) > lo && -c.y() / (2 * c.x()) < hi) mid = -c.y() / (2 * c.x());
   Eigen::Vector3d best = pts.front();
   double best_d = kInf;
-  for (const Eigen::Vector3d& p : pts)
-    if (p.dot(dir) >= top - band && std::abs(p.dot(across) - mid) < best_d) best_d = std::abs(p.dot(across) - mid), best = p;
+  const Eigen::Vector3d* below = nullptr;  // the nearest points either side of the middle
+  const Eigen::Vector3d* above = nullptr;
+  for (const Eigen::Vector3d& p : pts) {
+    if (p.dot(dir) < top - band) continue;
+    const double t = p.dot(across);
+    if (std::abs(t - mid) < best_d) best_d = std::abs(t - mid), best = p;
+    if (t <= mid && (!below || t > below->dot(across))) below = &p;
+    if (t >= mid && (!above || t < above->dot(across))) above = &p;
+  }
+  if (between && below && above && above->dot(across) > below->dot(across)) {
+    const double f = (mid - below->dot(across)) / (above->dot(across) - below->dot(across));
+    return *below + f * (*above - *below);
+  }
   return best;
 }
 
@@ -248,6 +266,40 @@ std::optional<double> parabola_vertex(const std::vector<double>& x, const std::v
   return x[k] + t;
 }
 
+// The vertex of a parabola fitted with weights that fall smoothly to zero `half`
+// either side of the vertex itself: start at x[k], fit, move the window's centre to
+// the vertex, and repeat until it stays (a local quadratic fit whose slope is zero
+// at its own centre). parabola_vertex's window is centred on the extreme sample,
+// which jumps with the skin's noise, and samples enter and leave it whole; this
+// vertex moves smoothly with the profile. Nothing when a fit has fewer than 7
+// samples, opens the other way, or leaves the samples' range.
+std::optional<double> settled_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
+                                     bool lowest) {
+  double c = x[k];
+  for (int it = 0; it < 30; ++it) {
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+      const double t = x[i] - c, u = t / half;
+      if (std::abs(u) >= 1) continue;
+      const double w = (1 - u * u) * (1 - u * u);
+      const Eigen::Vector3d row(t * t, t, 1);
+      ata += w * row * row.transpose();
+      atb += w * row * v[i];
+      ++n;
+    }
+    if (n < 7) return std::nullopt;
+    const Eigen::Vector3d q = ata.ldlt().solve(atb);
+    if (!((lowest ? q(0) : -q(0)) > 1e-9)) return std::nullopt;
+    const double step = std::clamp(-q(1) / (2 * q(0)), -0.5 * half, 0.5 * half);
+    c += step;
+    if (!(c >= std::min(x.front(), x.back()) && c <= std::max(x.front(), x.back()))) return std::nullopt;
+    if (std::abs(step) < 1e-3) break;
+  }
+  return c;
+}
+
 size_t arg_extreme(const std::vector<double>& v, bool largest) {
   return static_cast<size_t>((largest ? std::max_element(v.begin(), v.end()) : std::min_element(v.begin(), v.end())) -
                              v.begin());
@@ -281,7 +333,8 @@ Notch deepest_behind_chord(const std::vector<Eigen::Vector2d>& c, double half) {
 // `v_end`: the sample farthest from the chord from the first sample to where v
 // reaches v_end (interpolated between the last two: the last sample jumps with the
 // walk's step, and the chord's end with it), refined to the vertex of a parabola
-// fitted to that distance over `half` of x either side. Only samples on the
+// fitted to that distance with weights reaching zero `half` of x either side of the
+// vertex (settled_vertex). Only samples on the
 // chord's left (above an outline) count. Returns the sample and the refined x; the
 // sample is 0 where nothing lies on that side.
 std::pair<size_t, double> refined_corner(const std::vector<double>& x, const std::vector<double>& v, double v_end,
@@ -296,7 +349,7 @@ std::pair<size_t, double> refined_corner(const std::vector<double>& x, const std
   std::vector<double> dist;
   for (size_t i = 0; i < n; ++i) dist.push_back(d.x() * (v[i] - a.y()) - d.y() * (x[i] - a.x()));
   const size_t k = arg_extreme(dist, true);
-  return {k, parabola_vertex(x, dist, k, half, false).value_or(x[k])};
+  return {k, settled_vertex(x, dist, k, half, false).value_or(x[k])};
 }
 
 // Whether a loop in the plane with normal n winds round p (the loop is the limb's
@@ -638,21 +691,29 @@ class Finder {
     if (us.size() < 4) return not_found("measure: no " + side(s) + " shoulder outline");
     // The shoulder's corner bulges above the chord from the neck to where the outline
     // is well down the arm (that end interpolated between columns), refined to the
-    // vertex of a parabola fitted to the height above the chord over 2 % of the
-    // height either side: the outline is a smooth curve there, and its highest
-    // sample above the chord moved 6-10 mm under +-0.5 mm of skin noise. Over 1 %
-    // the vertex still moved 9.5 mm under skin noise (male_average, one seed of
-    // five) and 4-8 mm between two scans of one body on the thesis rig.
-    const auto [k, u] = refined_corner(us, tops, y_arm, 0.02 * h_);
+    // vertex of a parabola fitted to the height above the chord: the outline is a
+    // smooth curve there, and its highest sample above the chord moved 6-10 mm under
+    // +-0.5 mm of skin noise. Over 1 % of the height either side the vertex still
+    // moved 9.5 mm under skin noise (male_average, one seed of five) and 4-8 mm
+    // between two scans of one body on the thesis rig; over 2 %, centred on the
+    // highest sample, 0.6-1.4 mm RMS across the body under smooth skin noise of
+    // 0.25 mm. Since session 25 the fit's weights fall smoothly to zero kCornerHalf
+    // of the height either side of its own vertex (settled_vertex): 0.4-0.7 mm RMS,
+    // and the biacromial breadth 0.4-0.8 mm RMS on six bodies (was 0.6-2.0). That
+    // vertex lies 3-5 mm nearer the neck than the narrower fit's (biacromial breadth
+    // 6-10 mm smaller), 17-34 mm outside the MakeHuman shoulder joint's centre.
+    const auto [k, u] = refined_corner(us, tops, y_arm, kCornerHalf * h_);
     if (k == 0) {
       landmark("shoulder_point_" + side(s), snp);
       return Status();
     }
-    // The top of the shoulder runs front to back: its middle there.
+    // The top of the shoulder runs front to back: its middle there, between the
+    // section's points (the nearest of them moved the point 1.1-2.7 mm RMS front to
+    // back under smooth skin noise, on a mesh with a point every 5-10 mm; now 0.3-0.8).
     const std::vector<std::vector<Eigen::Vector3d>> at_u = sections([&](size_t) { return u; }, 1);
     landmark("shoulder_point_" + side(s),
              middle_of_extreme(at_u[0].empty() ? column[std::min(nb - 1, static_cast<size_t>((us[k] - u0) / bin))] : at_u[0],
-                               Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), kRidgeBand));
+                               Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), kRidgeBand, true));
     return Status();
   }
 
