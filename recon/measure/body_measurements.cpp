@@ -68,6 +68,9 @@ constexpr double kMinElbowBend = 10 * M_PI / 180;
 // The shoulder's corner: the fit's weights reach zero this far either side of its
 // vertex, as a fraction of the stature (find_shoulder).
 constexpr double kCornerHalf = 0.04;
+// The wrist's level along the forearm: the fit's weights reach zero this far either
+// side of its vertex, as a fraction of the stature (24 mm on male_average).
+constexpr double kWristHalf = 0.014;
 // Knees whose levels lie within this (mm) of each other are level: the mid-thigh
 // takes their mean (measure_leg).
 constexpr double kLevelKneesMm = 10;
@@ -1222,8 +1225,16 @@ class Finder {
         // the cuts within 1 mm of it) 4-5 mm along the arm between two scans of one
         // body, and the outer arm length with it. Halfway between where the tape
         // has grown by 3 mm either side, on the hand's steep rise and the forearm's
-        // slope, it moves about half as far.
-        std::optional<double> t = flat_bottom_middle(ts, gs, arg_extreme(gs, false), kFlatRiseMm);
+        // slope, it moved about half as far; but the forearm's side rises only
+        // 0.25-0.4 mm per mm, and there a quarter of a millimetre of smooth skin
+        // noise moved the crossing a few mm (outer arm length 1.2-3.1 mm RMS over
+        // six bodies). Since session 25 it is the vertex of a parabola whose weights
+        // fall to zero kWristHalf of the height either side of the vertex itself
+        // (settled_vertex: 0.5-2.6 mm RMS); the middle of the flat minimum where
+        // that fit fails.
+        const size_t low = arg_extreme(gs, false);
+        std::optional<double> t = settled_vertex(ts, gs, low, kWristHalf * h_, true);
+        if (!t) t = flat_bottom_middle(ts, gs, low, kFlatRiseMm);
         if (t) {
           const Eigen::Vector3d p = wrist_c + *t * fd;
           StatusOr<Girth> mid = mesh_girth(mesh_, Plane{p, fd}, p, &wt);

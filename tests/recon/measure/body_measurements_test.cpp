@@ -492,14 +492,18 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
   }
 }
 
-TEST(BodyMeasurements, TheShoulderPointsStayPutUnderSmoothSkinNoise) {
+TEST(BodyMeasurements, TheShoulderPointsTheWristsAndTheOuterArmStayPutUnderSmoothSkinNoise) {
   // The shoulder's corner was the vertex of a parabola fitted over 2 % of the height
   // either side of the outline's highest sample above the chord, which jumps with the
   // noise, and its point front to back the section's point nearest the top's middle,
   // a point every 5-10 mm on these meshes: under eight smooth fields of 0.25 mm RMS
   // the shoulder points moved up to 3.4 mm (male_average) and 3.05 (female_average),
   // the biacromial breadth 2.6. Now the fit's weights fall smoothly to zero round its
-  // own vertex, and the point is interpolated between the section's points.
+  // own vertex, and the point is interpolated between the section's points. The
+  // wrist's level along the forearm was halfway between where the tape had grown
+  // 3 mm either side, and the forearm's side rises gently: male_average's wrist
+  // points moved up to 2.6 mm and its outer arm lengths 3.6; the wrist is now a
+  // smoothly weighted vertex too.
   for (const char* body : {"male_average", "female_average"}) {
     const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
     ASSERT_TRUE(shipped) << body;
@@ -512,6 +516,12 @@ TEST(BodyMeasurements, TheShoulderPointsStayPutUnderSmoothSkinNoise) {
             << body << " " << name << ", seed " << seed;
       EXPECT_NEAR(b->find("biacromial_breadth")->value_mm, clean.find("biacromial_breadth")->value_mm, 1.6)
           << body << ", seed " << seed;
+      for (const char* side : {"left", "right"}) {
+        const std::string wrist = std::string("wrist_point_") + side, arm = std::string("outer_arm_length_") + side;
+        EXPECT_LT((b->landmark(wrist)->position - clean.landmark(wrist)->position).norm(), 2.0)
+            << body << " " << wrist << ", seed " << seed;
+        EXPECT_NEAR(b->find(arm)->value_mm, clean.find(arm)->value_mm, 2.8) << body << " " << arm << ", seed " << seed;
+      }
     }
   }
 }
