@@ -492,7 +492,7 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
   }
 }
 
-TEST(BodyMeasurements, TheShoulderPointsTheWristsAndTheOuterArmStayPutUnderSmoothSkinNoise) {
+TEST(BodyMeasurements, TheShouldersTheWristsTheOuterArmsAndTheHipStayPutUnderSmoothSkinNoise) {
   // The shoulder's corner was the vertex of a parabola fitted over 2 % of the height
   // either side of the outline's highest sample above the chord, which jumps with the
   // noise, and its point front to back the section's point nearest the top's middle,
@@ -503,11 +503,14 @@ TEST(BodyMeasurements, TheShoulderPointsTheWristsAndTheOuterArmStayPutUnderSmoot
   // wrist's level along the forearm was halfway between where the tape had grown
   // 3 mm either side, and the forearm's side rises gently: male_average's wrist
   // points moved up to 2.6 mm and its outer arm lengths 3.6; the wrist is now a
-  // smoothly weighted vertex too.
+  // smoothly weighted vertex too, and so is the hip's level, which moved up to 2.0
+  // mm (female_average) and 1.35 (male_average) as a parabola's vertex over 2 % of
+  // the height either side of the backmost sample.
   for (const char* body : {"male_average", "female_average"}) {
     const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
     ASSERT_TRUE(shipped) << body;
     const BodyMeasurements& clean = shipped->measured;
+    const bool male = std::string(body) == "male_average";
     for (uint64_t seed = 1; seed <= 8; ++seed) {
       auto b = measure_body(with_smooth_skin_noise(shipped->mesh, 0.25, seed));
       ASSERT_TRUE(b.ok()) << b.status().message();
@@ -522,6 +525,8 @@ TEST(BodyMeasurements, TheShoulderPointsTheWristsAndTheOuterArmStayPutUnderSmoot
             << body << " " << wrist << ", seed " << seed;
         EXPECT_NEAR(b->find(arm)->value_mm, clean.find(arm)->value_mm, 2.8) << body << " " << arm << ", seed " << seed;
       }
+      EXPECT_NEAR(b->find("hip_height")->value_mm, clean.find("hip_height")->value_mm, male ? 1.2 : 1.6)
+          << body << ", seed " << seed;
     }
   }
 }
