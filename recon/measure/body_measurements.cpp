@@ -848,7 +848,7 @@ class Finder {
     // either side, as at the knee, until session 25; now the vertex of a parabola
     // whose weights fall to zero kHipHalf of the height either side of itself: under
     // smooth skin noise of 0.25 mm the hip height moved 0.7-1.6 mm RMS over six
-    // bodies, now 0.5-1.05, and the hip girth 0.7-1.1, now 0.5-0.9.
+    // bodies, now 0.5-1.05, and the hip girth 0.7-1.1, now 0.5-1.0.
     hip_y_ = profile(crotch_y_ + 0.01 * h_, crotch_y_ + 0.16 * h_, [](const Ring& m) { return m.z_min; }, false, 0.5,
                      crotch_y_ + 0.08 * h_, kHipHalf * h_, true);
     Eigen::Vector3d hip_point(xc_, hip_y_, zc_);
