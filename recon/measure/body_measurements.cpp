@@ -272,40 +272,6 @@ std::optional<double> parabola_vertex(const std::vector<double>& x, const std::v
   return x[k] + t;
 }
 
-// The vertex of a parabola fitted with weights that fall smoothly to zero `half`
-// either side of the vertex itself: start at x[k], fit, move the window's centre to
-// the vertex, and repeat until it stays (a local quadratic fit whose slope is zero
-// at its own centre). parabola_vertex's window is centred on the extreme sample,
-// which jumps with the skin's noise, and samples enter and leave it whole; this
-// vertex moves smoothly with the profile. Nothing when a fit has fewer than 7
-// samples, opens the other way, or leaves the samples' range.
-std::optional<double> settled_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
-                                     bool lowest) {
-  double c = x[k];
-  for (int it = 0; it < 30; ++it) {
-    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-    int n = 0;
-    for (size_t i = 0; i < x.size(); ++i) {
-      const double t = x[i] - c, u = t / half;
-      if (std::abs(u) >= 1) continue;
-      const double w = (1 - u * u) * (1 - u * u);
-      const Eigen::Vector3d row(t * t, t, 1);
-      ata += w * row * row.transpose();
-      atb += w * row * v[i];
-      ++n;
-    }
-    if (n < 7) return std::nullopt;
-    const Eigen::Vector3d q = ata.ldlt().solve(atb);
-    if (!((lowest ? q(0) : -q(0)) > 1e-9)) return std::nullopt;
-    const double step = std::clamp(-q(1) / (2 * q(0)), -0.5 * half, 0.5 * half);
-    c += step;
-    if (!(c >= std::min(x.front(), x.back()) && c <= std::max(x.front(), x.back()))) return std::nullopt;
-    if (std::abs(step) < 1e-3) break;
-  }
-  return c;
-}
-
 size_t arg_extreme(const std::vector<double>& v, bool largest) {
   return static_cast<size_t>((largest ? std::max_element(v.begin(), v.end()) : std::min_element(v.begin(), v.end())) -
                              v.begin());
@@ -1383,6 +1349,33 @@ double minimum_centroid(const std::vector<double>& x, const std::vector<double>&
     moment += dx / 6 * (2 * x0 * f0 + x0 * f1 + x1 * f0 + 2 * x1 * f1);
   }
   return area != 0 ? moment / area : x[k];
+}
+
+std::optional<double> settled_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
+                                     bool lowest) {
+  double c = x[k];
+  for (int it = 0; it < 30; ++it) {
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+      const double t = x[i] - c, u = t / half;
+      if (std::abs(u) >= 1) continue;
+      const double w = (1 - u * u) * (1 - u * u);
+      const Eigen::Vector3d row(t * t, t, 1);
+      ata += w * row * row.transpose();
+      atb += w * row * v[i];
+      ++n;
+    }
+    if (n < 7) return std::nullopt;
+    const Eigen::Vector3d q = ata.ldlt().solve(atb);
+    if (!((lowest ? q(0) : -q(0)) > 1e-9)) return std::nullopt;
+    const double step = std::clamp(-q(1) / (2 * q(0)), -0.5 * half, 0.5 * half);
+    c += step;
+    if (!(c >= std::min(x.front(), x.back()) && c <= std::max(x.front(), x.back()))) return std::nullopt;
+    if (std::abs(step) < 1e-3) break;
+  }
+  return c;
 }
 
 size_t wrist_cut(const std::vector<double>& g, double palm_rise) {

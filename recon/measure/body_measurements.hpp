@@ -109,6 +109,18 @@ size_t wrist_cut(const std::vector<double>& girths, double palm_rise);
 // level (measure_body).
 double minimum_centroid(const std::vector<double>& x, const std::vector<double>& v, size_t k, double depth);
 
+// Where a shallow, noisy profile v sampled over x (x monotonic) bottoms out
+// (`lowest`) or tops out, starting from its extreme sample k: the vertex of a
+// parabola fitted with weights that fall smoothly to zero `half` either side of the
+// vertex itself (a biweight), found by moving the window's centre to the vertex
+// until it stays. A window centred on the extreme sample moves with that sample,
+// which jumps with a scan's noise, and samples enter and leave it whole; this
+// vertex moves smoothly with the profile. Nothing when a fit has fewer than 7
+// samples, opens the other way, or leaves the samples' range. The shoulder's
+// corner, the wrist along the forearm and the hip's level (measure_body).
+std::optional<double> settled_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
+                                     bool lowest);
+
 // One leg's tape in a horizontal cut where hole filling has bridged the gap between
 // the thighs (`ring` spans the midline X = xc and crosses it on invented surface
 // only, mesh confidence under 0.5 front and back): round the measured skin

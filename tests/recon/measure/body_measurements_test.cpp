@@ -450,6 +450,63 @@ TEST(BodyMeasurements, TheCentreOfADipMovesWithTheProfile) {
   EXPECT_NEAR(minimum_centroid(x, falling, x.size() - 1, 2.4), 60 - 12 / 3.0, 1e-9);
 }
 
+TEST(BodyMeasurements, TheSettledVertexMovesWithTheProfileNotWithItsSamples) {
+  // A lopsided bottom, steep on one side and gentle on the other (a wrist along the
+  // forearm, a hip's back), sampled every 4 mm and moved in steps of 0.5 mm. A
+  // parabola over a window centred on the lowest sample jumps when that sample does;
+  // the settled vertex follows the profile: each step moves it by the step, within
+  // a tenth of a millimetre, in both directions of sampling.
+  std::vector<double> x;
+  for (double t = 0; t <= 120; t += 4) x.push_back(t);
+  auto profile = [&](double c) {
+    std::vector<double> v;
+    for (double t : x) v.push_back(t < c ? 0.02 * (c - t) * (c - t) : 0.006 * (t - c) * (t - c));
+    return v;
+  };
+  std::optional<double> prev;
+  double jumps = 0;  // the window-centred vertex's largest error on a step
+  std::optional<double> prev_windowed;
+  for (double c = 50; c <= 62; c += 0.5) {
+    const std::vector<double> v = profile(c);
+    const size_t k = static_cast<size_t>(std::min_element(v.begin(), v.end()) - v.begin());
+    const std::optional<double> s = settled_vertex(x, v, k, 40, true);
+    ASSERT_TRUE(s) << c;
+    if (prev) {
+      EXPECT_NEAR(*s - *prev, 0.5, 0.1) << c;
+    }
+    prev = s;
+    // Sampled from the other end: the same vertex.
+    const std::vector<double> rx(x.rbegin(), x.rend()), rv(v.rbegin(), v.rend());
+    const std::optional<double> r = settled_vertex(rx, rv, x.size() - 1 - k, 40, true);
+    ASSERT_TRUE(r) << c;
+    EXPECT_NEAR(*r, *s, 1e-6) << c;
+    // A window of the same reach fixed round the lowest sample: unweighted, least
+    // squares over the samples within 40 mm.
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < x.size(); ++i)
+      if (std::abs(x[i] - x[k]) <= 40) {
+        const Eigen::Vector3d row(x[i] * x[i], x[i], 1);
+        ata += row * row.transpose(), atb += row * v[i];
+      }
+    const Eigen::Vector3d q = ata.ldlt().solve(atb);
+    const double windowed = -q(1) / (2 * q(0));
+    if (prev_windowed) jumps = std::max(jumps, std::abs(windowed - *prev_windowed - 0.5));
+    prev_windowed = windowed;
+  }
+  EXPECT_GT(jumps, 0.5);  // the rule it replaced errs by more than the step
+  // A peak (lowest = false) is found as the bottom of its mirror image.
+  std::vector<double> v = profile(55), neg;
+  for (double d : v) neg.push_back(-d);
+  const size_t k = static_cast<size_t>(std::min_element(v.begin(), v.end()) - v.begin());
+  EXPECT_NEAR(*settled_vertex(x, neg, k, 40, false), *settled_vertex(x, v, k, 40, true), 1e-9);
+  // Too few samples, or a profile with no bottom, give nothing.
+  EXPECT_FALSE(settled_vertex(x, v, k, 10, true));
+  std::vector<double> line;
+  for (double t : x) line.push_back(0.5 * t);
+  EXPECT_FALSE(settled_vertex(x, line, 0, 40, true));
+}
+
 TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNoise) {
   // A scan's surface errs in gentle swells (recon/geometry/skin_noise.hpp): here two
   // fields, at 40 and 10 mm, each 0.25 mm RMS, eight seeds. The elbow's outer point
