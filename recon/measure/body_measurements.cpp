@@ -1149,9 +1149,9 @@ class Finder {
     // The bend's sample c[e] moves in the 3 mm steps of the cuts, and with the
     // armpit's level, where they start; where two lines meet moves with the skin.
     // Under smooth skin noise (measure_benchmark --noise-study) the elbow point moved
-    // 1.7-2.6 mm RMS on the female bodies with c[e], now 0.8-1.2 (female_heavy,
-    // whose fits tilt by 4 degrees with the noise, 3-4 mm either way). An arm nearly
-    // straight has no meeting point to speak of: there c[e] stands.
+    // 1.7-4.1 mm RMS on the female bodies with c[e], now 0.8-1.6 (female_heavy's
+    // with its wrist's cut held, wrist_cut). An arm nearly straight has no meeting
+    // point to speak of: there c[e] stands.
     Eigen::Vector3d elbow_c = on_axis(uc, ud, c[e]);
     if (const double cross = 1 - std::pow(ud.dot(fd), 2); cross > std::pow(std::sin(kMinElbowBend), 2)) {
       const Eigen::Vector3d w0 = uc - fc;
