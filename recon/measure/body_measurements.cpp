@@ -247,25 +247,41 @@ std::optional<double> flat_bottom_middle(const std::vector<double>& x, const std
   return 0.5 * (*lo + *hi);
 }
 
+// The parabola a t^2 + b t + c in t = x - centre least-squares fitted to the samples
+// (x[i], v[i]) within `half` of `centre`: its coefficients (a, b, c), and how many
+// samples it rests on. Each sample weighs 1, or with `biweight` (1 - (t/half)^2)^2,
+// which reaches zero at `half`.
+struct LocalParabola {
+  Eigen::Vector3d coef = Eigen::Vector3d::Zero();
+  int samples = 0;
+};
+LocalParabola local_parabola(const std::vector<double>& x, const std::vector<double>& v, double centre, double half,
+                             bool biweight) {
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  LocalParabola p;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double t = x[i] - centre, u = t / half;
+    if (biweight ? std::abs(u) >= 1 : std::abs(t) > half) continue;
+    const double w = biweight ? (1 - u * u) * (1 - u * u) : 1.0;
+    const Eigen::Vector3d row(t * t, t, 1);
+    ata += w * row * row.transpose();
+    atb += w * row * v[i];
+    ++p.samples;
+  }
+  if (p.samples > 0) p.coef = ata.ldlt().solve(atb);
+  return p;
+}
+
 // The vertex of the parabola least-squares fitted to the samples (x[i], v[i]) within
 // `half` of x[k]: where a shallow, noisy profile bottoms out (`lowest`) or tops out.
 // Nothing when fewer than 7 samples lie there, the fit opens the other way (or is
 // flat), or its vertex falls outside the window.
 std::optional<double> parabola_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k,
                                       double half, bool lowest) {
-  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-  int n = 0;
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double t = x[i] - x[k];
-    if (std::abs(t) > half) continue;
-    const Eigen::Vector3d row(t * t, t, 1);
-    ata += row * row.transpose();
-    atb += row * v[i];
-    ++n;
-  }
-  if (n < 7) return std::nullopt;
-  const Eigen::Vector3d c = ata.ldlt().solve(atb);
+  const LocalParabola p = local_parabola(x, v, x[k], half, false);
+  if (p.samples < 7) return std::nullopt;
+  const Eigen::Vector3d& c = p.coef;
   if (!((lowest ? c(0) : -c(0)) > 1e-9)) return std::nullopt;
   const double t = -c(1) / (2 * c(0));
   if (!(std::abs(t) <= half)) return std::nullopt;
@@ -1355,20 +1371,9 @@ std::optional<double> settled_vertex(const std::vector<double>& x, const std::ve
                                      bool lowest) {
   double c = x[k];
   for (int it = 0; it < 30; ++it) {
-    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-    int n = 0;
-    for (size_t i = 0; i < x.size(); ++i) {
-      const double t = x[i] - c, u = t / half;
-      if (std::abs(u) >= 1) continue;
-      const double w = (1 - u * u) * (1 - u * u);
-      const Eigen::Vector3d row(t * t, t, 1);
-      ata += w * row * row.transpose();
-      atb += w * row * v[i];
-      ++n;
-    }
-    if (n < 7) return std::nullopt;
-    const Eigen::Vector3d q = ata.ldlt().solve(atb);
+    const LocalParabola p = local_parabola(x, v, c, half, true);
+    if (p.samples < 7) return std::nullopt;
+    const Eigen::Vector3d& q = p.coef;
     if (!((lowest ? q(0) : -q(0)) > 1e-9)) return std::nullopt;
     const double step = std::clamp(-q(1) / (2 * q(0)), -0.5 * half, 0.5 * half);
     c += step;
