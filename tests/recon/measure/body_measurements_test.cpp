@@ -549,6 +549,67 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
   }
 }
 
+TEST(BodyMeasurements, TheBustIsReadAtItsFullestOverABreastAndAtItsPointsOnAMansChest) {
+  // Over female_average's breasts the tape grows 2-3 mm per mm of height through the
+  // apex's level and is fullest 6 mm above it; a man's chest (no breast's crease
+  // beneath) rises into the armpits, and there the bust points' level stands.
+  for (const char* body : {"female_average", "male_average"}) {
+    const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
+    ASSERT_TRUE(shipped) << body;
+    const BodyMeasurements& b = shipped->measured;
+    const BodyMeasurement* bust = b.find("bust_girth");
+    ASSERT_TRUE(bust && bust->plane) << body;
+    const double apex = b.landmark("bust_point_left")->position.y(), y = bust->plane->point.y();
+    const double stature = b.find("stature")->value_mm;
+    const BodySlicer slicer(shipped->mesh, apex - 0.02 * stature, apex + 0.02 * stature);
+    const Eigen::Vector3d near(0.5 * (b.landmark("bust_point_left")->position.x() +
+                                      b.landmark("bust_point_right")->position.x()),
+                               apex, b.landmark("bust_point_left")->position.z());
+    auto at_apex = slicer.girth(apex, near);
+    ASSERT_TRUE(at_apex.ok()) << body;
+    if (std::string(body) == "male_average") {
+      EXPECT_NEAR(y, apex, 1e-6) << body;
+      continue;
+    }
+    EXPECT_GT(y, apex + 2) << body;
+    EXPECT_GT(bust->value_mm, at_apex->value_mm + 5) << body;
+    // No level within 1.2 % of the height of the apex reads a fuller tape.
+    double fullest = 0;
+    for (double t = apex - 0.012 * stature; t <= apex + 0.012 * stature; t += 0.25)
+      if (auto g = slicer.girth(t, near); g.ok()) fullest = std::max(fullest, g->value_mm);
+    EXPECT_NEAR(bust->value_mm, fullest, 0.3) << body;
+  }
+}
+
+TEST(BodyMeasurements, TheBustPointsTheBustAndTheUnderBustStayPutUnderSmoothSkinNoise) {
+  // Eight smooth fields of 0.25 mm RMS, as above. female_average's front is flat
+  // across the breast at the apex's level, and its foremost point jumped up to
+  // 23 mm from side to side: the bust points are now the centroid of the front
+  // within 4 mm of the foremost. Its bust girth, at the apex's level where the tape
+  // grows 2-3 mm per mm, moved up to 2.3 mm; at the fullest level, 1.2. The
+  // under-bust's crease was read in one column under each bust point, and moved the
+  // tape up to 1.7 mm; now in seven columns, 0.6.
+  for (const char* body : {"female_average", "male_average"}) {
+    const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
+    ASSERT_TRUE(shipped) << body;
+    const BodyMeasurements& clean = shipped->measured;
+    const bool male = std::string(body) == "male_average";
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+      auto b = measure_body(with_smooth_skin_noise(shipped->mesh, 0.25, seed));
+      ASSERT_TRUE(b.ok()) << b.status().message();
+      for (const char* name : {"bust_point_left", "bust_point_right"})
+        EXPECT_LT((b->landmark(name)->position - clean.landmark(name)->position).norm(), male ? 3.0 : 2.0)
+            << body << " " << name << ", seed " << seed;
+      if (!male) {
+        EXPECT_NEAR(b->find("bust_girth")->value_mm, clean.find("bust_girth")->value_mm, 1.6)
+            << body << ", seed " << seed;
+        EXPECT_NEAR(b->find("underbust_girth")->value_mm, clean.find("underbust_girth")->value_mm, 1.0)
+            << body << ", seed " << seed;
+      }
+    }
+  }
+}
+
 TEST(BodyMeasurements, TheShouldersTheWristsTheOuterArmsAndTheHipStayPutUnderSmoothSkinNoise) {
   // The shoulder's corner was the vertex of a parabola fitted over 2 % of the height
   // either side of the outline's highest sample above the chord, which jumps with the
