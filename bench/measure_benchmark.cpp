@@ -8,7 +8,7 @@
 //   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR | --saved DIR]
 //                     [--resurface] [--seed N] [--min-weight W]
-//   measure_benchmark --noise-study N [--noise-rms MM] --body BODY.ply...
+//   measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body BODY.ply...
 //
 // --save writes each scan's surface, its point cloud and the posed true body as PLY
 // into DIR (with --repeat, the second scan's surface and cloud too). --saved DIR
@@ -21,7 +21,8 @@
 // --noise-study N measures each body's own mesh N times under smooth skin noise
 // (recon/geometry/skin_noise.hpp: fields at 40 and 10 mm, each --noise-rms RMS, default
 // 0.25 mm) and ranks the measurements and landmarks by how far they move: no scan,
-// a few seconds a body.
+// a few seconds a body. --noisy-out DIR also writes each noisy mesh there
+// (noisyN.ply, N the field's seed), to look at one with `bodyscan measure`.
 //
 // Defaults: the thesis rig, its demo body. ISO 20685-1 allows scan-derived values
 // 9 mm off on large girths, 4 mm on small girths and heights, 5 mm on lengths. The
@@ -356,7 +357,7 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
 // measured `n` times. Prints, per measurement, the RMS and the largest difference
 // from the clean body's value, largest first; the rules that move most are those a
 // second scan moves most.
-int noise_study(const std::string& body, int n, double rms_mm) {
+int noise_study(const std::string& body, int n, double rms_mm, const std::string& noisy_out) {
   auto mesh = read_ply_mesh(body);
   if (!mesh.ok()) return std::fprintf(stderr, "%s\n", mesh.status().message().c_str()), 1;
   auto clean = measure_body(*mesh);
@@ -365,6 +366,10 @@ int noise_study(const std::string& body, int n, double rms_mm) {
   std::map<std::string, std::vector<Eigen::Vector3d>> moves;
   for (int s = 1; s <= n; ++s) {
     const TriangleMesh noisy = with_smooth_skin_noise(*mesh, rms_mm, s);
+    if (!noisy_out.empty()) {
+      const std::string path = noisy_out + "/noisy" + std::to_string(s) + ".ply";
+      if (Status w = write_ply(path, noisy); !w.ok()) std::fprintf(stderr, "%s: %s\n", path.c_str(), w.message().c_str());
+    }
     auto m = measure_body(noisy);
     if (!m.ok()) {
       std::printf("seed %d: %s\n", s, m.status().message().c_str());
@@ -411,6 +416,7 @@ int main(int argc, char** argv) {
   double sway = 3;
   int every = 1, noise_fields = 0;
   double noise_rms = 0.25;
+  std::string noisy_out;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
@@ -423,6 +429,7 @@ int main(int argc, char** argv) {
     else if (a == "--resurface") g_resurface = true;
     else if (a == "--noise-study" && i + 1 < argc) noise_fields = std::atoi(argv[++i]);
     else if (a == "--noise-rms" && i + 1 < argc) noise_rms = std::atof(argv[++i]);
+    else if (a == "--noisy-out" && i + 1 < argc) noisy_out = argv[++i];
     else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--min-weight" && i + 1 < argc) g_surface.min_relative_weight = std::strtof(argv[++i], nullptr);
     else if (a == "--fairing" && i + 1 < argc) {
@@ -431,12 +438,12 @@ int main(int argc, char** argv) {
     }
     else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
                         "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W]\n"
-                        "       measure_benchmark --noise-study N [--noise-rms MM] --body B...\n"), 2;
+                        "       measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body B...\n"), 2;
   }
   if (noise_fields > 0) {
     if (bodies.empty()) return std::fprintf(stderr, "measure_benchmark: --noise-study needs --body B.ply\n"), 2;
     int rc = 0;
-    for (const std::string& b : bodies) rc |= noise_study(b, noise_fields, noise_rms);
+    for (const std::string& b : bodies) rc |= noise_study(b, noise_fields, noise_rms, noisy_out);
     return rc;
   }
   if (rigs.empty()) rigs = {"thesis"};

@@ -80,6 +80,11 @@ constexpr double kCornerHalf = 0.04;
 // The wrist's level along the forearm: the fit's weights reach zero this far either
 // side of its vertex, as a fraction of the stature (24 mm on male_average).
 constexpr double kWristHalf = 0.014;
+// The wrist is this fraction of the stature back toward the elbow from where the
+// tape, cut by cut toward the hand, has grown kWristFlareMm (mm) over the forearm's
+// narrowest cut (measure_arm).
+constexpr double kWristBeforeFlare = 0.01;
+constexpr double kWristFlareMm = 7;
 // The hip's level: the fit's weights reach zero this far either side of its vertex,
 // as a fraction of the stature (find_torso_levels).
 constexpr double kHipHalf = 0.04;
@@ -1283,6 +1288,34 @@ class Finder {
         const size_t low = arg_extreme(gs, false);
         std::optional<double> t = settled_vertex(ts, gs, low, kWristHalf * h_, true);
         if (!t) t = flat_bottom_middle(ts, gs, low, kFlatRiseMm);
+        // The hand's side is steep (the tape grows 0.5-1 mm per mm into the palm), and
+        // a level read there stands where a bottom's vertex moves: since session 26
+        // the wrist is kWristBeforeFlare of the height back from where the tape, cut
+        // by cut toward the hand, has grown kWristFlareMm over the narrowest cut
+        // (past the window's end if need be). Under smooth skin noise of 0.25 mm RMS
+        // the vertex left male_muscular's right wrist up to 4.3 mm along the arm
+        // (outer arm length 2.42 mm RMS, largest 5.1); from the hand's flare, 0.75
+        // (largest 1.1). The vertex stands where no flare is reached.
+        {
+          const double hand = (c[w] - c[e]).dot(fd) > 0 ? 1 : -1;
+          const double flare = gs[low] + kWristFlareMm;
+          std::vector<double> ht, hg;  // from the narrowest cut toward the hand
+          for (size_t i = low;; i = hand > 0 ? i + 1 : i - 1) {
+            ht.push_back(ts[i]), hg.push_back(gs[i]);
+            if (hand > 0 ? i + 1 >= ts.size() : i == 0) break;
+          }
+          for (double tt = ht.back() + hand * 4; std::abs(tt) <= 0.055 * h_ && hg.back() < flare; tt += hand * 4) {
+            const Eigen::Vector3d p = wrist_c + tt * fd;
+            StatusOr<Girth> g = mesh_girth(mesh_, Plane{p, fd}, p, &wt);
+            if (!g.ok() || !winds_round(g->loop, p, fd) || g->value_mm > 0.25 * h_) continue;
+            ht.push_back(tt), hg.push_back(g->value_mm);
+          }
+          for (size_t i = 0; i + 1 < ht.size(); ++i)
+            if (hg[i + 1] >= flare) {
+              t = ht[i] + (flare - hg[i]) / (hg[i + 1] - hg[i]) * (ht[i + 1] - ht[i]) - hand * kWristBeforeFlare * h_;
+              break;
+            }
+        }
         if (t) {
           const Eigen::Vector3d p = wrist_c + *t * fd;
           StatusOr<Girth> mid = mesh_girth(mesh_, Plane{p, fd}, p, &wt);

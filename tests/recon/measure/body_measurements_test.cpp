@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <map>
 #include <optional>
 #include <random>
@@ -12,6 +13,7 @@
 #include "recon/geometry/skin_noise.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_slicer.hpp"
+#include "recon/measure/girth.hpp"
 #include "tests/shapes.hpp"
 #include "tests/test_meshes.hpp"
 
@@ -605,6 +607,46 @@ TEST(BodyMeasurements, TheBustPointsTheBustAndTheUnderBustStayPutUnderSmoothSkin
             << body << ", seed " << seed;
         EXPECT_NEAR(b->find("underbust_girth")->value_mm, clean.find("underbust_girth")->value_mm, 1.0)
             << body << ", seed " << seed;
+      }
+    }
+  }
+}
+
+TEST(BodyMeasurements, TheWristIsReadFromTheHandsFlareAndStaysPutUnderSmoothSkinNoise) {
+  // Along the forearm the tape's bottom is flat, its forearm side rising 0.25-0.4 mm
+  // per mm: a bottom's vertex moved male_average's wrists up to 2.4 mm along the arm
+  // under eight smooth fields of 0.25 mm RMS, and the outer arm lengths with them
+  // (male_muscular's up to 5.1). The wrist is now 1 % of the height back from where
+  // the tape has grown 7 mm toward the hand, whose side is steep.
+  for (const char* body : {"male_average", "female_average"}) {
+    const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
+    ASSERT_TRUE(shipped) << body;
+    const BodyMeasurements& clean = shipped->measured;
+    const double stature = clean.find("stature")->value_mm;
+    // On the clean body: 1 % of the height further toward the hand (the side where
+    // the tape grows faster) the tape has grown close to 7 mm, and back at the wrist
+    // it is within 1.5 mm of the forearm's narrowest over 4 % of the height.
+    for (const char* side : {"left", "right"}) {
+      const BodyMeasurement* wrist = clean.find(std::string("wrist_girth_") + side);
+      ASSERT_TRUE(wrist && wrist->plane) << body << " " << side;
+      const Eigen::Vector3d p = wrist->plane->point, n = wrist->plane->normal;
+      auto tape = [&](double t) {
+        auto g = mesh_girth(shipped->mesh, Plane{p + t * n, n}, p + t * n);
+        return g.ok() ? g->value_mm : std::numeric_limits<double>::quiet_NaN();
+      };
+      const double ahead = tape(0.01 * stature), behind = tape(-0.01 * stature);
+      const double hand = std::max(ahead, behind) - wrist->value_mm;
+      EXPECT_NEAR(hand, 7.0, 1.5) << body << " " << side;
+      double narrowest = wrist->value_mm;
+      for (double t = -0.02 * stature; t <= 0.02 * stature; t += 1) narrowest = std::min(narrowest, tape(t));
+      EXPECT_LT(wrist->value_mm - narrowest, 1.5) << body << " " << side;
+    }
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+      auto b = measure_body(with_smooth_skin_noise(shipped->mesh, 0.25, seed));
+      ASSERT_TRUE(b.ok()) << b.status().message();
+      for (const char* side : {"left", "right"}) {
+        const std::string arm = std::string("outer_arm_length_") + side;
+        EXPECT_NEAR(b->find(arm)->value_mm, clean.find(arm)->value_mm, 2.0) << body << " " << arm << ", seed " << seed;
       }
     }
   }
