@@ -246,6 +246,20 @@ void under_skin_noise(std::initializer_list<uint32_t> seeds, const Check& check)
   }
 }
 
+// Measures a shipped body under eight smooth skin-noise fields (0.25 mm RMS at 40 and
+// at 10 mm: a scan's kind of error), and hands each result, the clean body's and the
+// field's seed to `check`.
+template <typename Check>
+void under_smooth_skin_noise(const std::string& body, const Check& check) {
+  const ShippedBody* shipped = shipped_body(body + ".ply");
+  ASSERT_TRUE(shipped) << body;
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    auto b = measure_body(with_smooth_skin_noise(shipped->mesh, 0.25, seed));
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    check(*b, shipped->measured, seed);
+  }
+}
+
 TEST(BodyMeasurements, TheKneeStaysPutUnderTheScansNoise) {
   // The knee is the narrowest cut between calf and thigh, and the profile there is
   // shallow: its lowest sample moved 8-10 mm between two scans of one body, taking
@@ -591,24 +605,18 @@ TEST(BodyMeasurements, TheBustPointsTheBustAndTheUnderBustStayPutUnderSmoothSkin
   // grows 2-3 mm per mm, moved up to 2.3 mm; at the fullest level, 1.2. The
   // under-bust's crease was read in one column under each bust point, and moved the
   // tape up to 1.7 mm; now in seven columns, 0.6.
-  for (const char* body : {"female_average", "male_average"}) {
-    const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
-    ASSERT_TRUE(shipped) << body;
-    const BodyMeasurements& clean = shipped->measured;
-    const bool male = std::string(body) == "male_average";
-    for (uint64_t seed = 1; seed <= 8; ++seed) {
-      auto b = measure_body(with_smooth_skin_noise(shipped->mesh, 0.25, seed));
-      ASSERT_TRUE(b.ok()) << b.status().message();
+  for (const std::string body : {"female_average", "male_average"}) {
+    const bool male = body == "male_average";
+    under_smooth_skin_noise(body, [&](const BodyMeasurements& b, const BodyMeasurements& clean, uint64_t seed) {
       for (const char* name : {"bust_point_left", "bust_point_right"})
-        EXPECT_LT((b->landmark(name)->position - clean.landmark(name)->position).norm(), male ? 3.0 : 2.0)
+        EXPECT_LT((b.landmark(name)->position - clean.landmark(name)->position).norm(), male ? 3.0 : 2.0)
             << body << " " << name << ", seed " << seed;
       if (!male) {
-        EXPECT_NEAR(b->find("bust_girth")->value_mm, clean.find("bust_girth")->value_mm, 1.6)
-            << body << ", seed " << seed;
-        EXPECT_NEAR(b->find("underbust_girth")->value_mm, clean.find("underbust_girth")->value_mm, 1.0)
+        EXPECT_NEAR(b.find("bust_girth")->value_mm, clean.find("bust_girth")->value_mm, 1.6) << body << ", seed " << seed;
+        EXPECT_NEAR(b.find("underbust_girth")->value_mm, clean.find("underbust_girth")->value_mm, 1.0)
             << body << ", seed " << seed;
       }
-    }
+    });
   }
 }
 
@@ -641,14 +649,12 @@ TEST(BodyMeasurements, TheWristIsReadFromTheHandsFlareAndStaysPutUnderSmoothSkin
       for (double t = -0.02 * stature; t <= 0.02 * stature; t += 1) narrowest = std::min(narrowest, tape(t));
       EXPECT_LT(wrist->value_mm - narrowest, 1.5) << body << " " << side;
     }
-    for (uint64_t seed = 1; seed <= 8; ++seed) {
-      auto b = measure_body(with_smooth_skin_noise(shipped->mesh, 0.25, seed));
-      ASSERT_TRUE(b.ok()) << b.status().message();
+    under_smooth_skin_noise(body, [&](const BodyMeasurements& b, const BodyMeasurements& noise_free, uint64_t seed) {
       for (const char* side : {"left", "right"}) {
         const std::string arm = std::string("outer_arm_length_") + side;
-        EXPECT_NEAR(b->find(arm)->value_mm, clean.find(arm)->value_mm, 2.0) << body << " " << arm << ", seed " << seed;
+        EXPECT_NEAR(b.find(arm)->value_mm, noise_free.find(arm)->value_mm, 2.0) << body << " " << arm << ", seed " << seed;
       }
-    }
+    });
   }
 }
 
