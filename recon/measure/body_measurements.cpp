@@ -65,6 +65,10 @@ constexpr double kShallowFoldMm = 10;
 // Over a breast, the bust girth is the fullest within this fraction of the stature
 // of the bust points' level (find_torso_levels).
 constexpr double kBustReachOfHeight = 0.012;
+// A fold under the chest this deep (mm) or less is a man's, this deep or more a
+// breast's crease; the bust girth's reach grows between them (breast_reach).
+constexpr double kChestFoldMm = 6;
+constexpr double kBreastFoldMm = 14;
 // A bust point is the centroid of its side's front within this (mm) of the foremost.
 constexpr double kBustBandMm = 4;
 // The front under the bust is the mean of this many columns either side of each
@@ -854,7 +858,7 @@ class Finder {
         // deep (1.7 mm RMS; female_average 1.3 → 0.8).
         if (notch.depth > -kShallowFoldMm && notch.vertex_y) underbust_y_ = *notch.vertex_y;
         if (notch.depth <= -kShallowFoldMm) underbust_y_ = minimum_centroid(notch.ys, notch.depths, notch.k, kCreaseDepthMm);
-        breast_ = notch.depth <= -kShallowFoldMm;
+        breast_ = breast_reach(-notch.depth);
       }
       landmark("underbust_front_point", {xc_, underbust_y_, front_z(underbust_y_)});
     }
@@ -866,11 +870,14 @@ class Finder {
     // horizontal girth ... across the bust prominence"): the largest girth within
     // kBustReachOfHeight of the apex's level, below the armpits, every 2 mm and then
     // every 0.5 mm round the largest. A man's chest rises into the armpits with no
-    // such fullest level, and a breast's crease beneath (17-46 mm deep on the
-    // shipped bodies, a man's fold 0-6) tells them apart: there the apex's level.
+    // such fullest level, and the crease beneath tells them apart (17-46 mm deep
+    // under the shipped bodies' breasts, a man's fold 0-6): a man's is read at the
+    // apex's level, and between the two the reach grows with the crease's depth
+    // (breast_reach).
     bust_girth_y_ = bust_y_;
-    if (breast_) {
-      const double lo = bust_y_ - kBustReachOfHeight * h_, hi = std::min(bust_y_ + kBustReachOfHeight * h_, ya - 0.01 * h_);
+    if (breast_ > 0) {
+      const double reach = breast_ * kBustReachOfHeight * h_;
+      const double lo = bust_y_ - reach, hi = std::max(bust_y_, std::min(bust_y_ + reach, ya - 0.01 * h_));
       const auto [ys, vs] = sample(lo, hi, [](const Ring& m) { return m.girth; });
       if (!ys.empty()) {
         const size_t k = arg_extreme(vs, true);
@@ -1022,9 +1029,9 @@ class Finder {
           "horizontal, just under the lower armpit's vault (where the join of arm and flank is 1.5 % of the height deep)");
     girth("bust_girth", "Bust girth", "5.3.4", level_girth(bust_girth_y_, near(bust_girth_y_)),
           {"bust_point_left", "bust_point_right"},
-          breast_ ? "horizontal, the fullest within 1.2 % of the height of the bust points' level (across the breasts' "
-                    "prominence)"
-                  : "horizontal, at the level of the chest's most forward point (no breast's crease beneath)");
+          breast_ > 0 ? "horizontal, the fullest within 1.2 % of the height of the bust points' level (across the "
+                        "breasts' prominence; less where the crease beneath is under 14 mm deep)"
+                      : "horizontal, at the level of the chest's most forward point (no breast's crease beneath)");
     girth("underbust_girth", "Under-bust girth", "5.3.8", level_girth(underbust_y_, near(underbust_y_)),
           {"underbust_front_point"}, "horizontal, where the front turns in below the bust");
     girth("waist_girth", "Waist girth", "5.3.10", level_girth(waist_y_, near(waist_y_)),
@@ -1432,11 +1439,15 @@ class Finder {
   double arm_apart_y_[2] = {0, 0};  // where each arm's own loop ends (the armpit below a filled bridge)
   double bust_y_ = 0, underbust_y_ = 0, waist_y_ = 0, hip_y_ = 0;
   bool underbust_fold_ = false;  // the front turns in below the bust
-  bool breast_ = false;           // that fold is a breast's crease (kShallowFoldMm deep or more)
+  double breast_ = 0;  // how far that fold is a breast's crease: 0 (kChestFoldMm deep) to 1 (kBreastFoldMm)
   double bust_girth_y_ = 0;       // the bust girth's level: the fullest over a breast, else bust_y_
 };
 
 }  // namespace
+
+double breast_reach(double fold_depth_mm) {
+  return std::clamp((fold_depth_mm - kChestFoldMm) / (kBreastFoldMm - kChestFoldMm), 0.0, 1.0);
+}
 
 double minimum_centroid(const std::vector<double>& x, const std::vector<double>& v, size_t k, double depth) {
   const double level = v[k] + depth;

@@ -121,6 +121,14 @@ double minimum_centroid(const std::vector<double>& x, const std::vector<double>&
 std::optional<double> settled_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
                                      bool lowest);
 
+// How far the fold under a chest, `fold_depth_mm` behind its chord, is a breast's
+// crease: 0 up to 6 mm (a man's fold: 0-6 mm on the shipped bodies), 1 from 14 mm
+// (their breasts' creases: 17-46 mm), in proportion between. Over a breast the bust
+// girth is the fullest within 1.2 % of the height of the apex's level, times this:
+// a small breast's girth then does not jump between the apex's reading and the
+// fullest as its crease's depth moves with a scan's noise (measure_body).
+double breast_reach(double fold_depth_mm);
+
 // One leg's tape in a horizontal cut where hole filling has bridged the gap between
 // the thighs (`ring` spans the midline X = xc and crosses it on invented surface
 // only, mesh confidence under 0.5 front and back): round the measured skin

@@ -597,6 +597,32 @@ TEST(BodyMeasurements, TheBustIsReadAtItsFullestOverABreastAndAtItsPointsOnAMans
   }
 }
 
+TEST(BodyMeasurements, TheBustsReachGrowsWithTheCreaseWithoutAJump) {
+  // A man's fold (0-6 mm on the shipped bodies) reads the bust at the apex; a
+  // breast's crease (17-46 mm) at the fullest within 1.2 % of the height; between,
+  // the reach grows with the depth: no step as the depth moves by a hundredth of a mm.
+  EXPECT_EQ(breast_reach(0), 0);
+  EXPECT_EQ(breast_reach(6), 0);
+  EXPECT_EQ(breast_reach(14), 1);
+  EXPECT_EQ(breast_reach(46), 1);
+  EXPECT_NEAR(breast_reach(10), 0.5, 1e-12);
+  double last = breast_reach(0);
+  for (double d = 0.01; d <= 50; d += 0.01) {
+    const double r = breast_reach(d);
+    EXPECT_GE(r, last) << d;
+    EXPECT_LT(r - last, 0.002) << d;
+    last = r;
+  }
+  // On the shipped bodies: female_average's crease reaches the whole way (its
+  // bust girth is read 6 mm over the apex), male_average's fold not at all.
+  const ShippedBody* woman = shipped_body("female_average.ply");
+  const ShippedBody* man = shipped_body("male_average.ply");
+  ASSERT_TRUE(woman && man);
+  EXPECT_GT(woman->measured.find("bust_girth")->plane->point.y(),
+            woman->measured.landmark("bust_point_left")->position.y() + 2);
+  EXPECT_EQ(man->measured.find("bust_girth")->plane->point.y(), man->measured.landmark("bust_point_left")->position.y());
+}
+
 TEST(BodyMeasurements, TheBustPointsTheBustAndTheUnderBustStayPutUnderSmoothSkinNoise) {
   // Eight smooth fields of 0.25 mm RMS, as above. female_average's front is flat
   // across the breast at the apex's level, and its foremost point jumped up to
