@@ -716,7 +716,9 @@ class Finder {
     // The top of the shoulder runs front to back: its middle there, between the
     // section's points (the nearest of them moved the point 1.1-2.7 mm RMS front to
     // back under smooth skin noise, on a mesh with a point every 5-10 mm; now 0.3-0.8).
-    const std::vector<std::vector<Eigen::Vector3d>> at_u = sections([&](size_t) { return u; }, 1);
+    // (A copy: clang before 16 cannot capture a structured binding.)
+    const double corner = u;
+    const std::vector<std::vector<Eigen::Vector3d>> at_u = sections([corner](size_t) { return corner; }, 1);
     landmark("shoulder_point_" + side(s),
              middle_of_extreme(at_u[0].empty() ? column[std::min(nb - 1, static_cast<size_t>((us[k] - u0) / bin))] : at_u[0],
                                Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), kRidgeBand, true));
