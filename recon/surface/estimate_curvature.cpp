@@ -211,6 +211,26 @@ Eigen::Matrix2f transported(const ShapeOperator& s, const LocalFrames& f, size_t
 
 }  // namespace
 
+LocalFrames correct_normal_tilt(const LocalFrames& pca, const std::vector<ShapeOperator>& shape) {
+  const size_t n = pca.normals.size();
+  if (pca.offset.size() != n || shape.size() != n) return pca;
+  LocalFrames out = pca;
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+    const Vec3f &t1 = pca.tangent1[i], &t2 = pca.tangent2[i];
+    const float u = pca.offset[i].dot(t1), v = pca.offset[i].dot(t2);
+    const ShapeOperator& s = shape[i];
+    const Vec3f nr = (pca.normals[i] + (s.s11 * u + s.s12 * v) * t1 + (s.s12 * u + s.s22 * v) * t2).normalized();
+    if (!nr.allFinite()) return;
+    Vec3f a = t1 - t1.dot(nr) * nr;
+    if (a.squaredNorm() < 1e-12f) return;
+    a.normalize();
+    out.normals[i] = nr;
+    out.tangent1[i] = a;
+    out.tangent2[i] = nr.cross(a);
+  });
+  return out;
+}
+
 std::vector<ShapeOperator> estimate_shape_operators(const std::vector<Vec3f>& points, const KnnIndex& index,
                                                     const NeighborGraph& graph, const LocalFrames& frames,
                                                     const MeanCurvatureOptions& options) {

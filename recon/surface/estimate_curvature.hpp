@@ -90,6 +90,18 @@ std::vector<ShapeOperator> estimate_shape_operators(const std::vector<Vec3f>& po
                                                     const NeighborGraph& graph, const LocalFrames& frames,
                                                     const MeanCurvatureOptions& options = {});
 
+// Carries each PCA normal from its neighbourhood's mean to the point itself along
+// the surface's shape operator: n = normalise(n_pca + S d), d the point's tangential
+// offset from the mean (pca.offset), S in pca's tangent frame. Inside a
+// well-sampled patch d is a fraction of the spacing and nothing moves; at the edge
+// of what the cameras saw every neighbour lies on one side, the PCA normal is the
+// one a few millimetres back, and a kernel extrapolating across the unseen strip
+// from that tilted plane stands proud of the skin (the crown of a head, seen only
+// up its sides, came out 4 mm high). The tangents are re-orthogonalised to the new
+// normal, tangent1 kept as close to pca's as possible. pca without offsets, or a
+// shape of the wrong size, returns pca unchanged.
+LocalFrames correct_normal_tilt(const LocalFrames& pca, const std::vector<ShapeOperator>& shape);
+
 // Signed mean curvature per point: the trace of estimate_shape_operators() / 2.
 std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, const KnnIndex& index,
                                            const NeighborGraph& graph, const LocalFrames& frames,

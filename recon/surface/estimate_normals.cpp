@@ -21,6 +21,7 @@ LocalFrames estimate_normals(const std::vector<Vec3f>& points, const KnnIndex& i
   f.tangent1.resize(n);
   f.tangent2.resize(n);
   f.eigenvalues.resize(n);
+  f.offset.resize(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
     std::vector<uint32_t> queried(from_graph ? 0 : k + 1);
     std::vector<float> d2(queried.size());
@@ -61,6 +62,7 @@ LocalFrames estimate_normals(const std::vector<Vec3f>& points, const KnnIndex& i
       f.tangent1[i] = t1.cast<float>();
       f.tangent2[i] = t2.cast<float>();
       f.eigenvalues[i] = es.eigenvalues().cwiseMax(0.0).cast<float>();
+      f.offset[i] = (-mean).cast<float>();
     }
   });
   return f;

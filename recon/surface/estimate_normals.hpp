@@ -22,6 +22,12 @@ struct LocalFrames {
   // Covariance eigenvalues, ascending (lambda0 <= lambda1 <= lambda2), mm^2: the
   // mean squared spread along normal, tangent2 and tangent1.
   std::vector<Vec3f> eigenvalues;
+  // Each point minus the mean of its PCA neighbourhood (itself included), the
+  // points' unit. A PCA normal is the surface's normal near that mean, not at the
+  // point: where the neighbours lie to one side (the edge of what a camera saw) the
+  // two differ, and correct_normal_tilt() (estimate_curvature.hpp) carries the
+  // normal back to the point. Empty where unknown.
+  std::vector<Vec3f> offset;
 };
 
 struct EstimateNormalsOptions {

@@ -197,6 +197,19 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   if (options.curvature_compensation) {
     shape = estimate_shape_operators(pts, index, graph, frames, {.k = 20});
   }
+  // The PCA normals belong to their neighbourhoods' means; at the edge of what the
+  // cameras saw those lie a few millimetres back from the point, and a kernel
+  // extrapolating across the unseen strip from that tilted plane stands proud of
+  // the skin. Each normal is carried to its own point along the shape operator
+  // (correct_normal_tilt). On the tiered rig's scans of six bodies the crown stood
+  // 2.8-3.9 mm high before and 1.7-3.0 after, and the wrist girths, whose sparse
+  // stripes leave one-sided neighbourhoods too, 1.3 mm large on average before and
+  // 0.4 after (docs/benchmarks.md). Passes that refit the shape operator to the
+  // carried normals and carry them again overshoot: those normals turn faster than
+  // the surface where the sampling is uneven (wrists 1.4 mm small after three).
+  if (options.correct_normal_tilt && !shape.empty() && source != NormalSource::kInput) {
+    frames = correct_normal_tilt(frames, shape);
+  }
   // Isolated points (a floor sample, a speck of dust far from the body) would get
   // kernels as wide as the gap to their neighbours, and the field's grid with them.
   std::vector<float> confidence = options.use_confidence ? cloud->confidence : std::vector<float>{};

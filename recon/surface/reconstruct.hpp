@@ -40,6 +40,10 @@ struct ReconstructOptions {
   // Bend kernels by the local mean curvature (removes the thesis kernel's
   // curvature bias; implicit_field.hpp). Off = the thesis's flat kernels.
   bool curvature_compensation = true;
+  // With curvature_compensation: carry each PCA normal from its neighbourhood's mean
+  // to the point itself along the shape operator (correct_normal_tilt); off = the
+  // PCA normals as they are. Input normals are never touched.
+  bool correct_normal_tilt = true;
   float voxel_size = 0.f;     // grid spacing in the cloud's unit (0 = auto)
   float epsilon = 1e-2f;      // kernel cut-off tolerance, eq. 3.26
   size_t density_k = 10;      // neighbours of eq. 3.17
