@@ -219,6 +219,7 @@ LocalFrames correct_normal_tilt(const LocalFrames& pca, const std::vector<ShapeO
     const Vec3f &t1 = pca.tangent1[i], &t2 = pca.tangent2[i];
     const float u = pca.offset[i].dot(t1), v = pca.offset[i].dot(t2);
     const ShapeOperator& s = shape[i];
+    if (!(s.mean() > 0.f)) return;  // a hollow keeps its PCA normal (see the header)
     const Vec3f nr = (pca.normals[i] + (s.s11 * u + s.s12 * v) * t1 + (s.s12 * u + s.s22 * v) * t2).normalized();
     if (!nr.allFinite()) return;
     Vec3f a = t1 - t1.dot(nr) * nr;

@@ -201,10 +201,11 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   // cameras saw those lie a few millimetres back from the point, and a kernel
   // extrapolating across the unseen strip from that tilted plane stands proud of
   // the skin. Each normal is carried to its own point along the shape operator
-  // (correct_normal_tilt). On the tiered rig's scans of six bodies the crown stood
-  // 2.8-3.9 mm high before and 1.7-3.0 after, and the wrist girths, whose sparse
-  // stripes leave one-sided neighbourhoods too, 1.3 mm large on average before and
-  // 0.4 after (docs/benchmarks.md). Passes that refit the shape operator to the
+  // (correct_normal_tilt), where the skin is convex. On the tiered rig's scans of
+  // six bodies the crown stood 2.8-3.9 mm high before and 2.2-2.3 after, and the
+  // wrist girths, whose sparse stripes leave one-sided neighbourhoods too, came out
+  // 1.3 mm large on average before and 0.4 after (docs/benchmarks.md §7, session
+  // 27). Passes that refit the shape operator to the
   // carried normals and carry them again overshoot: those normals turn faster than
   // the surface where the sampling is uneven (wrists 1.4 mm small after three), and
   // so does one pass whose kernels are bent by an operator refitted to the carried

@@ -289,6 +289,7 @@ TEST(CorrectNormalTilt, CarriesAnEdgeNormalToItsPointAndKeepsTheInsideTrue) {
   // the one at their mean, a few mm down the sphere: tilted about 2 degrees away
   // from the pole. Carried along the shape operator it comes within a third of a
   // degree of the truth; in the middle of the band the normals stay within 0.1.
+  // Only convex skin is carried (estimate_curvature.hpp).
   const double radius = 90.0, spacing = 4.0;
   const int n = static_cast<int>(4 * std::numbers::pi * radius * radius / (spacing * spacing));
   std::vector<Vec3f> pts, truth;
@@ -334,6 +335,13 @@ TEST(CorrectNormalTilt, CarriesAnEdgeNormalToItsPointAndKeepsTheInsideTrue) {
   // off by up to 0.37 degrees and carried within 0.05.
   EXPECT_LT(percentile(inside_after, 1.0), 0.1);
   EXPECT_LT(percentile(inside_after, 0.5), percentile(inside_before, 0.5));
+  // Seen from inside, the band is a hollow (its shape operator negative): its
+  // normals stay as PCA gave them.
+  LocalFrames hollow = f;
+  for (size_t i = 0; i < pts.size(); ++i) flip_frame(hollow, i);
+  const std::vector<ShapeOperator> hs = estimate_shape_operators(pts, index, g, hollow);
+  ASSERT_LT(hs[pts.size() / 2].mean(), 0.f);
+  EXPECT_EQ(correct_normal_tilt(hollow, hs).normals, hollow.normals);
   // Without offsets (frames built by hand) nothing is carried.
   LocalFrames bare = f;
   bare.offset.clear();
