@@ -202,16 +202,29 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   // extrapolating across the unseen strip from that tilted plane stands proud of
   // the skin. Each normal is carried to its own point along the shape operator
   // (correct_normal_tilt), where the skin is convex. On the tiered rig's scans of
-  // six bodies the crown stood 2.8-3.9 mm high before and 2.2-2.3 after, and the
-  // wrist girths, whose sparse stripes leave one-sided neighbourhoods too, came out
-  // 1.3 mm large on average before and 0.4 after (docs/benchmarks.md §7, session
-  // 27). Passes that refit the shape operator to the
-  // carried normals and carry them again overshoot: those normals turn faster than
-  // the surface where the sampling is uneven (wrists 1.4 mm small after three), and
-  // so does one pass whose kernels are bent by an operator refitted to the carried
-  // normals (0.9 mm small).
+  // six bodies the crown stood 2.75-3.94 mm high before and 1.54-2.40 after, and
+  // the wrist girths, whose sparse stripes leave one-sided neighbourhoods too, came
+  // out 1.36 mm large on average before and 0.54 after (docs/benchmarks.md §7,
+  // session 27). Passes that refit the shape operator to the carried normals and
+  // carry them again overshoot: those normals turn faster than the surface where
+  // the sampling is uneven (wrists 1.4 mm small after three).
   if (options.correct_normal_tilt && !shape.empty() && source != NormalSource::kInput) {
     frames = correct_normal_tilt(frames, shape);
+    // At the edge itself the operator was fitted to PCA normals that all lean the
+    // same way and so turn too slowly across it: there the kernels take the
+    // operator fitted again to the carried normals. Only there: refitted
+    // everywhere, it bends unevenly sampled limbs too far (wrists 0.9 mm small).
+    // The edge is where the point lies more than edge_refit_offset density sigmas
+    // from its neighbourhood's mean across the surface (4 % of female_average's
+    // points at 0.6; inside a patch the offset is a fraction of that).
+    if (options.edge_refit_offset > 0.f && frames.offset.size() == pts.size()) {
+      const std::vector<ShapeOperator> carried = estimate_shape_operators(pts, index, graph, frames, {.k = 20});
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const Vec3f& d = frames.offset[i];
+        if ((d - d.dot(frames.normals[i]) * frames.normals[i]).norm() > options.edge_refit_offset * sigma_density[i])
+          shape[i] = carried[i];
+      }
+    }
   }
   // Isolated points (a floor sample, a speck of dust far from the body) would get
   // kernels as wide as the gap to their neighbours, and the field's grid with them.

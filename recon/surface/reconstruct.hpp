@@ -44,6 +44,11 @@ struct ReconstructOptions {
   // to the point itself along the shape operator (correct_normal_tilt); off = the
   // PCA normals as they are. Input normals are never touched.
   bool correct_normal_tilt = true;
+  // With correct_normal_tilt: where a point lies more than this many density sigmas
+  // from its PCA neighbourhood's mean across the surface (the edge of what the
+  // cameras saw), its kernel is bent by the shape operator fitted again to the
+  // carried normals. 0 = every kernel keeps the PCA normals' operator.
+  float edge_refit_offset = 0.6f;
   float voxel_size = 0.f;     // grid spacing in the cloud's unit (0 = auto)
   float epsilon = 1e-2f;      // kernel cut-off tolerance, eq. 3.26
   size_t density_k = 10;      // neighbours of eq. 3.17
