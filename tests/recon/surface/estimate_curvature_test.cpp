@@ -291,16 +291,13 @@ TEST(CorrectNormalTilt, CarriesAnEdgeNormalToItsPointAndKeepsTheInsideTrue) {
   // degree of the truth; in the middle of the band the normals stay within 0.1.
   // Only convex skin is carried (estimate_curvature.hpp).
   const double radius = 90.0, spacing = 4.0;
-  const int n = static_cast<int>(4 * std::numbers::pi * radius * radius / (spacing * spacing));
+  const PointCloud sphere = fibonacci_sphere(static_cast<size_t>(4 * std::numbers::pi * radius * radius / (spacing * spacing)), radius);
   std::vector<Vec3f> pts, truth;
-  for (int i = 0; i < n; ++i) {
-    const double y = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - y * y);
-    const double a = std::numbers::pi * (3.0 - std::sqrt(5.0)) * i;
-    const double polar = std::acos(y) * 180 / std::numbers::pi;
+  for (size_t i = 0; i < sphere.size(); ++i) {
+    const double polar = std::acos(static_cast<double>(sphere.normals[i].y())) * 180 / std::numbers::pi;
     if (polar < 20 || polar > 70) continue;
-    const Vec3f d(static_cast<float>(r * std::cos(a)), static_cast<float>(y), static_cast<float>(r * std::sin(a)));
-    pts.push_back(d * static_cast<float>(radius));
-    truth.push_back(d);
+    pts.push_back(sphere.positions[i]);
+    truth.push_back(sphere.normals[i]);
   }
   const KnnIndex index(pts);
   const NeighborGraph g = knn_graph(index, pts, 20);

@@ -25,6 +25,11 @@ namespace {
 
 double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
+// One standard normal draw (Box-Muller, the cosine half).
+double gaussian(std::mt19937_64& rng) {
+  return std::sqrt(-2.0 * std::log(1.0 - uniform01(rng))) * std::cos(2 * std::numbers::pi * uniform01(rng));
+}
+
 ReconstructResult run(const PointCloud& cloud, const ReconstructOptions& options = {}) {
   auto r = reconstruct_surface(cloud, options);
   EXPECT_TRUE(r.ok()) << r.status().message();
@@ -204,7 +209,6 @@ TEST(ReconstructSurface, AStripedLimbKeepsItsRadiusAcrossAGap) {
   // came out 0.11 mm thick on average and, across the gap, where only the ring's
   // kernels reach, 0.87 mm. Bent along the principal directions: 0.03 and 0.09.
   std::mt19937_64 rng(5);
-  auto gauss = [&] { return std::sqrt(-2.0 * std::log(1.0 - uniform01(rng))) * std::cos(2 * std::numbers::pi * uniform01(rng)); };
   const double radius = 26, ring = 12, step = 3, gap_lo = 80, gap_hi = 125;  // mm and degrees
   PointCloud c;
   for (double y = 3; y < 300; y += ring) {
@@ -214,7 +218,7 @@ TEST(ReconstructSurface, AStripedLimbKeepsItsRadiusAcrossAGap) {
       if (deg > gap_lo && deg < gap_hi) continue;
       const double a = deg * std::numbers::pi / 180;
       const Vec3f n(static_cast<float>(std::cos(a)), 0.f, static_cast<float>(std::sin(a)));
-      c.positions.push_back(n * static_cast<float>(radius + 0.2 * gauss()) + Vec3f(0.f, static_cast<float>(y + 0.2 * gauss()), 0.f));
+      c.positions.push_back(n * static_cast<float>(radius + 0.2 * gaussian(rng)) + Vec3f(0.f, static_cast<float>(y + 0.2 * gaussian(rng)), 0.f));
       c.normals.push_back(n);
     }
   }
@@ -245,16 +249,13 @@ TEST(ReconstructSurface, ACrownSeenOnlyUpItsSidesStandsHalfAsHighWithItsNormalsC
   // with the edge's kernels bent by the operator fitted to the carried normals,
   // 0.86.
   std::mt19937_64 rng(11);
-  auto gauss = [&] { return std::sqrt(-2.0 * std::log(1.0 - uniform01(rng))) * std::cos(2 * std::numbers::pi * uniform01(rng)); };
   const double radius = 90, spacing = 6, half_strip = 18, noise = 0.3;
-  const int n = static_cast<int>(4 * std::numbers::pi * radius * radius / (spacing * spacing));
+  const PointCloud sphere = fibonacci_sphere(static_cast<size_t>(4 * std::numbers::pi * radius * radius / (spacing * spacing)), radius);
   PointCloud c;
-  for (int i = 0; i < n; ++i) {
-    const double y = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - y * y);
-    const double a = std::numbers::pi * (3.0 - std::sqrt(5.0)) * i;
-    const Eigen::Vector3d d(r * std::cos(a), y, r * std::sin(a));
+  for (const Vec3f& unit : sphere.normals) {
+    const Eigen::Vector3d d = unit.cast<double>();
     if (d.y() > 0 && std::abs(d.z()) * radius < half_strip) continue;
-    const Eigen::Vector3d p = d * (radius + noise * gauss()) + 0.3 * noise * Eigen::Vector3d(gauss(), gauss(), gauss());
+    const Eigen::Vector3d p = d * (radius + noise * gaussian(rng)) + 0.3 * noise * Eigen::Vector3d(gaussian(rng), gaussian(rng), gaussian(rng));
     c.positions.push_back(p.cast<float>());
   }
   auto top = [&](bool correct) {
