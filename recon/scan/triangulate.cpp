@@ -83,10 +83,7 @@ StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration
                                                          const TriangulateOptions& options) {
   std::vector<ColumnRange> windows;
   if (plane) windows = stripe_windows(cal, *plane, scan_volume(cal.frame), options.window_pad_px);
-  ASSIGN_OR_RETURN(std::vector<StripeSample> samples,
-                   extract_stripe(frame, base, options.stripe, full_scale, plane ? &windows : nullptr));
-  if (options.smooth_rows > 0) smooth_stripe(samples, options.smooth_rows);
-  return samples;
+  return extract_stripe(frame, base, options.stripe, full_scale, plane ? &windows : nullptr);
 }
 
 float angle_confidence(double angle_deg, double full_angle_deg) {

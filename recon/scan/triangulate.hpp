@@ -57,7 +57,9 @@ float stripe_confidence(const StripeSample& s, int threshold);
 float angle_confidence(double angle_deg, double full_angle_deg);
 
 // The frame's stripe samples where `plane` can meet the subject (stripe_windows), or
-// along whole rows when there is no plane yet; smoothed along the stripe.
+// along whole rows when there is no plane yet, as extracted: smooth_stripe them
+// (options.smooth_rows) before triangulating. The scan keeps them unsmoothed in its
+// raw record, so that a later smoothing can be replayed on them.
 StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration& cal, const LaserPlane* plane,
                                                          const ImageView& frame, const ImageView& base, int full_scale,
                                                          const TriangulateOptions& options);

@@ -100,7 +100,8 @@ class ScanProcessor {
     bool has_plane = false;             // the stripe crossed enough poles
     LaserPlane plane;                   // from this frame's poles
     std::vector<LaserState> others;     // the other lasers lit
-    std::vector<StripeSample> samples;
+    std::vector<StripeSample> samples;  // as extracted (smoothed when triangulated)
+    bool smoothed = false;              // already smoothed: a record of format 1
   };
   const RigCalibration& cal_;
   ScanOptions options_;

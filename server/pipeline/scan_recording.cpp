@@ -140,7 +140,10 @@ StatusOr<RigCalibration> calibration_from_record(const nlohmann::json& j) {
 
 namespace {
 
-constexpr char kMagic[8] = {'B', 'S', 'S', 'T', 'R', 'I', 'P', '1'};
+// The last byte is the format: '2' holds the stripe samples as extracted (a replay
+// smooths them), '1' (before 2026-11-27) as smoothed then (a replay takes them so).
+constexpr char kMagic[8] = {'B', 'S', 'S', 'T', 'R', 'I', 'P', '2'};
+constexpr size_t kFormatByte = sizeof kMagic - 1;
 
 class Writer {
  public:
@@ -216,6 +219,9 @@ std::string ScanProcessor::recording() const {
   uLongf packed_size = compressBound(raw.size());
   std::string out(sizeof kMagic + 8 + packed_size, '\0');
   std::memcpy(out.data(), kMagic, sizeof kMagic);
+  // A format-1 record replayed and recorded again stays format 1: its samples are
+  // the smoothed ones.
+  if (!records_.empty() && records_.front().smoothed) out[kFormatByte] = '1';
   const uint64_t n = raw.size();
   std::memcpy(out.data() + sizeof kMagic, &n, 8);
   compress2(reinterpret_cast<Bytef*>(out.data() + sizeof kMagic + 8), &packed_size,
@@ -226,8 +232,11 @@ std::string ScanProcessor::recording() const {
 
 Status ScanProcessor::load_recording(std::string_view bytes) {
   auto bad = [](const std::string& what) { return invalid_argument("scan record: " + what); };
-  if (bytes.size() < sizeof kMagic + 8 || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+  if (bytes.size() < sizeof kMagic + 8 || std::memcmp(bytes.data(), kMagic, kFormatByte) != 0)
     return bad("not a bodyscan stripe record");
+  const char format = bytes[kFormatByte];
+  if (format != '1' && format != '2')
+    return bad(std::string("format ") + format + " is newer than this build reads (1 and 2)");
   uint64_t n = 0;
   std::memcpy(&n, bytes.data() + sizeof kMagic, 8);
   if (n > (uint64_t{1} << 34)) return bad("its size field is impossible");
@@ -255,6 +264,7 @@ Status ScanProcessor::load_recording(std::string_view bytes) {
     if (camera >= cal_.cameras.size()) return bad("a frame names a camera the calibration does not have");
     r.camera = camera, r.laser = laser, r.step = step, r.frame = frame, r.full_scale = full_scale;
     r.has_plane = has_plane != 0;
+    r.smoothed = format == '1';
     LaserPlane& p = r.plane;
     if (!rd.get(&p.normal) || !rd.get(&p.offset) || !rd.get(&p.fourth_point_mm)) return bad("cut short");
     for (PoleStripe& s : p.poles) {

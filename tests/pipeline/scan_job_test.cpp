@@ -73,6 +73,32 @@ TEST(ScanJob, PointsLieOnTheBodyFromEveryCamera) {
   EXPECT_DOUBLE_EQ(again->scan.fourth_point_rms_mm, result->scan.fourth_point_rms_mm);
   std::printf("[ scan job ] raw record: %zu bytes of stripes for %zu frames, %zu bytes of calibration\n",
               result->raw_stripes.size(), result->scan.frames, record_text.size());
+  // The record keeps the stripes as extracted (format 2), and a replay smooths them
+  // as today's code does. A format-1 record (before 2026-11-27) kept them smoothed:
+  // replayed, it is not smoothed twice. The same samples marked format 1 make the
+  // cloud that today's record makes with smoothing off, and not the smoothed one.
+  ASSERT_GT(result->raw_stripes.size(), 8u);
+  EXPECT_EQ(result->raw_stripes.substr(0, 8), "BSSTRIP2");
+  std::string as_format_1 = result->raw_stripes;
+  as_format_1[7] = '1';
+  ScanJobOptions unsmoothed = options;
+  unsmoothed.scan.triangulate.smooth_rows = 0;
+  auto old_format = reprocess_scan(result->raw_record, as_format_1, options);
+  auto raw = reprocess_scan(result->raw_record, result->raw_stripes, unsmoothed);
+  ASSERT_TRUE(old_format.ok()) << old_format.status().message();
+  ASSERT_TRUE(raw.ok()) << raw.status().message();
+  ASSERT_EQ(old_format->cloud.size(), raw->cloud.size());
+  size_t moved = 0;
+  for (size_t i = 0; i < raw->cloud.size(); ++i) {
+    ASSERT_EQ(old_format->cloud.positions[i], raw->cloud.positions[i]) << i;
+    moved += i < cloud.size() && raw->cloud.positions[i] != cloud.positions[i];
+  }
+  EXPECT_GT(moved, cloud.size() / 2) << "smoothing moved too few points to tell the formats apart";
+  std::string future = result->raw_stripes;
+  future[7] = '3';
+  auto unknown = reprocess_scan(result->raw_record, future, options);
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.status().message().find("format 3"), std::string::npos) << unknown.status().message();
   // Damaged records say so.
   std::string cut = result->raw_stripes.substr(0, result->raw_stripes.size() / 2);
   auto broken = reprocess_scan(result->raw_record, cut, options);
