@@ -17,6 +17,12 @@
 // noise, speckle, its pixel format), extracted against a base frame and smoothed
 // along the stripe exactly as the scan does, still with the true camera and plane:
 // what the frame itself costs, apart from calibration.
+//
+// Each table also counts the points more than 2 and 4 mm off the skin, and a second
+// table sorts the same points by where their sample lies along its stripe: the end
+// of a run of consecutive rows (the next row has no sample, or one more than
+// 1.5 px across: where the stripe fades, leaves the body or goes behind a limb),
+// the row next to an end, or further in.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -41,32 +47,66 @@ namespace {
 
 struct Bins {
   std::vector<double> edges{0, 30, 45, 60, 70, 75, 80, 85, 90.01};
-  std::vector<double> sum, sum2;
-  std::vector<size_t> n;
-  std::vector<std::vector<double>> all;
-  Bins()
-      : sum(edges.size() - 1), sum2(edges.size() - 1), n(edges.size() - 1), all(edges.size() - 1) {}
+  std::vector<std::vector<double>> all = std::vector<std::vector<double>>(edges.size() - 1);
   void add(double view, double err) {
     for (size_t b = 0; b + 1 < edges.size(); ++b)
       if (view >= edges[b] && view < edges[b + 1]) {
-        sum[b] += err, sum2[b] += err * err, ++n[b];
         all[b].push_back(err);
         return;
       }
   }
   void print(const char* label) const {
-    std::printf("  %s: view (deg), signed mean (mm), median, |err| p50 / p90, samples\n", label);
+    std::printf("  %s: view (deg), signed mean (mm), median, |err| p50 / p90, samples, over 2 / 4 mm\n", label);
     for (size_t b = 0; b + 1 < edges.size(); ++b) {
-      std::vector<double> v = all[b], a;
-      if (v.empty()) continue;
-      for (double e : v) a.push_back(std::abs(e));
-      std::sort(v.begin(), v.end());
-      std::sort(a.begin(), a.end());
-      std::printf("    %2.0f-%2.0f  %+.3f  %+.3f  %.3f / %.3f  %zu\n", edges[b], edges[b + 1],
-                  sum[b] / n[b], v[v.size() / 2], a[a.size() / 2], a[a.size() * 9 / 10], n[b]);
+      if (all[b].empty()) continue;
+      std::printf("    %2.0f-%2.0f  ", edges[b], edges[b + 1]);
+      print_row(all[b]);
+    }
+  }
+  // Signed mean, median, |err| p50 / p90, count, and how many are over 2 and 4 mm.
+  static void print_row(std::vector<double> v) {
+    std::vector<double> a;
+    double s = 0;
+    for (double e : v) a.push_back(std::abs(e)), s += e;
+    std::sort(v.begin(), v.end());
+    std::sort(a.begin(), a.end());
+    const auto over = [&](double mm) { return a.end() - std::upper_bound(a.begin(), a.end(), mm); };
+    std::printf("%+.3f  %+.3f  %.3f / %.3f  %zu  %td / %td\n", s / static_cast<double>(v.size()), v[v.size() / 2],
+                a[a.size() / 2], a[a.size() * 9 / 10], v.size(), over(2), over(4));
+  }
+};
+
+// The same errors by where the sample lies along its run of consecutive rows.
+struct RunBins {
+  std::vector<double> by[3];  // at a run's end, next to it, further in
+  void add(int from_end, double err) { by[std::min(from_end, 2)].push_back(err); }
+  void print(const char* label) const {
+    static const char* const names[3] = {"run end", "next row", "inside"};
+    std::printf("  %s by place on the stripe: signed mean (mm), median, |err| p50 / p90, samples, over 2 / 4 mm\n",
+                label);
+    for (int k = 0; k < 3; ++k) {
+      if (by[k].empty()) continue;
+      std::printf("    %-9s ", names[k]);
+      Bins::print_row(by[k]);
     }
   }
 };
+
+// Rows from each sample to the nearer end of its run: consecutive rows whose
+// columns differ by at most max_step px (smooth_stripe's continuation rule).
+std::vector<int> rows_from_run_end(const std::vector<StripeSample>& s, double max_step = 1.5) {
+  const auto continues = [&](size_t a, size_t b) {
+    return s[b].row - s[a].row == 1 && std::abs(s[b].column - s[a].column) <= max_step;
+  };
+  std::vector<int> out(s.size(), 0);
+  for (size_t i = 1; i < s.size(); ++i) out[i] = continues(i - 1, i) ? out[i - 1] + 1 : 0;
+  int after = 0;
+  for (size_t i = s.size(); i-- > 0;) {
+    after = i + 1 < s.size() && continues(i, i + 1) ? after + 1 : 0;
+    out[i] = std::min(out[i], after);
+  }
+  return out;
+}
 
 // The laser radiance seen along the ray through image point (px, py), before the
 // lens's spread and the pixel's integration. The sub-ray's own footprint (1/k of a
@@ -173,6 +213,7 @@ int main(int argc, char** argv) {
               desc->name.c_str(), body.empty() ? "(the rig's)" : body.c_str(), every, sub, sub,
               radius);
   Bins shipped_all, reference_all;
+  RunBins shipped_runs, reference_runs;
   for (size_t c = 0; c < desc->cameras.size(); ++c) {
     const CameraDescription& cam = desc->cameras[c];
     const Renderer& renderer = (*rig)->renderer(c);
@@ -276,7 +317,9 @@ int main(int argc, char** argv) {
           if (!samples.ok()) continue;
           const Vec3d n = l.plane_normal(step);
           const double off = l.plane_offset(step);
-          for (const StripeSample& s : *samples) {
+          const std::vector<int> from_end = rows_from_run_end(*samples);
+          for (size_t si = 0; si < samples->size(); ++si) {
+            const StripeSample& s = (*samples)[si];
             const auto r = model.ray(Vec2d(s.column, s.row));
             if (!r) continue;
             const double den = n.dot(*r);
@@ -294,6 +337,7 @@ int main(int argc, char** argv) {
             const double view = std::acos(std::min(1.0, std::abs(nn.dot(to_cam)))) * 180 / M_PI;
             (which == 0 ? shipped : reference).add(view, cp.signed_distance);
             (which == 0 ? shipped_all : reference_all).add(view, cp.signed_distance);
+            (which == 0 ? shipped_runs : reference_runs).add(from_end[si], cp.signed_distance);
           }
         }
       }
@@ -306,5 +350,7 @@ int main(int argc, char** argv) {
   std::printf("all cameras\n");
   shipped_all.print("shipped");
   reference_all.print(noisy ? "frames" : "reference");
+  shipped_runs.print("shipped");
+  reference_runs.print(noisy ? "frames" : "reference");
   return 0;
 }
