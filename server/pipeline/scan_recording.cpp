@@ -236,7 +236,7 @@ Status ScanProcessor::load_recording(std::string_view bytes) {
     return bad("not a bodyscan stripe record");
   const char format = bytes[kFormatByte];
   if (format != '1' && format != '2')
-    return bad(std::string("format ") + format + " is newer than this build reads (1 and 2)");
+    return bad(std::string("format ") + format + " is not one this build reads (1 and 2)");
   uint64_t n = 0;
   std::memcpy(&n, bytes.data() + sizeof kMagic, 8);
   if (n > (uint64_t{1} << 34)) return bad("its size field is impossible");
