@@ -155,7 +155,7 @@ StatusOr<PointCloud> ScanProcessor::finish() {
     // Smoothed along the stripe here, not when extracted: the raw record keeps the
     // samples as the camera gave them, and a replay smooths them as today's code does.
     std::vector<StripeSample> smoothed;
-    if (!r.smoothed && options_.triangulate.smooth_rows > 0) {
+    if (!samples_smoothed_ && options_.triangulate.smooth_rows > 0) {
       smoothed = *samples;
       smooth_stripe(smoothed, options_.triangulate.smooth_rows);
       samples = &smoothed;

@@ -101,13 +101,13 @@ class ScanProcessor {
     LaserPlane plane;                   // from this frame's poles
     std::vector<LaserState> others;     // the other lasers lit
     std::vector<StripeSample> samples;  // as extracted (smoothed when triangulated)
-    bool smoothed = false;              // already smoothed: a record of format 1
   };
   const RigCalibration& cal_;
   ScanOptions options_;
   std::vector<LaserPlaneFinder> finders_;
   std::vector<std::vector<hw::Frame>> base_;  // per group, per camera
   std::vector<FrameRecord> records_;
+  bool samples_smoothed_ = false;  // loaded from a format-1 record: already smoothed
   ScanStats stats_;
   double fourth_ss_ = 0;
   size_t fourth_n_ = 0;

@@ -221,7 +221,7 @@ std::string ScanProcessor::recording() const {
   std::memcpy(out.data(), kMagic, sizeof kMagic);
   // A format-1 record replayed and recorded again stays format 1: its samples are
   // the smoothed ones.
-  if (!records_.empty() && records_.front().smoothed) out[kFormatByte] = '1';
+  if (samples_smoothed_) out[kFormatByte] = '1';
   const uint64_t n = raw.size();
   std::memcpy(out.data() + sizeof kMagic, &n, 8);
   compress2(reinterpret_cast<Bytef*>(out.data() + sizeof kMagic + 8), &packed_size,
@@ -264,7 +264,6 @@ Status ScanProcessor::load_recording(std::string_view bytes) {
     if (camera >= cal_.cameras.size()) return bad("a frame names a camera the calibration does not have");
     r.camera = camera, r.laser = laser, r.step = step, r.frame = frame, r.full_scale = full_scale;
     r.has_plane = has_plane != 0;
-    r.smoothed = format == '1';
     LaserPlane& p = r.plane;
     if (!rd.get(&p.normal) || !rd.get(&p.offset) || !rd.get(&p.fourth_point_mm)) return bad("cut short");
     for (PoleStripe& s : p.poles) {
@@ -303,6 +302,7 @@ Status ScanProcessor::load_recording(std::string_view bytes) {
   }
   if (!rd.done()) return bad("trailing bytes");
   records_ = std::move(records);
+  samples_smoothed_ = format == '1';
   stats_ = {};
   stats_.frames = frames, stats_.frames_unseen = unseen, stats_.frames_without_plane = without;
   stats_.far_bottom_estimated = far, stats_.samples = samples;
