@@ -49,13 +49,6 @@ constexpr double kRidgeBand = 10;
 // A join (the legs' at the crotch, an arm's with the flank) counts where it has
 // grown this long front to back (a fraction of the height; Finder::widened).
 constexpr double kJoinDepth = 0.015;
-// Above a filled bridge (Finder::above_bridge), measured skin counts where it goes
-// on up for this long (mm). Where male_heavy's thighs close behind the crotch, a few
-// stripes' ends left a measured patch 3-4 mm tall on the bridge 8 mm under the
-// crotch, and whether it passed the measured mark moved the crotch 8 mm between two
-// smoothings of one scan's stripes; the crotch's own floor is measured for 20 mm
-// and more.
-constexpr double kBridgeHoldMm = 5;
 // The thigh's tape is taken this far (a fraction of the height) below the crotch
 // or lower (measure_leg).
 constexpr double kThighBelowCrotch = 0.015;
@@ -470,22 +463,16 @@ class Finder {
 
   // Up from where two parts join at height y: where the joined loop crosses the
   // vertical plane X = x on invented surface only, front and back (hole filling's
-  // bridge across a gap no camera sees into), the first level above from which the
-  // crossing, front or back, is measured skin for kBridgeHoldMm on end, within
-  // `reach`, bisected. Else y: the join is measured, or the bridge reaches farther
-  // than that (wholly unseen).
+  // bridge across a gap no camera sees into), the first level above whose crossing,
+  // front or back, is measured skin, within `reach`, bisected. Else y: the join is
+  // measured, or the bridge reaches farther than that (wholly unseen).
   double above_bridge(double y, double x, double reach) {
-    const auto measured_at = [&](double yy) {
+    const auto measured = [&](double yy) {
       const Ring* m = midline(rings(yy), xc_);
       return !m || m->crossing_confidence(x) >= kMeasuredConfidence;
     };
-    const auto measured = [&](double yy) {
-      for (double k = 0; k <= kBridgeHoldMm; k += 1)
-        if (!measured_at(yy + k)) return false;
-      return true;
-    };
     if (measured(y + 0.5)) return y;
-    prefetch(y, y + reach + kBridgeHoldMm, 1);
+    prefetch(y, y + reach, 1);
     for (double yy = y + 1; yy <= y + reach; yy += 1)
       if (measured(yy)) return bisect(yy - 1, yy, measured);
     return y;

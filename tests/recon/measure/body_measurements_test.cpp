@@ -843,29 +843,6 @@ TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
   EXPECT_NEAR(filled->find("crotch_height")->value_mm, clean, 1.0);
 }
 
-TEST(BodyMeasurements, AMeasuredPatchOnAFilledBridgeIsNoCrotch) {
-  // Where male_heavy's thighs close behind the crotch (tiered rig), a few stripes'
-  // ends leave a measured patch 3-4 mm tall on the filled bridge 8 mm under the
-  // crotch. Here the filled wall of the test above carries one measured ring 10 mm
-  // under the crotch (measured within about 1.9 mm of it): measured skin that does
-  // not go on up is no crotch, which stays where the skin joins.
-  const ShippedBody* body = male_average();
-  ASSERT_TRUE(body);
-  const double clean = body->measured.find("crotch_height")->value_mm;
-  const double crotch_y = body->measured.landmark("crotch")->position.y();
-  TriangleMesh mesh = with_crotch_wall(*body, 30, 25, 5);
-  size_t patch = 0;
-  for (size_t i = body->mesh.vertices.size(); i < mesh.vertices.size(); ++i) {
-    const bool on_ring = std::abs(mesh.vertices[i].y() - (crotch_y - 10)) < 0.01;
-    mesh.confidence[i] = on_ring ? 1.f : 0.f;
-    patch += on_ring;
-  }
-  ASSERT_EQ(patch, 64u);  // the wall's ring at that level
-  auto b = measure_body(mesh);
-  ASSERT_TRUE(b.ok()) << b.status().message();
-  EXPECT_NEAR(b->find("crotch_height")->value_mm, clean, 1.0);
-}
-
 TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
   // No camera sees the top of the armpit, and hole filling can join arm and flank
   // below it (male_average, tiered rig: 9 mm below the truth's junction). Here the
