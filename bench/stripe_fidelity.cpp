@@ -22,7 +22,10 @@
 // table sorts the same points by where their sample lies along its stripe: the end
 // of a run of consecutive rows (the next row has no sample, or one more than
 // 1.5 px across: where the stripe fades, leaves the body or goes behind a limb),
-// the row next to an end, or further in.
+// the row next to an end, or further in. With --noisy, the runs' ends are sorted
+// further: by their run's length (a run of one row is a lone sample, which the scan
+// drops: drop_short_runs), by their peak against the median of the run's next six,
+// and by how far their raw column lies off the line through those six.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -88,6 +91,55 @@ struct RunBins {
       if (by[k].empty()) continue;
       std::printf("    %-9s ", names[k]);
       Bins::print_row(by[k]);
+    }
+  }
+};
+
+// The runs' last samples by two things the raw record keeps: the peak against the
+// median peak of the run's next 6 samples, and the raw column's distance from the
+// straight line through those 6 samples, extrapolated to the end's row (px).
+struct EndFeatures {
+  std::vector<double> ratio_edges{0, 0.3, 0.5, 0.7, 0.85, 1.0, 1e9};
+  std::vector<double> resid_edges{0, 0.2, 0.4, 0.7, 1.0, 1.5, 1e9};
+  std::vector<std::vector<double>> by_ratio = std::vector<std::vector<double>>(6);
+  std::vector<std::vector<double>> by_resid = std::vector<std::vector<double>>(6);
+  std::vector<std::vector<double>> both = std::vector<std::vector<double>>(36);
+  std::vector<std::vector<double>> by_length = std::vector<std::vector<double>>(5);  // 1, 2, 3-5, 6-10, 11+
+  static size_t bin(const std::vector<double>& e, double v) {
+    for (size_t b = 0; b + 1 < e.size(); ++b)
+      if (v < e[b + 1]) return b;
+    return e.size() - 2;
+  }
+  void add(double ratio, double resid, double err) {
+    const size_t a = bin(ratio_edges, ratio), b = bin(resid_edges, std::abs(resid));
+    by_ratio[a].push_back(err);
+    by_resid[b].push_back(err);
+    both[a * 6 + b].push_back(err);
+  }
+  void add_length(int length, double err) {
+    by_length[length <= 2 ? length - 1 : length <= 5 ? 2 : length <= 10 ? 3 : 4].push_back(err);
+  }
+  void print() const {
+    static const char* const lengths[5] = {"1", "2", "3-5", "6-10", "11+"};
+    std::printf("  run ends by their run's length (rows): signed mean, median, |err| p50 / p90, n, over 2 / 4\n");
+    for (size_t b = 0; b < 5; ++b)
+      if (!by_length[b].empty()) std::printf("    %-6s ", lengths[b]), Bins::print_row(by_length[b]);
+    std::printf("  run ends by peak / the run's median peak: signed mean, median, |err| p50 / p90, n, over 2 / 4\n");
+    for (size_t b = 0; b < 6; ++b)
+      if (!by_ratio[b].empty()) std::printf("    %.2f-%.2f  ", ratio_edges[b], std::min(9.0, ratio_edges[b + 1])), Bins::print_row(by_ratio[b]);
+    std::printf("  run ends by |raw column - the run's line| (px)\n");
+    for (size_t b = 0; b < 6; ++b)
+      if (!by_resid[b].empty()) std::printf("    %.2f-%.2f  ", resid_edges[b], std::min(9.0, resid_edges[b + 1])), Bins::print_row(by_resid[b]);
+    std::printf("  over 2 mm / n, rows peak ratio, columns residual\n");
+    for (size_t a = 0; a < 6; ++a) {
+      std::printf("    %.2f-%.2f ", ratio_edges[a], std::min(9.0, ratio_edges[a + 1]));
+      for (size_t b = 0; b < 6; ++b) {
+        const auto& v = both[a * 6 + b];
+        size_t o = 0;
+        for (double e : v) o += std::abs(e) > 2;
+        std::printf(" %4zu/%-5zu", o, v.size());
+      }
+      std::printf("\n");
     }
   }
 };
@@ -214,6 +266,7 @@ int main(int argc, char** argv) {
               radius);
   Bins shipped_all, reference_all;
   RunBins shipped_runs, reference_runs;
+  EndFeatures end_features;
   for (size_t c = 0; c < desc->cameras.size(); ++c) {
     const CameraDescription& cam = desc->cameras[c];
     const Renderer& renderer = (*rig)->renderer(c);
@@ -295,6 +348,7 @@ int main(int argc, char** argv) {
         so.threshold = 40;
         for (int which = 0; which < 2; ++which) {
           StatusOr<std::vector<StripeSample>> samples = internal_error("unset");
+          std::vector<StripeSample> raw;
           if (which == 1 && noisy) {
             // As the scan sees it: the camera's frame against the base frame taken
             // with the lasers off, its threshold, smoothed along the stripe.
@@ -309,6 +363,7 @@ int main(int argc, char** argv) {
             pso.radius = radius;
             samples = extract_stripe(ImageView{f.pixels.data(), w, h},
                                      ImageView{b0.pixels.data(), w, h}, pso, f.max_value());
+            if (samples.ok()) raw = *samples;
             if (samples.ok() && smooth > 0) smooth_stripe(*samples, smooth);
           } else {
             const std::vector<uint16_t> px = to_pixels(which == 0 ? shipped_img : ref_img);
@@ -318,6 +373,48 @@ int main(int argc, char** argv) {
           const Vec3d n = l.plane_normal(step);
           const double off = l.plane_offset(step);
           const std::vector<int> from_end = rows_from_run_end(*samples);
+          // Each raw run end's features (the raw and smoothed samples are row for row).
+          std::vector<double> ratio(raw.size(), -1), resid(raw.size(), 0);
+          std::vector<int> run_length(raw.size(), 0);
+          std::vector<uint8_t> at_end(raw.size(), 0);
+          if (!raw.empty()) {
+            // Each raw sample's run length (the smoothing's continuation rule).
+            size_t a = 0;
+            for (size_t i = 1; i <= raw.size(); ++i)
+              if (i == raw.size() || raw[i].row - raw[i - 1].row != 1 || std::abs(raw[i].column - raw[i - 1].column) > 1.5) {
+                for (size_t j = a; j < i; ++j) run_length[j] = static_cast<int>(i - a);
+                at_end[a] = at_end[i - 1] = 1;
+                a = i;
+              }
+          }
+          if (!raw.empty()) {
+            const std::vector<int> raw_end = rows_from_run_end(raw);
+            for (size_t i = 0; i < raw.size(); ++i) {
+              if (raw_end[i] != 0) continue;
+              for (int dir : {-1, 1}) {
+                std::vector<size_t> in;
+                for (long j = static_cast<long>(i) + dir; j >= 0 && j < static_cast<long>(raw.size()) && in.size() < 6;
+                     j += dir) {
+                  const size_t pj = in.empty() ? i : in.back();
+                  if (std::abs(raw[j].row - raw[pj].row) != 1 || std::abs(raw[j].column - raw[pj].column) > 1.5) break;
+                  in.push_back(static_cast<size_t>(j));
+                }
+                if (in.size() < 6) continue;
+                std::vector<double> pk;
+                double s0 = 0, s1 = 0, s2 = 0, t0 = 0, t1 = 0;
+                for (size_t j : in) {
+                  pk.push_back(raw[j].peak);
+                  const double r = raw[j].row - raw[i].row, c = raw[j].column;
+                  s0 += 1, s1 += r, s2 += r * r, t0 += c, t1 += r * c;
+                }
+                std::sort(pk.begin(), pk.end());
+                const double med = 0.5 * (pk[2] + pk[3]);
+                const double det = s0 * s2 - s1 * s1;
+                ratio[i] = raw[i].peak / std::max(1.0, med);
+                resid[i] = raw[i].column - (t0 * s2 - s1 * t1) / det;
+              }
+            }
+          }
           for (size_t si = 0; si < samples->size(); ++si) {
             const StripeSample& s = (*samples)[si];
             const auto r = model.ray(Vec2d(s.column, s.row));
@@ -338,6 +435,10 @@ int main(int argc, char** argv) {
             (which == 0 ? shipped : reference).add(view, cp.signed_distance);
             (which == 0 ? shipped_all : reference_all).add(view, cp.signed_distance);
             (which == 0 ? shipped_runs : reference_runs).add(from_end[si], cp.signed_distance);
+            if (which == 1 && noisy && si < run_length.size() && at_end[si])
+              end_features.add_length(run_length[si], cp.signed_distance);
+            if (which == 1 && noisy && si < ratio.size() && ratio[si] >= 0)
+              end_features.add(ratio[si], resid[si], cp.signed_distance);
           }
         }
       }
@@ -352,5 +453,6 @@ int main(int argc, char** argv) {
   reference_all.print(noisy ? "frames" : "reference");
   shipped_runs.print("shipped");
   reference_runs.print(noisy ? "frames" : "reference");
+  if (noisy) end_features.print();
   return 0;
 }

@@ -92,8 +92,8 @@ constexpr double kWristFlareMm = 7;
 // The hip's level: the fit's weights reach zero this far either side of its vertex,
 // as a fraction of the stature (find_torso_levels).
 constexpr double kHipHalf = 0.04;
-// Knees whose levels lie within this (mm) of each other are level: the mid-thigh
-// takes their mean (measure_leg).
+// Knees whose levels lie within this (mm) of each other are level: the knee heights
+// and the mid-thigh take their mean (knee_reading_level).
 constexpr double kLevelKneesMm = 10;
 // A second narrowing of the forearm's cuts nearer the hand, past a rise of more
 // than this (mm) and within this of the narrowest, is the wrist (wrist_cut).
@@ -1166,18 +1166,29 @@ class Finder {
       const Ring* l = leg(r, s);
       landmark("knee_" + sd, {kc.x(), ky, l ? l->z_max : kc.z()});
     }
-    height("knee_height_" + sd, "Knee height (" + sd + ")", "", "knee_" + sd, lm("knee_" + sd),
-           "knee level above the floor");
+    // The knee height and the mid-thigh read the knees' mean level where they are
+    // level (knee_reading_level): each knee's own level moves 1-2.5 mm RMS with the
+    // skin's noise (a shallow profile's bottom), the two independently (tiered
+    // male_average, two scans: +1.67 and -1.77 mm; male_heavy +3.22 and -0.22).
+    const std::optional<Knee>& other = knee_[s > 0 ? 1 : 0];
+    const double kr = knee_reading_level(ky, other ? std::optional<double>(other->y) : std::nullopt);
+    const bool level_knees = other && std::abs(other->y - ky) <= kLevelKneesMm;
+    {
+      BodyMeasurement m;
+      m.name = "knee_height_" + sd, m.label = "Knee height (" + sd + ")", m.kind = "height";
+      const Eigen::Vector3d p = lm("knee_" + sd);
+      m.value_mm = kr - floor_;
+      m.path = {Eigen::Vector3d(p.x(), floor_, p.z()), Eigen::Vector3d(p.x(), kr, p.z())};
+      m.landmarks = {"knee_" + sd};
+      if (level_knees) m.landmarks.push_back("knee_" + side(-s));
+      m.definition = level_knees ? "the knees' mean level above the floor (standing, they lie within 10 mm)"
+                                 : "knee level above the floor";
+      add(std::move(m));
+    }
     girth("knee_girth_" + sd, "Knee girth (" + sd + ")", "5.3.22", level_girth(ky, kc), {"knee_" + sd},
           "horizontal, the narrowest cut of the leg between calf and thigh (18-36 % of the height)");
-    // Mid-thigh: halfway between the crotch and the knees' level. Standing, the knees
-    // are level; each knee's own level moves 1-2.5 mm RMS with the skin's noise (a
-    // shallow profile's bottom), the two independently (tiered male_average, two
-    // scans: +1.67 and -1.77 mm), so both knees' mean is taken where they lie within
-    // kLevelKneesMm of each other, and the leg's own where they do not.
-    const std::optional<Knee>& other = knee_[s > 0 ? 1 : 0];
-    const bool level_knees = other && std::abs(other->y - ky) <= kLevelKneesMm;
-    const double my = 0.5 * (crotch_y_ + (level_knees ? 0.5 * (ky + other->y) : ky));
+    // Mid-thigh: halfway between the crotch and the knee's reading level.
+    const double my = 0.5 * (crotch_y_ + kr);
     const std::vector<Ring>& mr = rings(my);
     const Ring* ml = leg(mr, s);
     std::vector<std::string> mid_landmarks = {"crotch", "knee_" + sd};
@@ -1446,6 +1457,10 @@ class Finder {
 };
 
 }  // namespace
+
+double knee_reading_level(double own_y, std::optional<double> other_y) {
+  return other_y && std::abs(*other_y - own_y) <= kLevelKneesMm ? 0.5 * (own_y + *other_y) : own_y;
+}
 
 double breast_reach(double fold_depth_mm) {
   return std::clamp((fold_depth_mm - kChestFoldMm) / (kBreastFoldMm - kChestFoldMm), 0.0, 1.0);

@@ -129,6 +129,14 @@ std::optional<double> settled_vertex(const std::vector<double>& x, const std::ve
 // fullest as its crease's depth moves with a scan's noise (measure_body).
 double breast_reach(double fold_depth_mm);
 
+// The level a leg's knee height and mid-thigh read the knee at: standing, both
+// knees are at one height, so where the other knee's level (`other_y`, if found)
+// lies within 10 mm of this knee's (`own_y`), the two knees' mean; else this knee's
+// own. Each knee's level is a shallow girth profile's bottom and moves 1-2.5 mm RMS
+// with a scan's noise, the two independently: their mean moves about 1/sqrt(2) as
+// much (measure_body).
+double knee_reading_level(double own_y, std::optional<double> other_y);
+
 // One leg's tape in a horizontal cut where hole filling has bridged the gap between
 // the thighs (`ring` spans the midline X = xc and crosses it on invented surface
 // only, mesh confidence under 0.5 front and back): round the measured skin

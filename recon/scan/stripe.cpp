@@ -141,4 +141,23 @@ void smooth_stripe(std::vector<StripeSample>& samples, int half_window, double m
   for (size_t i = 0; i < n; ++i) samples[i].column = out[i];
 }
 
+size_t drop_short_runs(std::vector<StripeSample>& samples, int min_rows, double max_step) {
+  if (min_rows <= 1) return 0;
+  const size_t n = samples.size();
+  std::vector<uint8_t> keep(n, 1);
+  size_t begin = 0;
+  for (size_t i = 1; i <= n; ++i) {
+    if (i < n && samples[i].row - samples[i - 1].row == 1 &&
+        std::abs(samples[i].column - samples[i - 1].column) <= max_step)
+      continue;
+    if (i - begin < static_cast<size_t>(min_rows)) std::fill(keep.begin() + begin, keep.begin() + i, 0);
+    begin = i;
+  }
+  size_t out = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (keep[i]) samples[out++] = samples[i];
+  samples.resize(out);
+  return n - out;
+}
+
 }  // namespace bodyscan

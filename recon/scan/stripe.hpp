@@ -60,4 +60,13 @@ StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const
 // stripe keep their column.
 void smooth_stripe(std::vector<StripeSample>& samples, int half_window = 5, double max_step = 1.5);
 
+// Drops the samples of runs shorter than `min_rows` (a run: consecutive rows whose
+// columns differ by at most `max_step` px, smooth_stripe's continuation rule) and
+// returns how many. A sample with no neighbour on its stripe is where a stripe is
+// glimpsed for one row, between a limb and the skin it hides or at a silhouette,
+// and nothing along the stripe confirms it: on the simulated tiered rig such samples
+// are 1.3 % of a body's samples and hold 4 of the 5 that land over 4 mm off the skin
+// (bench/stripe_fidelity --noisy, docs/benchmarks.md §7, session 30).
+size_t drop_short_runs(std::vector<StripeSample>& samples, int min_rows = 2, double max_step = 1.5);
+
 }  // namespace bodyscan

@@ -152,12 +152,15 @@ StatusOr<PointCloud> ScanProcessor::finish() {
       }
       samples = &kept;
     }
-    // Smoothed along the stripe here, not when extracted: the raw record keeps the
-    // samples as the camera gave them, and a replay smooths them as today's code does.
+    // Lone samples dropped and the rest smoothed along the stripe here, not when
+    // extracted: the raw record keeps the samples as the camera gave them, and a
+    // replay treats them as today's code does. A format-1 record holds them as the
+    // code of its day left them.
     std::vector<StripeSample> smoothed;
-    if (!samples_smoothed_ && options_.triangulate.smooth_rows > 0) {
+    if (!samples_smoothed_ && (options_.triangulate.smooth_rows > 0 || options_.triangulate.min_run_rows > 1)) {
       smoothed = *samples;
-      smooth_stripe(smoothed, options_.triangulate.smooth_rows);
+      drop_short_runs(smoothed, options_.triangulate.min_run_rows);
+      if (options_.triangulate.smooth_rows > 0) smooth_stripe(smoothed, options_.triangulate.smooth_rows);
       samples = &smoothed;
     }
     std::vector<SweepPlane> others;

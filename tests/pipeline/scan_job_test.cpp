@@ -83,6 +83,7 @@ TEST(ScanJob, PointsLieOnTheBodyFromEveryCamera) {
   as_format_1[7] = '1';
   ScanJobOptions unsmoothed = options;
   unsmoothed.scan.triangulate.smooth_rows = 0;
+  unsmoothed.scan.triangulate.min_run_rows = 1;
   auto old_format = reprocess_scan(result->raw_record, as_format_1, options);
   auto raw = reprocess_scan(result->raw_record, result->raw_stripes, unsmoothed);
   ASSERT_TRUE(old_format.ok()) << old_format.status().message();

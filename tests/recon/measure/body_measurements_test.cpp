@@ -279,6 +279,29 @@ TEST(BodyMeasurements, TheKneeStaysPutUnderTheScansNoise) {
   }
 }
 
+// Standing, both knees are at one height: a knee height (and the mid-thigh) reads
+// the two knees' mean level where they lie within 10 mm, the knee's own where one is
+// raised. On a shipped body both sides then give one value, from both landmarks.
+TEST(BodyMeasurements, KneeHeightsReadTheLevelKneesMean) {
+  EXPECT_DOUBLE_EQ(knee_reading_level(500, 506), 503);
+  EXPECT_DOUBLE_EQ(knee_reading_level(506, 500), 503);
+  EXPECT_DOUBLE_EQ(knee_reading_level(500, 510), 505);
+  EXPECT_DOUBLE_EQ(knee_reading_level(500, 511), 500);
+  EXPECT_DOUBLE_EQ(knee_reading_level(500, std::nullopt), 500);
+  const ShippedBody* body = male_average();
+  ASSERT_TRUE(body);
+  const BodyMeasurements& b = body->measured;
+  const BodyMeasurement* left = b.find("knee_height_left");
+  const BodyMeasurement* right = b.find("knee_height_right");
+  ASSERT_TRUE(left && right);
+  double mean = 0;
+  for (const BodyLandmark& l : b.landmarks)
+    if (l.name == "knee_left" || l.name == "knee_right") mean += 0.5 * (l.position.y() - b.floor_y);
+  EXPECT_NEAR(left->value_mm, mean, 1e-9);
+  EXPECT_DOUBLE_EQ(left->value_mm, right->value_mm);
+  EXPECT_EQ(left->landmarks.size(), 2u);
+}
+
 TEST(BodyMeasurements, TheWristIsAboveThePalmWhenAScanFusesTheFingers) {
   // An arm's horizontal cuts, armpit downwards, every 3 mm (tapes in mm): the upper
   // arm, the forearm narrowing to the wrist at cut 60, the palm widening to 306 mm by

@@ -128,5 +128,32 @@ TEST(StripeSmoothing, ACurvedStripeIsNotPulledToItsInside) {
   for (size_t i = 2; i + 2 < s.size(); ++i) EXPECT_NEAR(s[i].column, truth(s[i].row), 2e-3) << "row " << s[i].row;
 }
 
+// A sample that no neighbouring row continues (a stripe glimpsed for one row) goes;
+// runs of two rows or more stay whole, and a jump of more than 1.5 px per row
+// starts a new run.
+TEST(StripeRuns, LoneSamplesAreDroppedAndRunsKept) {
+  std::vector<StripeSample> s;
+  for (int y = 10; y < 20; ++y) s.push_back({y, 100.0f + 0.5f * (y - 10), 80, false});  // a run of 10
+  s.push_back({20, 120.0f, 30, false});   // continues row 19 but 15.5 px across: alone
+  s.push_back({25, 300.0f, 90, false});   // a gap of rows before and after: alone
+  s.push_back({30, 50.0f, 70, false});    // a run of two
+  s.push_back({31, 51.0f, 70, false});
+  std::vector<StripeSample> kept = s;
+  EXPECT_EQ(drop_short_runs(kept), 2u);
+  ASSERT_EQ(kept.size(), 12u);
+  for (size_t i = 0; i < 10; ++i) EXPECT_EQ(kept[i].row, s[i].row);
+  EXPECT_EQ(kept[10].row, 30);
+  EXPECT_EQ(kept[11].row, 31);
+  // Three rows at least: the pair goes too. One row: everything stays.
+  kept = s;
+  EXPECT_EQ(drop_short_runs(kept, 3), 4u);
+  EXPECT_EQ(kept.size(), 10u);
+  kept = s;
+  EXPECT_EQ(drop_short_runs(kept, 1), 0u);
+  EXPECT_EQ(kept.size(), s.size());
+  std::vector<StripeSample> none;
+  EXPECT_EQ(drop_short_runs(none), 0u);
+}
+
 }  // namespace
 }  // namespace bodyscan
