@@ -947,13 +947,14 @@ class Finder {
   }
   void skip(const std::string& name, const std::string& why) { out_->skipped.push_back(name + ": " + why); }
 
-  void height(const std::string& name, const std::string& label, const std::string& clause, const std::string& lmk,
-              const Eigen::Vector3d& p, const std::string& definition) {
+  // A height: the level of p above the floor, drawn as a plumb line up to p.
+  void height(const std::string& name, const std::string& label, const std::string& clause,
+              std::vector<std::string> landmarks, const Eigen::Vector3d& p, const std::string& definition) {
     BodyMeasurement m;
     m.name = name, m.label = label, m.iso_clause = clause, m.kind = "height";
     m.value_mm = p.y() - floor_;
     m.path = {Eigen::Vector3d(p.x(), floor_, p.z()), p};
-    m.landmarks = {lmk};
+    m.landmarks = std::move(landmarks);
     m.definition = definition;
     add(std::move(m));
   }
@@ -981,10 +982,10 @@ class Finder {
 
   void measure_heights() {
     landmark("top_of_head", top_);
-    height("stature", "Stature", "5.1.1", "top_of_head", top_, "top of the head above the floor");
-    height("cervical_height", "Cervical height", "", "back_neck_point", lm("back_neck_point"),
+    height("stature", "Stature", "5.1.1", {"top_of_head"}, top_, "top of the head above the floor");
+    height("cervical_height", "Cervical height", "", {"back_neck_point"}, lm("back_neck_point"),
            "back neck point above the floor");
-    height("crotch_height", "Inside leg length (crotch height)", "5.1.15", "crotch", lm("crotch"),
+    height("crotch_height", "Inside leg length (crotch height)", "5.1.15", {"crotch"}, lm("crotch"),
            "crotch above the floor");
   }
 
@@ -1051,9 +1052,9 @@ class Finder {
       girth("max_hip_girth", "Maximum hip girth", "5.3.14", level_girth(yb, near(yb)), {"crotch", "waist_back_point"},
             "horizontal, the largest between crotch and waist");
     }
-    height("waist_height", "Waist height", "5.1.10", "waist_back_point", lm("waist_back_point"),
+    height("waist_height", "Waist height", "5.1.10", {"waist_back_point"}, lm("waist_back_point"),
            "waist level above the floor");
-    height("hip_height", "Hip height", "", "hip_back_point", lm("hip_back_point"), "hip level above the floor");
+    height("hip_height", "Hip height", "", {"hip_back_point"}, lm("hip_back_point"), "hip level above the floor");
   }
 
   // The leg's loop on side s at a level, when it is whole there. Scraps of a cut (a
@@ -1174,16 +1175,12 @@ class Finder {
     const double kr = knee_reading_level(ky, other ? std::optional<double>(other->y) : std::nullopt);
     const bool level_knees = other && std::abs(other->y - ky) <= kLevelKneesMm;
     {
-      BodyMeasurement m;
-      m.name = "knee_height_" + sd, m.label = "Knee height (" + sd + ")", m.kind = "height";
       const Eigen::Vector3d p = lm("knee_" + sd);
-      m.value_mm = kr - floor_;
-      m.path = {Eigen::Vector3d(p.x(), floor_, p.z()), Eigen::Vector3d(p.x(), kr, p.z())};
-      m.landmarks = {"knee_" + sd};
-      if (level_knees) m.landmarks.push_back("knee_" + side(-s));
-      m.definition = level_knees ? "the knees' mean level above the floor (standing, they lie within 10 mm)"
-                                 : "knee level above the floor";
-      add(std::move(m));
+      std::vector<std::string> knees = {"knee_" + sd};
+      if (level_knees) knees.push_back("knee_" + side(-s));
+      height("knee_height_" + sd, "Knee height (" + sd + ")", "", std::move(knees), {p.x(), kr, p.z()},
+             level_knees ? "the knees' mean level above the floor (standing, they lie within 10 mm)"
+                         : "knee level above the floor");
     }
     girth("knee_girth_" + sd, "Knee girth (" + sd + ")", "5.3.22", level_girth(ky, kc), {"knee_" + sd},
           "horizontal, the narrowest cut of the leg between calf and thigh (18-36 % of the height)");
