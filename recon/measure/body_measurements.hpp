@@ -37,7 +37,7 @@
 
 namespace bodyscan {
 
-inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-9";
+inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-10";
 
 // A mesh vertex at or above this confidence is measured skin; below, hole filling
 // invented it.
@@ -128,6 +128,14 @@ std::optional<double> settled_vertex(const std::vector<double>& x, const std::ve
 // a small breast's girth then does not jump between the apex's reading and the
 // fullest as its crease's depth moves with a scan's noise (measure_body).
 double breast_reach(double fold_depth_mm);
+
+// A sampled profile with each sample that stands more than `tol` off the median of
+// the samples within `half` of it (fewer at the ends) replaced by that median: a
+// bump or dent at most `half` samples long is gone, a smooth profile keeps every
+// sample. The bust's level is read from the front's profile despiked over two 2 mm
+// samples either side: a heavy man's front is flat within 0.5 mm over 40 mm, and a
+// stray bump there 1-3 mm proud was its foremost point (measure_body).
+std::vector<double> despiked(const std::vector<double>& v, size_t half, double tol);
 
 // The level a leg's knee height and mid-thigh read the knee at: standing, both
 // knees are at one height, so where the other knee's level (`other_y`, if found)
