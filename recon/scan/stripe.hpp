@@ -61,8 +61,9 @@ StatusOr<std::vector<StripeSample>> extract_stripe(const ImageView& frame, const
 void smooth_stripe(std::vector<StripeSample>& samples, int half_window = 5, double max_step = 1.5);
 
 // Drops the samples of runs shorter than `min_rows` (a run: consecutive rows whose
-// columns differ by at most `max_step` px, smooth_stripe's continuation rule) and
-// returns how many. A sample with no neighbour on its stripe is where a stripe is
+// columns differ by at most `max_step` px; smooth_stripe's step per row, though
+// smooth_stripe also reaches across missing rows and this does not) and returns
+// how many. A sample with no neighbour on its stripe is where a stripe is
 // glimpsed for one row, between a limb and the skin it hides or at a silhouette,
 // and nothing along the stripe confirms it: on the simulated tiered rig such samples
 // are 1.3 % of a body's samples and hold 4 of the 5 that land over 4 mm off the skin
