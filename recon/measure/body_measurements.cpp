@@ -72,6 +72,9 @@ constexpr double kBreastFoldMm = 14;
 // The bust's level ignores a bump in the front's profile this many 2 mm samples
 // tall or less (despiked).
 constexpr size_t kBustBumpSamples = 2;
+// A flat chest's top: where the front falls this far (mm) below its foremost on
+// both sides, over more than 2 % of the height.
+constexpr double kBustTopDropMm = 1.5;
 // A bust point is the centroid of its side's front within this (mm) of the foremost.
 constexpr double kBustBandMm = 4;
 // The front under the bust is the mean of this many columns either side of each
@@ -253,11 +256,11 @@ size_t settle(const std::vector<double>& v, size_t k, double tol) {
   return (a + b) / 2;
 }
 
-// The middle of a flat minimum of v over x (x ascending) at v[k]: halfway between
-// where v first rises `rise` above v[k] on either side (interpolated between
-// samples). Nothing when either side never rises that far.
-std::optional<double> flat_bottom_middle(const std::vector<double>& x, const std::vector<double>& v, size_t k,
-                                         double rise) {
+// A flat minimum of v over x (x ascending) at v[k]: where v first rises `rise`
+// above v[k] on either side (interpolated between samples), (lower x, upper x).
+// Nothing when either side never rises that far.
+std::optional<std::pair<double, double>> flat_bottom_span(const std::vector<double>& x, const std::vector<double>& v,
+                                                          size_t k, double rise) {
   const double level = v[k] + rise;
   std::optional<double> lo, hi;
   for (size_t i = k; i > 0 && !lo; --i)
@@ -265,7 +268,15 @@ std::optional<double> flat_bottom_middle(const std::vector<double>& x, const std
   for (size_t i = k; i + 1 < v.size() && !hi; ++i)
     if (v[i + 1] >= level) hi = x[i] + (level - v[i]) / (v[i + 1] - v[i]) * (x[i + 1] - x[i]);
   if (!lo || !hi) return std::nullopt;
-  return 0.5 * (*lo + *hi);
+  return std::make_pair(*lo, *hi);
+}
+
+// The middle of that flat minimum: halfway between the two rises.
+std::optional<double> flat_bottom_middle(const std::vector<double>& x, const std::vector<double>& v, size_t k,
+                                         double rise) {
+  const auto span = flat_bottom_span(x, v, k, rise);
+  if (!span) return std::nullopt;
+  return 0.5 * (span->first + span->second);
 }
 
 // The parabola a t^2 + b t + c in t = x - centre least-squares fitted to the samples
@@ -805,8 +816,24 @@ class Finder {
     // between two replays of one scan's stripes (bust girth -1.5 and -5.5 mm). A
     // sample more than the settling tolerance (0.5 mm) off the median of the
     // kBustBumpSamples either side takes that median (despiked).
-    bust_y_ = profile(ya - 0.12 * h_, ya - 0.01 * h_, [](const Ring& m) { return m.z_max; }, true, 0.5,
-                      ya - 0.06 * h_, 0.01 * h_, false, kBustBumpSamples);
+    //
+    // And that flat front is flat further still: within 1.5 mm of its foremost over
+    // 70-80 mm of height (a woman's apex 15-24 mm, male_average's 30), and a
+    // parabola over 1 % of the height either side followed ripples of a few tenths
+    // of a millimetre across it. Replays of one still male_heavy scan whose sway
+    // estimates differed by that much put the level 1118-1138 mm up, the bust girth
+    // 0.0 to -6.4 mm off the truth. Where the front falls kBustTopDropMm below its
+    // foremost on both sides within the search, over more than 2 % of the height,
+    // the level is the vertex of a parabola whose weights reach zero half that span
+    // either side of itself (settled_vertex), over the whole top.
+    {
+      const double y0 = ya - 0.12 * h_, y1 = ya - 0.01 * h_;
+      const auto front = [](const Ring& m) { return m.z_max; };
+      auto [ys, vs] = sample(y0, y1, front);
+      std::optional<double> level;
+      if (!ys.empty()) level = flat_top_vertex(ys, despiked(vs, kBustBumpSamples, 0.5), kBustTopDropMm, 0.02 * h_);
+      bust_y_ = level ? *level : profile(y0, y1, front, true, 0.5, ya - 0.06 * h_, 0.01 * h_, false, kBustBumpSamples);
+    }
     {
       const std::vector<Ring>& r = rings(bust_y_);
       const Ring* m = midline(r, xc_);
@@ -1517,6 +1544,21 @@ std::optional<double> settled_vertex(const std::vector<double>& x, const std::ve
     if (std::abs(step) < 1e-3) break;
   }
   return c;
+}
+
+std::optional<double> flat_top_vertex(const std::vector<double>& x, const std::vector<double>& v, double drop,
+                                      double min_span) {
+  if (x.size() != v.size() || x.empty()) return std::nullopt;
+  std::vector<double> below = v;
+  for (double& b : below) b = -b;
+  const size_t k = arg_extreme(v, true);
+  const auto span = flat_bottom_span(x, below, k, drop);
+  if (!span || span->second - span->first <= min_span) return std::nullopt;
+  const double mid = 0.5 * (span->first + span->second);
+  size_t km = k;
+  for (size_t i = 0; i < x.size(); ++i)
+    if (std::abs(x[i] - mid) < std::abs(x[km] - mid)) km = i;
+  return settled_vertex(x, v, km, 0.5 * (span->second - span->first), false);
 }
 
 size_t wrist_cut(const std::vector<double>& g, double palm_rise) {

@@ -37,7 +37,7 @@
 
 namespace bodyscan {
 
-inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-10";
+inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-11";
 
 // A mesh vertex at or above this confidence is measured skin; below, hole filling
 // invented it.
@@ -120,6 +120,14 @@ double minimum_centroid(const std::vector<double>& x, const std::vector<double>&
 // corner, the wrist along the forearm and the hip's level (measure_body).
 std::optional<double> settled_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
                                      bool lowest);
+
+// The level (x) of a flat top of the profile v over x (x ascending): where v falls
+// `drop` below its largest on both sides, over more than `min_span` of x, the vertex
+// of a parabola whose weights reach zero half that span either side of itself
+// (settled_vertex), fitted over the whole top. Nothing where the top is narrower,
+// or does not fall that far on both sides (a chest rising into the armpits).
+std::optional<double> flat_top_vertex(const std::vector<double>& x, const std::vector<double>& v, double drop,
+                                      double min_span);
 
 // How far the fold under a chest, `fold_depth_mm` behind its chord, is a breast's
 // crease: 0 up to 6 mm (a man's fold: 0-6 mm on the shipped bodies), 1 from 14 mm

@@ -709,6 +709,67 @@ TEST(BodyMeasurements, AShortBumpOnTheChestIsNotTheBust) {
   EXPECT_NEAR(b->find("underbust_girth")->value_mm, clean->find("underbust_girth")->value_mm, 0.5);
 }
 
+std::vector<double> every_2mm_from(double first, size_t n) {
+  std::vector<double> x(n);
+  for (size_t i = 0; i < n; ++i) x[i] = first + 2.0 * static_cast<double>(i);
+  return x;
+}
+
+TEST(BodyMeasurements, AFlatChestsLevelIsTheVertexOverItsWholeTop) {
+  // The front's foremost Z every 2 mm up a tiered scan of male_heavy, still, its
+  // stripes reprocessed with two sway estimates a few tenths of a millimetre apart
+  // (despiked). The front lies within 1.5 mm of its foremost over 70-80 mm; a
+  // parabola over 17 mm either side put the bust's level at 1138 and 1118 mm (bust
+  // girth 0.0 and -5.7 mm off the truth). Over the whole top: within 2 mm.
+  const std::vector<double> one = {
+      42.41, 42.27, 42.27, 42.42, 42.75, 42.67, 42.51, 42.70, 42.72, 42.70, 42.71, 42.63, 42.91,
+      43.55, 43.55, 43.55, 43.48, 43.30, 43.18, 43.92, 43.58, 43.49, 43.58, 43.70, 43.77, 43.92,
+      43.81, 43.91, 44.37, 44.18, 43.93, 43.92, 43.93, 43.94, 43.93, 43.92, 43.91, 43.89, 43.83,
+      43.70, 43.86, 43.75, 43.43, 43.33, 43.36, 43.36, 43.36, 43.23, 42.40, 41.97, 41.73, 41.58,
+      41.44, 41.23, 40.91, 40.59, 40.28, 40.01, 39.72, 39.43, 39.27, 39.03, 38.30, 38.03, 37.83,
+      37.50, 37.10, 36.72, 36.15, 35.77, 35.52, 35.18, 34.75, 34.37, 33.94, 33.48, 33.13, 32.73,
+      32.29, 31.97, 31.56, 31.08, 30.79, 30.48, 30.48, 30.96, 31.60, 32.23, 32.95, 33.63, 34.36,
+      34.97, 35.53, 35.89, 36.23, 36.56, 36.85};
+  const std::vector<double> two = {
+      41.98, 41.99, 42.05, 42.16, 42.73, 42.66, 42.32, 42.49, 42.56, 42.56, 42.58, 42.51, 42.85,
+      43.49, 43.68, 44.01, 43.68, 43.18, 43.68, 43.31, 43.37, 43.31, 43.37, 43.51, 43.59, 43.60,
+      43.66, 43.67, 43.66, 43.68, 43.76, 43.79, 43.80, 43.81, 43.80, 43.78, 43.78, 43.73, 43.62,
+      43.44, 43.51, 43.41, 43.33, 43.18, 43.12, 43.47, 43.12, 43.12, 42.11, 41.81, 41.58, 41.45,
+      41.28, 41.03, 40.75, 40.46, 40.13, 39.80, 39.55, 39.31, 39.22, 38.84, 38.16, 37.92, 37.66,
+      37.30, 36.96, 36.58, 35.97, 35.65, 35.40, 34.98, 34.60, 34.22, 33.75, 33.34, 32.99, 32.53,
+      32.15, 31.83, 31.35, 30.93, 30.66, 30.29, 30.36, 30.86, 31.49, 32.13, 32.86, 33.53, 34.27,
+      34.85, 35.44, 35.78, 36.08, 36.46, 36.75};
+  const std::vector<double> y = every_2mm_from(1076.6, one.size());
+  ASSERT_EQ(two.size(), one.size());
+  const std::optional<double> a = flat_top_vertex(y, one, 1.5, 35), b = flat_top_vertex(y, two, 1.5, 35);
+  ASSERT_TRUE(a && b);
+  EXPECT_NEAR(*a, *b, 2.0);
+  EXPECT_GT(*a, 1128);
+  EXPECT_LT(*a, 1146);
+  // female_average's front (the same scan's kind): a breast's apex, 18 mm wide at
+  // 1.5 mm down, is no flat top; male_muscular's chest rises into the armpits and
+  // never falls 1.5 mm above its foremost. Both keep the narrow parabola.
+  const std::vector<double> breast = {
+      20.86, 21.04, 21.22, 21.44, 21.68, 21.88, 22.01, 22.17, 22.35, 22.54, 22.76, 22.93, 23.00,
+      23.10, 23.23, 23.38, 23.49, 23.63, 23.87, 23.88, 23.94, 24.16, 24.42, 24.50, 24.61, 24.93,
+      25.09, 24.93, 25.09, 25.18, 25.25, 25.39, 25.38, 25.41, 25.43, 25.53, 25.55, 25.51, 25.43,
+      25.38, 25.38, 25.33, 25.13, 24.89, 24.83, 24.88, 24.91, 24.79, 24.57, 24.42, 24.34, 24.39,
+      24.62, 24.75, 24.83, 24.14, 23.44, 23.21, 23.08, 22.74, 22.53, 22.41, 23.23, 25.48, 27.63,
+      29.40, 30.97, 32.31, 33.45, 34.45, 35.33, 36.03, 36.56, 36.86, 36.98, 36.96, 36.87, 36.63,
+      36.20, 35.47, 34.65, 33.67, 32.71, 31.77, 30.77, 29.65, 29.65, 28.43};
+  EXPECT_FALSE(flat_top_vertex(every_2mm_from(986.6, breast.size()), breast, 1.5, 35));
+  const std::vector<double> rising = {
+      -7.49, -6.06, -6.79, -6.79, -6.79, -7.59, -7.56, -7.74, -8.07, -8.12, -8.09, -8.06, -7.65,
+      -7.07, -4.81, -4.81, -4.81, -6.71, -7.12, -6.88, -6.79, -6.63, -6.42, -6.15, -5.81, -5.53,
+      -5.22, -4.84, -4.47, -4.20, -3.93, -3.20, -3.04, -2.99, -2.85, -2.69, -2.43, -2.08, -1.89,
+      -1.77, -1.68, -1.53, -1.35, -1.17, -1.00, -0.90, -0.79, -0.67, -0.53, -0.42, -0.25, 0.10,
+      0.58, 0.79, 0.93, 0.67, 0.68, 0.80, 1.03, 0.82, 0.88, 0.94, 1.03, 1.13, 1.24, 1.29, 1.27,
+      1.17, 1.06, 1.07, 1.19, 1.17, 1.02, 1.40, 1.81, 1.79, 1.34, 1.20, 1.36, 1.36, 1.96, 1.36,
+      1.52, 1.66, 2.02, 2.58, 3.12, 3.78, 4.48, 5.16, 5.68, 6.28, 6.69, 6.97, 7.26, 7.48, 7.63,
+      7.73, 7.71, 7.65, 7.52, 7.37};
+  EXPECT_FALSE(flat_top_vertex(every_2mm_from(1146.1, rising.size()), rising, 1.5, 35));
+}
+
 TEST(BodyMeasurements, TheBustPointsTheBustAndTheUnderBustStayPutUnderSmoothSkinNoise) {
   // Eight smooth fields of 0.25 mm RMS, as above. female_average's front is flat
   // across the breast at the apex's level, and its foremost point jumped up to
