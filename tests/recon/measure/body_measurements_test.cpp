@@ -946,14 +946,15 @@ TEST(BodyMeasurements, TheThighsTapeIsWhereTheCrotchDoesNotPullIt) {
 
 // The true male_average with a wall 5 mm thick and 2 * half_length long front to
 // back standing between its thighs at the crotch, from `below` under it to `above`
-// over it, all marked measured (confidence 1).
-TriangleMesh with_crotch_wall(const ShippedBody& body, double half_length, double below, double above) {
+// over it, all marked measured (confidence 1); its side walls in `layers` rows.
+TriangleMesh with_crotch_wall(const ShippedBody& body, double half_length, double below, double above,
+                              int layers = 8) {
   const Eigen::Vector3d crotch = body.measured.landmark("crotch")->position;
   std::vector<Eigen::Vector2d> wall;
   for (const Eigen::Vector2d& p : testing::circle(1, {0, 0}, 64))
     wall.emplace_back(crotch.x() + 2.5 * p.x(), crotch.z() + half_length * p.y());
   TriangleMesh mesh = testing::merged(
-      body.mesh, testing::prism(wall, {crotch.x(), crotch.z()}, crotch.y() - below, crotch.y() + above));
+      body.mesh, testing::prism(wall, {crotch.x(), crotch.z()}, crotch.y() - below, crotch.y() + above, layers));
   mesh.confidence.assign(mesh.vertices.size(), 1.f);
   return mesh;
 }
@@ -996,6 +997,29 @@ TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
   EXPECT_NEAR(filled->find("crotch_height")->value_mm, clean, 1.0);
 }
 
+TEST(BodyMeasurements, AShortMeasuredStretchOnTheBridgeIsWhereTheCrotchIs) {
+  // Where a scan's bridge meets the skin, the midline's crossing runs in and out of
+  // the filled patch: measured stretches half a millimetre tall lie between
+  // unmeasured ones (male_average, tiered rig: measured at 812.3-812.8 and from
+  // 813.9 up). The first is the crotch, wherever it falls. Here the filled wall of
+  // AFilledBridgeBetweenTheThighsIsNoCrotch, in rows 0.25 mm apart, is measured
+  // only in its two rows 3.5 and 3.75 mm above its foot (the stretch where the
+  // interpolated confidence is at least 0.5: 3.375-3.875 mm). A walk up in whole
+  // millimetres from the foot steps over it and finds the skin 25 mm higher.
+  const ShippedBody* body = male_average();
+  ASSERT_TRUE(body);
+  const double clean = body->measured.find("crotch_height")->value_mm;
+  const double foot = body->measured.landmark("crotch")->position.y() - 25;
+  TriangleMesh mesh = with_crotch_wall(*body, 30, 25, 5, 120);
+  for (size_t i = body->mesh.vertices.size(); i < mesh.vertices.size(); ++i) {
+    const double up = mesh.vertices[i].y() - foot;
+    mesh.confidence[i] = std::abs(up - 3.5) < 0.01 || std::abs(up - 3.75) < 0.01 ? 1.f : 0.f;
+  }
+  auto b = measure_body(mesh);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  EXPECT_NEAR(b->find("crotch_height")->value_mm, clean - 25 + 3.375, 0.15);
+}
+
 TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
   // No camera sees the top of the armpit, and hole filling can join arm and flank
   // below it (male_average, tiered rig: 9 mm below the truth's junction). Here the
@@ -1026,6 +1050,35 @@ TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
     EXPECT_LT(chest_y, std::min(left.y(), right.y()));
     // Up to 6 mm higher, about 1.2 mm of girth per mm; round an arm too, 200 mm more.
     EXPECT_NEAR(b->find("chest_girth")->value_mm, clean.find("chest_girth")->value_mm, 10.0) << "band " << band;
+  }
+}
+
+TEST(BodyMeasurements, OneArmpitReadHigherMovesTheChestHalfAsFar) {
+  // Each armpit's vault is read where a scan's measured skin begins, a few mm off
+  // on either side, independently (male_heavy, tiered rig: the left 1.9 mm apart
+  // between two scans, the right 0.7). The chest is cut under the two vaults' mean
+  // level, so one side's error moves it half as far, and still under both arms'
+  // own loops. Here one armpit's skin is marked invented for 6 mm above its
+  // junction: that armpit rises 6 mm, the chest half that.
+  const ShippedBody* body = male_average();
+  ASSERT_TRUE(body);
+  const BodyMeasurements& clean = body->measured;
+  const double chest_y = clean.find("chest_girth")->path.front().y();
+  for (const char* name : {"armpit_left", "armpit_right"}) {
+    const Eigen::Vector3d a = clean.landmark(name)->position;
+    TriangleMesh mesh = body->mesh;
+    mesh.confidence.assign(mesh.vertices.size(), 1.f);
+    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+      const Vec3f& v = mesh.vertices[i];
+      if (std::abs(v.x() - a.x()) < 25 && v.y() > a.y() - 1 && v.y() < a.y() + 6) mesh.confidence[i] = 0.f;
+    }
+    auto b = measure_body(mesh);
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    const double rise = b->landmark(name)->position.y() - a.y();
+    EXPECT_NEAR(rise, 6, 1.0) << name;
+    const double y = b->find("chest_girth")->path.front().y();
+    EXPECT_NEAR(y - chest_y, rise / 2, 0.75) << name;
+    EXPECT_LT(y, std::min(b->landmark("armpit_left")->position.y(), b->landmark("armpit_right")->position.y()));
   }
 }
 
