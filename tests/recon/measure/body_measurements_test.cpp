@@ -1059,7 +1059,7 @@ TEST(BodyMeasurements, OneArmpitReadHigherMovesTheChestHalfAsFar) {
   // between two scans, the right 0.7). The chest is cut under the two vaults' mean
   // level, so one side's error moves it half as far, and still under both arms'
   // own loops. Here one armpit's skin is marked invented for 6 mm above its
-  // junction: that armpit rises 6 mm, the chest half that.
+  // junction: that armpit rises about 5.5 mm, the chest half that.
   const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const BodyMeasurements& clean = body->measured;
