@@ -1071,10 +1071,11 @@ class Finder {
     // Each vault is read where a scan's measured skin begins, a few mm off on either
     // side independently, and there the tape grows about 1 mm per mm of height; the
     // lower of the two put the chest's level 1.9 mm apart between two scans of
-    // male_heavy (tiered rig; the mean 0.9, the girths 1.3 mm apart). Under the mean the tape is under both vaults while
-    // they differ by less than 1 % of the height. And below where either arm's own
-    // loop ends: above it, where the armpit's top was a filled bridge (find_armpit),
-    // the cut's loop holds that arm too.
+    // male_heavy (tiered rig; the mean 0.9, the girths 1.3 mm apart). Under the mean
+    // the tape is under both vaults while they differ by less than 1 % of the
+    // height. And below where either arm's own loop ends: above it, where the
+    // armpit's top was a filled bridge (find_armpit), the cut's loop holds that arm
+    // too.
     const double chest_y =
         std::min(0.5 * (vault_y_[0] + vault_y_[1]) - 0.005 * h_, std::min(arm_apart_y_[0], arm_apart_y_[1]) - 0.5);
     girth("chest_girth", "Chest girth", "5.3.6", level_girth(chest_y, near(chest_y)), {"armpit_left", "armpit_right"},

@@ -1005,7 +1005,7 @@ TEST(BodyMeasurements, AShortMeasuredStretchOnTheBridgeIsWhereTheCrotchIs) {
   // AFilledBridgeBetweenTheThighsIsNoCrotch, in rows 0.25 mm apart, is measured
   // only in its two rows 3.5 and 3.75 mm above its foot (the stretch where the
   // interpolated confidence is at least 0.5: 3.375-3.875 mm). A walk up in whole
-  // millimetres from the foot steps over it and finds the skin 25 mm higher.
+  // millimetres from the foot steps over it and finds the skin, 25 mm above the foot.
   const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const double clean = body->measured.find("crotch_height")->value_mm;
@@ -1020,12 +1020,24 @@ TEST(BodyMeasurements, AShortMeasuredStretchOnTheBridgeIsWhereTheCrotchIs) {
   EXPECT_NEAR(b->find("crotch_height")->value_mm, clean - 25 + 3.375, 0.15);
 }
 
+// `mesh` all measured but for the skin within 25 mm (along X) of each junction,
+// from 1 mm under it to `band` over it, marked invented.
+TriangleMesh with_invented_above(TriangleMesh mesh, const std::vector<Eigen::Vector3d>& junctions, double band) {
+  mesh.confidence.assign(mesh.vertices.size(), 1.f);
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3f& v = mesh.vertices[i];
+    for (const Eigen::Vector3d& a : junctions)
+      if (std::abs(v.x() - a.x()) < 25 && v.y() > a.y() - 1 && v.y() < a.y() + band) mesh.confidence[i] = 0.f;
+  }
+  return mesh;
+}
+
 TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
   // No camera sees the top of the armpit, and hole filling can join arm and flank
   // below it (male_average, tiered rig: 9 mm below the truth's junction). Here the
   // true body's skin round both junctions is marked invented for 6 mm above them:
   // the armpits rise to where it is measured again, and the chest, cut just under
-  // the lower armpit, stays below both arms' own loops. Marked for 30 mm (beyond 1 %
+  // the armpits, stays below both arms' own loops. Marked for 30 mm (beyond 1 %
   // of the height: the thesis rig sees no armpit at all) they stay at the junction.
   const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
@@ -1033,14 +1045,7 @@ TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
   const Eigen::Vector3d left = clean.landmark("armpit_left")->position;
   const Eigen::Vector3d right = clean.landmark("armpit_right")->position;
   for (double band : {6.0, 30.0}) {
-    TriangleMesh mesh = body->mesh;
-    mesh.confidence.assign(mesh.vertices.size(), 1.f);
-    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-      const Vec3f& v = mesh.vertices[i];
-      for (const Eigen::Vector3d& a : {left, right})
-        if (std::abs(v.x() - a.x()) < 25 && v.y() > a.y() - 1 && v.y() < a.y() + band) mesh.confidence[i] = 0.f;
-    }
-    auto b = measure_body(mesh);
+    auto b = measure_body(with_invented_above(body->mesh, {left, right}, band));
     ASSERT_TRUE(b.ok()) << b.status().message();
     const double rise = band < 17 ? band : 0;
     for (const char* name : {"armpit_left", "armpit_right"})
@@ -1066,13 +1071,7 @@ TEST(BodyMeasurements, OneArmpitReadHigherMovesTheChestHalfAsFar) {
   const double chest_y = clean.find("chest_girth")->path.front().y();
   for (const char* name : {"armpit_left", "armpit_right"}) {
     const Eigen::Vector3d a = clean.landmark(name)->position;
-    TriangleMesh mesh = body->mesh;
-    mesh.confidence.assign(mesh.vertices.size(), 1.f);
-    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-      const Vec3f& v = mesh.vertices[i];
-      if (std::abs(v.x() - a.x()) < 25 && v.y() > a.y() - 1 && v.y() < a.y() + 6) mesh.confidence[i] = 0.f;
-    }
-    auto b = measure_body(mesh);
+    auto b = measure_body(with_invented_above(body->mesh, {a}, 6));
     ASSERT_TRUE(b.ok()) << b.status().message();
     const double rise = b->landmark(name)->position.y() - a.y();
     EXPECT_NEAR(rise, 6, 1.0) << name;
