@@ -49,6 +49,10 @@ constexpr double kRidgeBand = 10;
 // A join (the legs' at the crotch, an arm's with the flank) counts where it has
 // grown this long front to back (a fraction of the height; Finder::widened).
 constexpr double kJoinDepth = 0.015;
+// Above a filled bridge, measured skin begins where the midline's crossing is
+// measured over at least half of this height (mm) around the level
+// (Finder::above_bridge).
+constexpr double kBridgeWindowMm = 3;
 // The thigh's tape is taken this far (a fraction of the height) below the crotch
 // or lower (measure_leg).
 constexpr double kThighBelowCrotch = 0.015;
@@ -477,25 +481,45 @@ class Finder {
 
   // Up from where two parts join at height y: where the joined loop crosses the
   // vertical plane X = x on invented surface only, front and back (hole filling's
-  // bridge across a gap no camera sees into), the first level above whose crossing,
-  // front or back, is measured skin, within `reach`, bisected. Else y: the join is
-  // measured, or the bridge reaches farther than that (wholly unseen).
-  // The walk goes up in quarter millimetres: where the bridge meets the skin, the
-  // crossing runs in and out of the filled patch, and measured stretches half a
-  // millimetre tall lie between unmeasured ones (male_average, tiered rig: measured
-  // at 812.3-812.8 and from 813.9 up; a walk in whole millimetres stepped over the
-  // first stretch on one scan and not on its repeat, and the crotch heights were
-  // 2.0 mm apart).
+  // bridge across a gap no camera sees into), the first level above which the
+  // crossing is measured skin: where the crossing's confidence (front or back, the
+  // higher), sampled every quarter millimetre and averaged over kBridgeWindowMm
+  // around the level, reaches kMeasuredConfidence (interpolated), within `reach`.
+  // Else y: the join is measured, or the bridge reaches farther than that (wholly
+  // unseen). Where the bridge meets the skin, the crossing runs in and out of the
+  // filled patch, and islands of measured surface 0.5-1.25 mm tall lie below the
+  // skin, up to 5 mm below it (tiered rig: male_average, male_heavy, female_heavy).
+  // The first measured level, walked in whole millimetres, stepped over such an
+  // island on one scan and not on its repeat (male_average's crotch heights 2.0 mm
+  // apart); walked finely, it took the island 5 mm under male_heavy's crotch. Over
+  // the window an island counts for its share, and a sharp edge of skin is read
+  // where it is.
   double above_bridge(double y, double x, double reach) {
-    const auto measured = [&](double yy) {
+    const auto confidence = [&](double yy) -> double {
       const Ring* m = midline(rings(yy), xc_);
-      return !m || m->crossing_confidence(x) >= kMeasuredConfidence;
+      return m ? m->crossing_confidence(x) : 1.0;
     };
-    if (measured(y + 0.5)) return y;
+    if (confidence(y + 0.5) >= kMeasuredConfidence) return y;
     constexpr double kStep = 0.25;
-    prefetch(y, y + reach, kStep);
-    for (double yy = y + kStep; yy <= y + reach; yy += kStep)
-      if (measured(yy)) return bisect(yy - kStep, yy, measured, 0.05);
+    const auto half = static_cast<size_t>(std::lround(kBridgeWindowMm / 2 / kStep));
+    // From y + 0.5 up (the join's own level may lie just under the joined loop);
+    // below it the window sees what y + 0.5 has, invented surface.
+    const double y0 = y + 0.5;
+    prefetch(y0, y0 + reach + kBridgeWindowMm, kStep);
+    std::vector<double> c(half, confidence(y0));
+    for (double yy = y0; yy <= y0 + reach + kBridgeWindowMm / 2; yy += kStep) c.push_back(confidence(yy));
+    double sum = 0, prev = 0;
+    for (size_t i = 0; i < 2 * half && i < c.size(); ++i) sum += c[i];
+    for (size_t i = half; i + half < c.size(); ++i) {
+      sum += c[i + half];
+      const double mean = sum / static_cast<double>(2 * half + 1);
+      if (mean >= kMeasuredConfidence) {
+        const double at = static_cast<double>(i - half) - 1 + (kMeasuredConfidence - prev) / (mean - prev);
+        return y0 + std::max(0.0, at) * kStep;
+      }
+      prev = mean;
+      sum -= c[i - half];
+    }
     return y;
   }
 

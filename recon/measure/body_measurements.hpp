@@ -37,7 +37,7 @@
 
 namespace bodyscan {
 
-inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-12";
+inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-13";
 
 // A mesh vertex at or above this confidence is measured skin; below, hole filling
 // invented it.

@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <random>
+#include <tuple>
 
 #include "recon/geometry/skin_noise.hpp"
 #include "recon/io/ply.hpp"
@@ -997,27 +998,33 @@ TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
   EXPECT_NEAR(filled->find("crotch_height")->value_mm, clean, 1.0);
 }
 
-TEST(BodyMeasurements, AShortMeasuredStretchOnTheBridgeIsWhereTheCrotchIs) {
+TEST(BodyMeasurements, AMeasuredIslandOnTheBridgeIsNoCrotchAndAStretchOfSkinIs) {
   // Where a scan's bridge meets the skin, the midline's crossing runs in and out of
-  // the filled patch: measured stretches half a millimetre tall lie between
-  // unmeasured ones (male_average, tiered rig: measured at 812.3-812.8 and from
-  // 813.9 up). The first is the crotch, wherever it falls. Here the filled wall of
-  // AFilledBridgeBetweenTheThighsIsNoCrotch, in rows 0.25 mm apart, is measured
-  // only in its two rows 3.5 and 3.75 mm above its foot (the stretch where the
-  // interpolated confidence is at least 0.5: 3.375-3.875 mm). A walk up in whole
-  // millimetres from the foot steps over it and finds the skin, 25 mm above the foot.
+  // the filled patch: islands of measured surface 0.5-1.25 mm tall lie below the
+  // skin, up to 5 mm below it (male_heavy, tiered rig: at 817.5 and 821 mm, the skin
+  // from 822.6). Here the filled wall of AFilledBridgeBetweenTheThighsIsNoCrotch, in
+  // rows 0.25 mm apart, is measured only in rows `from` to `to` mm above its foot.
+  // An island of three rows (the interpolated confidence at least 0.5 over 0.75
+  // mm, 2.6-3.4 mm above the foot) is no crotch: it stays where the skin joins, 25
+  // mm above the foot. Both earlier rules took the island: the first measured level
+  // walked in quarter millimetres, and walked in whole ones from the foot (which
+  // stepped over such islands or not by where its steps fell). A stretch 2 mm tall
+  // is skin: the crotch is at its foot.
   const ShippedBody* body = male_average();
   ASSERT_TRUE(body);
   const double clean = body->measured.find("crotch_height")->value_mm;
   const double foot = body->measured.landmark("crotch")->position.y() - 25;
-  TriangleMesh mesh = with_crotch_wall(*body, 30, 25, 5, 120);
-  for (size_t i = body->mesh.vertices.size(); i < mesh.vertices.size(); ++i) {
-    const double up = mesh.vertices[i].y() - foot;
-    mesh.confidence[i] = std::abs(up - 3.5) < 0.01 || std::abs(up - 3.75) < 0.01 ? 1.f : 0.f;
+  for (const auto& [from, to, expected, tolerance] :
+       {std::tuple{2.75, 3.25, clean, 1.0}, std::tuple{10.0, 12.0, clean - 25 + 10, 0.3}}) {
+    TriangleMesh mesh = with_crotch_wall(*body, 30, 25, 5, 120);
+    for (size_t i = body->mesh.vertices.size(); i < mesh.vertices.size(); ++i) {
+      const double up = mesh.vertices[i].y() - foot;
+      mesh.confidence[i] = up > from - 0.01 && up < to + 0.01 ? 1.f : 0.f;
+    }
+    auto b = measure_body(mesh);
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    EXPECT_NEAR(b->find("crotch_height")->value_mm, expected, tolerance) << "measured " << from << "-" << to << " mm";
   }
-  auto b = measure_body(mesh);
-  ASSERT_TRUE(b.ok()) << b.status().message();
-  EXPECT_NEAR(b->find("crotch_height")->value_mm, clean - 25 + 3.375, 0.15);
 }
 
 // `mesh` all measured but for the skin within 25 mm (along X) of each junction,
