@@ -315,7 +315,7 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   const size_t n = cloud.size();
   if (cloud.frame.size() != n || cloud.laser.size() != n)
     return invalid_argument("sway: the cloud needs each point's frame and laser");
-  if (o.knot_frames < 1 || o.radius_mm <= 0 || o.min_frame_gap < 1 || o.iterations < 1 || o.min_group < 3)
+  if (o.knot_frames < 1 || o.radius_mm <= 0 || o.min_frame_gap < 1 || o.iterations < 1 || !(o.converged_mm >= 0) || o.min_group < 3)
     return invalid_argument("sway: bad options");
   if (o.regularizations.empty() || (o.cv_folds >= 2 && !(o.cv_block_mm > 0)) || o.slow_frames < 1)
     return invalid_argument("sway: bad options (no hold to try, or no cubes to fold by)");
@@ -447,12 +447,17 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
     est.regularization = chosen;
     auto fit = solve_path(all, chosen, o, m, axes, slow);
     if (!fit.ok()) return fit.status();
+    double moved_most = 0;
+    for (size_t k = 0; k < m; ++k) moved_most = std::max(moved_most, ((*fit)[k] - x[k]).norm());
     x = std::move(*fit);
+    est.iterations = it + 1;
+    est.last_move_mm = moved_most;
     est.knots = x;
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
       moved[i] = cloud.frame[i] >= 0 ? (cloud.positions[i].cast<double>() - est.at(cloud.frame[i])).cast<float>()
                                      : cloud.positions[i];
     });
+    if (moved_most <= o.converged_mm) break;
   }
   est.pairs = pairs.size();
   if (pairs.empty()) {

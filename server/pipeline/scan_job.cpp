@@ -165,6 +165,8 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
     for (const Eigen::Vector3d& k : w.knots) path.push_back({k.x(), k.y(), k.z()});
     j["sway"] = {{"peak_mm", w.peak_mm},
                  {"pairs", w.pairs},
+                 {"iterations", w.iterations},
+                 {"last_move_mm", w.last_move_mm},
                  {"pair_rms_before_mm", w.rms_before_mm},
                  {"pair_rms_after_mm", w.rms_after_mm},
                  {"first_frame", w.first_frame},
