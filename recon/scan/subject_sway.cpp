@@ -315,7 +315,8 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   const size_t n = cloud.size();
   if (cloud.frame.size() != n || cloud.laser.size() != n)
     return invalid_argument("sway: the cloud needs each point's frame and laser");
-  if (o.knot_frames < 1 || o.radius_mm <= 0 || o.min_frame_gap < 1 || o.iterations < 1 || !(o.converged_mm >= 0) || o.min_group < 3)
+  if (o.knot_frames < 1 || o.radius_mm <= 0 || o.min_frame_gap < 1 || o.iterations < 1 || !(o.converged_mm >= 0) ||
+      o.min_group < 3)
     return invalid_argument("sway: bad options");
   if (o.regularizations.empty() || (o.cv_folds >= 2 && !(o.cv_block_mm > 0)) || o.slow_frames < 1)
     return invalid_argument("sway: bad options (no hold to try, or no cubes to fold by)");
