@@ -413,33 +413,71 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
   });
 }
 
-void blur(std::vector<float>& img, int w, int h, double sigma) {
-  if (sigma <= 0) return;
+namespace {
+
+// The lens's Gaussian, normalised, 3 sigma either side (at least one pixel).
+std::vector<float> blur_kernel(double sigma) {
   const int r = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
   std::vector<float> k(static_cast<size_t>(2 * r + 1));
   float sum = 0;
   for (int i = -r; i <= r; ++i) sum += k[static_cast<size_t>(i + r)] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
   for (float& v : k) v /= sum;
+  return k;
+}
+
+// The blur's two passes over columns x0..x1 of row y (edges clamp). The whole
+// image and a moving subject's part of it (Renderer::base_irradiance) go through
+// the same code, so a part redrawn is what the whole would have been to the bit.
+void blur_across(const std::vector<float>& in, std::vector<float>& out, int w, int y, const std::vector<float>& k,
+                 int x0, int x1) {
+  const int r = static_cast<int>(k.size() / 2);
+  const float* row = in.data() + static_cast<size_t>(y) * w;
+  float* o = out.data() + static_cast<size_t>(y) * w;
+  for (int x = x0; x <= x1; ++x) {
+    float acc = 0;
+    for (int i = -r; i <= r; ++i) acc += k[static_cast<size_t>(i + r)] * row[std::clamp(x + i, 0, w - 1)];
+    o[x] = acc;
+  }
+}
+void blur_down(const std::vector<float>& in, std::vector<float>& out, int w, int h, int y,
+               const std::vector<float>& k, int x0, int x1) {
+  const int r = static_cast<int>(k.size() / 2);
+  float* o = out.data() + static_cast<size_t>(y) * w;
+  for (int x = x0; x <= x1; ++x) o[x] = 0;
+  for (int i = -r; i <= r; ++i) {
+    const float* row = in.data() + static_cast<size_t>(std::clamp(y + i, 0, h - 1)) * w;
+    const float kk = k[static_cast<size_t>(i + r)];
+    for (int x = x0; x <= x1; ++x) o[x] += kk * row[x];
+  }
+}
+
+// Spans of columns (first, last): the spans of rows y - reach .. y + reach, each
+// widened by `widen` within 0 .. w - 1, overlapping and touching ones joined.
+using Spans = std::vector<std::pair<int, int>>;
+Spans spans_near(const std::vector<Spans>& rows, int y, int reach, int widen, int w) {
+  Spans out;
+  const int h = static_cast<int>(rows.size());
+  for (int yy = std::max(0, y - reach); yy <= std::min(h - 1, y + reach); ++yy)
+    for (const auto& [a, b] : rows[static_cast<size_t>(yy)]) out.emplace_back(std::max(0, a - widen), std::min(w - 1, b + widen));
+  std::sort(out.begin(), out.end());
+  size_t m = 0;
+  for (const auto& sp : out) {
+    if (m > 0 && sp.first <= out[m - 1].second + 1) out[m - 1].second = std::max(out[m - 1].second, sp.second);
+    else out[m++] = sp;
+  }
+  out.resize(m);
+  return out;
+}
+
+}  // namespace
+
+void blur(std::vector<float>& img, int w, int h, double sigma) {
+  if (sigma <= 0) return;
+  const std::vector<float> k = blur_kernel(sigma);
   std::vector<float> tmp(img.size());
-  // Rows, then columns; edges clamp.
-  tbb::parallel_for(0, h, [&](int y) {
-    const float* in = img.data() + static_cast<size_t>(y) * w;
-    float* out = tmp.data() + static_cast<size_t>(y) * w;
-    for (int x = 0; x < w; ++x) {
-      float acc = 0;
-      for (int i = -r; i <= r; ++i) acc += k[static_cast<size_t>(i + r)] * in[std::clamp(x + i, 0, w - 1)];
-      out[x] = acc;
-    }
-  });
-  tbb::parallel_for(0, h, [&](int y) {
-    float* out = img.data() + static_cast<size_t>(y) * w;
-    for (int x = 0; x < w; ++x) out[x] = 0;
-    for (int i = -r; i <= r; ++i) {
-      const float* in = tmp.data() + static_cast<size_t>(std::clamp(y + i, 0, h - 1)) * w;
-      const float kk = k[static_cast<size_t>(i + r)];
-      for (int x = 0; x < w; ++x) out[x] += kk * in[x];
-    }
-  });
+  // Rows, then columns.
+  tbb::parallel_for(0, h, [&](int y) { blur_across(img, tmp, w, y, k, 0, w - 1); });
+  tbb::parallel_for(0, h, [&](int y) { blur_down(tmp, img, w, h, y, k, 0, w - 1); });
 }
 
 Frame expose(const std::vector<float>& irradiance, const CameraDescription& camera, const Exposure& exposure,
@@ -487,21 +525,64 @@ const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Li
   BaseCache& cache = base_[key];
   if (cache.version == scene.version() && !cache.irradiance.empty()) return cache.irradiance;
   const int w = camera_.width, h = camera_.height;
-  cache.irradiance.assign(static_cast<size_t>(w) * h, 0.f);
-  tbb::parallel_for(0, h, [&](int y) {
-    for (int x = 0; x < w; ++x) {
+  const size_t n = static_cast<size_t>(w) * h;
+  auto light = [&](int y, int x0, int x1) {
+    for (int x = x0; x <= x1; ++x) {
       const size_t i = static_cast<size_t>(y) * w + x;
-      cache.irradiance[i] = static_cast<float>(light_at(scene, lighting, sim_, model_, rays_, hit[i], w, x, y));
+      cache.unblurred[i] = static_cast<float>(light_at(scene, lighting, sim_, model_, rays_, hit[i], w, x, y));
     }
-  });
-  blur(cache.irradiance, w, h, camera_.blur_px);
+  };
+  const bool blurs = camera_.blur_px > 0;
+  const std::vector<float> k = blurs ? blur_kernel(camera_.blur_px) : std::vector<float>{1.f};
+  const int r = static_cast<int>(k.size() / 2);
+  // The same scene posed anew: only the part of the image hits() casts again as the
+  // subject moves can change, and the blur carries that change r pixels farther.
+  // A swaying scan drew the whole image's room and frame lights (each frame light's
+  // pixels with 16 rays) and blurred it for every camera at every frame.
+  if (moving_.size() == static_cast<size_t>(h) && moving_range_ == (scene.version() >> 32) &&
+      cache.unblurred.size() == n && (cache.version >> 32) == (scene.version() >> 32)) {
+    tbb::parallel_for(0, h, [&](int y) {
+      for (const auto& [a, b] : moving_[static_cast<size_t>(y)]) {
+        light(y, a, b);
+        if (blurs) blur_across(cache.unblurred, cache.across, w, y, k, std::max(0, a - r), std::min(w - 1, b + r));
+      }
+    });
+    tbb::parallel_for(0, h, [&](int y) {
+      for (const auto& [a, b] : spans_near(moving_, y, r, r, w)) {
+        if (blurs) {
+          blur_down(cache.across, cache.irradiance, w, h, y, k, a, b);
+        } else {
+          const size_t row = static_cast<size_t>(y) * w;
+          std::copy(cache.unblurred.begin() + static_cast<std::ptrdiff_t>(row + a),
+                    cache.unblurred.begin() + static_cast<std::ptrdiff_t>(row + b + 1),
+                    cache.irradiance.begin() + static_cast<std::ptrdiff_t>(row + a));
+        }
+      }
+    });
+    cache.version = scene.version();
+    return cache.irradiance;
+  }
+  // The whole image; a moving scene keeps the unblurred image and the blur's first
+  // pass for the next pose.
+  cache.unblurred.assign(n, 0.f);
+  tbb::parallel_for(0, h, [&](int y) { light(y, 0, w - 1); });
+  cache.irradiance = cache.unblurred;
+  if (blurs) {
+    cache.across.assign(n, 0.f);
+    tbb::parallel_for(0, h, [&](int y) { blur_across(cache.unblurred, cache.across, w, y, k, 0, w - 1); });
+    tbb::parallel_for(0, h, [&](int y) { blur_down(cache.across, cache.irradiance, w, h, y, k, 0, w - 1); });
+  }
+  if (!scene.moves()) {
+    cache.unblurred = {};
+    cache.across = {};
+  }
   cache.version = scene.version();
   return cache.irradiance;
 }
 
 void Renderer::forget_lights() {
   std::lock_guard<std::mutex> lock(cache_mutex_);
-  for (BaseCache& c : base_) c.irradiance.clear();
+  for (BaseCache& c : base_) c = BaseCache{};
 }
 
 const std::vector<Renderer::CachedHit>& Renderer::hits(const Scene& scene) const {
@@ -521,29 +602,38 @@ const std::vector<Renderer::CachedHit>& Renderer::hits(const Scene& scene) const
   if (hits_.size() == n && (hits_version_ >> 32) == (scene.version() >> 32)) {
     const SubjectMotion& m = scene.rig().simulation.motion;
     const double motion_mm = 2 * (1.12 * m.sway_mm + m.breathing_mm) + 1;
-    double nearest = std::numeric_limits<double>::infinity();
-    std::vector<int> lo(static_cast<size_t>(h), w), hi(static_cast<size_t>(h), -1);
-    for (int y = 0; y < h; ++y)
+    // Per row, the runs of pixels that saw the subject, and the nearest of them.
+    std::vector<Spans> runs(static_cast<size_t>(h));
+    std::vector<double> nearest_in(static_cast<size_t>(h), std::numeric_limits<double>::infinity());
+    tbb::parallel_for(0, h, [&](int y) {
+      Spans& row = runs[static_cast<size_t>(y)];
       for (int x = 0; x < w; ++x) {
         const CachedHit& c = hits_[static_cast<size_t>(y) * w + x];
         if (c.surface != Surface::kSubject) continue;
-        lo[static_cast<size_t>(y)] = std::min(lo[static_cast<size_t>(y)], x);
-        hi[static_cast<size_t>(y)] = x;
-        nearest = std::min(nearest, (c.position.cast<double>() - model_.centre()).norm());
+        if (!row.empty() && row.back().second == x - 1) row.back().second = x;
+        else row.emplace_back(x, x);
+        nearest_in[static_cast<size_t>(y)] =
+            std::min(nearest_in[static_cast<size_t>(y)], (c.position.cast<double>() - model_.centre()).norm());
       }
+    });
+    const double nearest = *std::min_element(nearest_in.begin(), nearest_in.end());
     if (std::isfinite(nearest)) {
       const int reach = static_cast<int>(std::ceil(motion_mm * model_.fx() / nearest)) + 1;
+      // Any two poses differ only within the motion's range, so these spans hold
+      // every pixel that can differ between any two poses: base_irradiance redraws
+      // only them.
+      moving_.assign(static_cast<size_t>(h), {});
       tbb::parallel_for(0, h, [&](int y) {
-        int a = w, b = -1;
-        for (int yy = std::max(0, y - reach); yy <= std::min(h - 1, y + reach); ++yy)
-          if (hi[static_cast<size_t>(yy)] >= 0)
-            a = std::min(a, lo[static_cast<size_t>(yy)]), b = std::max(b, hi[static_cast<size_t>(yy)]);
-        for (int x = std::max(0, a - reach); x <= std::min(w - 1, b + reach); ++x) cast(static_cast<size_t>(y) * w + x);
+        moving_[static_cast<size_t>(y)] = spans_near(runs, y, reach, reach, w);
+        for (const auto& [a, b] : moving_[static_cast<size_t>(y)])
+          for (int x = a; x <= b; ++x) cast(static_cast<size_t>(y) * w + x);
       });
+      moving_range_ = scene.version() >> 32;
       hits_version_ = scene.version();
       return hits_;
     }
   }
+  moving_.clear();
   hits_.assign(n, CachedHit{});
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) cast(static_cast<size_t>(y) * w + x);

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <mutex>
+#include <utility>
 #include <vector>
 
 #include "hw/camera.hpp"
@@ -86,9 +87,11 @@ class Renderer {
   static constexpr int kLaserSubpixels = 4;
   // The irradiance without lasers, per room/frame light state, per scene version.
   const std::vector<float>& base_irradiance(const Scene& scene, const Lighting& lighting) const;
+  // A moving scene's cache also keeps the image before the blur and after its first
+  // (across) pass, so a new pose redraws only the part of the image it can change.
   struct BaseCache {
     uint64_t version = 0;
-    std::vector<float> irradiance;
+    std::vector<float> irradiance, unblurred, across;
   };
 
   CameraDescription camera_;
@@ -98,6 +101,10 @@ class Renderer {
   mutable std::mutex cache_mutex_;
   mutable std::vector<CachedHit> hits_;
   mutable uint64_t hits_version_ = 0;
+  // Per image row, the spans of columns (first, last) a moving subject can change
+  // in the scene range moving_range_ (no rows: not known, the whole image is redrawn).
+  mutable std::vector<std::vector<std::pair<int, int>>> moving_;
+  mutable uint64_t moving_range_ = 0;
   mutable BaseCache base_[8];  // by room, front and back frame lights
 };
 

@@ -266,26 +266,45 @@ TEST(Renderer, AStripeSeenAtAGrazingAngleLiesOnTheSurface) {
               median(frontal), frontal.size(), median(grazing), grazing.size());
 }
 
-// A swaying subject is cast again only where it was or could have come to be: the
-// frame a renderer draws after the subject moved is the one a fresh renderer draws.
+// A swaying subject is cast again only where it was or could have come to be, and
+// its room and frame lights are drawn again only there: the frame a renderer draws
+// after the subject moved is the one a fresh renderer draws, to the bit, for a
+// lighting last drawn at the pose before and for one last drawn poses ago, with the
+// lens's blur and without.
 TEST(Renderer, ASwayingSubjectIsRecastWhereItMovesAndNowhereElseChanges) {
-  RigDescription rig = test_rig();
-  rig.simulation.motion.sway_mm = 8;
-  rig.simulation.motion.sway_hz = 0.25;
-  auto scene = Scene::create(rig, cylinder(60, 0, 1400, 360));
-  ASSERT_TRUE(scene.ok()) << scene.status().message();
-  ASSERT_TRUE((**scene).moves());
-  Lighting lit;
-  lit.room_lights = true;
-  lit.lasers.push_back({&rig.lasers[0], 4});
-  const Renderer kept(rig.cameras[0], rig.simulation);
-  const std::vector<float> at_rest = kept.irradiance(**scene, lit);
-  for (double t : {1.0, 2.0, 0.3}) {
-    (**scene).set_time(t);
-    const Renderer fresh(rig.cameras[0], rig.simulation);
-    const std::vector<float> a = kept.irradiance(**scene, lit), b = fresh.irradiance(**scene, lit);
-    EXPECT_EQ(a, b) << "at " << t << " s";
-    EXPECT_NE(a, at_rest) << "at " << t << " s: the subject did not move";
+  for (double blur : {0.7, 0.0}) {
+    RigDescription rig = test_rig();
+    rig.simulation.motion.sway_mm = 8;
+    rig.simulation.motion.sway_hz = 0.25;
+    rig.cameras[0].blur_px = blur;
+    // Wide enough to see the bottom frame's front pole and its lights beside the subject.
+    rig.cameras[0].focal_mm = 4;
+    rig.cameras[0].look_at = Vec3d(0, 600, 0);
+    auto scene = Scene::create(rig, cylinder(60, 0, 1400, 360));
+    ASSERT_TRUE(scene.ok()) << scene.status().message();
+    ASSERT_TRUE((**scene).moves());
+    Lighting lit;
+    lit.room_lights = true;
+    lit.lasers.push_back({&rig.lasers[0], 4});
+    Lighting framed = lit;
+    framed.front_frame_lights = framed.back_frame_lights = true;
+    const Renderer kept(rig.cameras[0], rig.simulation);
+    const std::vector<float> at_rest = kept.irradiance(**scene, lit);
+    const std::vector<float> framed_at_rest = kept.irradiance(**scene, framed);
+    EXPECT_NE(at_rest, framed_at_rest) << "no frame light in view";
+    int step = 0;
+    for (double t : {1.0, 2.0, 0.3, 2.7}) {
+      (**scene).set_time(t);
+      const Renderer fresh(rig.cameras[0], rig.simulation);
+      // The framed lighting is drawn every other pose only.
+      const bool both = ++step % 2 == 0;
+      const std::vector<float> a = kept.irradiance(**scene, lit), b = fresh.irradiance(**scene, lit);
+      EXPECT_EQ(a, b) << "at " << t << " s, blur " << blur;
+      EXPECT_NE(a, at_rest) << "at " << t << " s: the subject did not move";
+      if (both) {
+        EXPECT_EQ(kept.irradiance(**scene, framed), fresh.irradiance(**scene, framed)) << "at " << t << " s, blur " << blur;
+      }
+    }
   }
 }
 
