@@ -542,10 +542,13 @@ const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Li
   if (moving_.size() == static_cast<size_t>(h) && moving_range_ == (scene.version() >> 32) &&
       cache.unblurred.size() == n && (cache.version >> 32) == (scene.version() >> 32)) {
     tbb::parallel_for(0, h, [&](int y) {
-      for (const auto& [a, b] : moving_[static_cast<size_t>(y)]) {
-        light(y, a, b);
-        if (blurs) blur_across(cache.unblurred, cache.across, w, y, k, std::max(0, a - r), std::min(w - 1, b + r));
-      }
+      // A row's spans all drawn before any is blurred across: two spans may lie
+      // within the blur's reach of each other.
+      const Spans& spans = moving_[static_cast<size_t>(y)];
+      for (const auto& [a, b] : spans) light(y, a, b);
+      if (blurs)
+        for (const auto& [a, b] : spans)
+          blur_across(cache.unblurred, cache.across, w, y, k, std::max(0, a - r), std::min(w - 1, b + r));
     });
     tbb::parallel_for(0, h, [&](int y) {
       for (const auto& [a, b] : spans_near(moving_, y, r, r, w)) {
