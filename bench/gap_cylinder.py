@@ -1,0 +1,89 @@
+#!/usr/bin/python3
+"""The surface across an unseen strip of a wrist: a cylinder of radius 27 mm (a
+170 mm girth), 300 mm long along Y, sampled every 1.5 mm round and along, with a
+strip of GAP degrees round it left unseen over Y in [-40, 40] but for a stray
+point every 16 mm along and 6 mm round (as the tiered rig leaves the right wrist:
+docs/benchmarks.md §7, session 31). Each cloud is made into a closed surface by
+`bodyscan reconstruct --body` (normals from the points, as a scan's), then
+measured by `bodyscan measure --girth-y 0`.
+
+    bench/gap_cylinder.py [--bodyscan build/server/bodyscan] [--seed 1]
+
+Prints per case the radius's error (mean and largest, mm) over the strip's middle
+(|Y| < 20, within 20 degrees of its centre) and on the far side, and the tape's
+girth at Y = 0 against the true 169.65 mm. Uses Debian's python3-numpy
+(deploy/install-deps.sh --bench).
+"""
+import argparse
+import json
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+
+RADIUS = 27.0
+STEP = 1.5
+
+
+def cloud(gap_deg, noise, stray, rng):
+    na = int(2 * np.pi * RADIUS / STEP)
+    pts = []
+    for y in np.arange(-150, 150.01, STEP):
+        for i in range(na):
+            a = 2 * np.pi * i / na
+            deg = np.degrees(a)
+            if abs(y) < 40 and (deg < gap_deg / 2 or deg > 360 - gap_deg / 2):
+                if not (stray and abs((y + 150) % 16) < 0.75 and i % 4 == 0):
+                    continue
+            r = RADIUS + noise * rng.standard_normal()
+            pts.append((r * np.cos(a), y, r * np.sin(a)))
+    return np.array(pts)
+
+
+def write_ply(path, pts):
+    with open(path, "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex %d\n" % len(pts))
+        f.write("property float x\nproperty float y\nproperty float z\nend_header\n")
+        for p in pts:
+            f.write("%.4f %.4f %.4f\n" % tuple(p))
+
+
+def read_ply_vertices(path):
+    with open(path) as f:
+        lines = f.read().split("\n")
+    end = lines.index("end_header")
+    nv = int(next(l for l in lines if l.startswith("element vertex")).split()[-1])
+    return np.array([[float(x) for x in l.split()[:3]] for l in lines[end + 1:end + 1 + nv]])
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bodyscan", default="build/server/bodyscan")
+    ap.add_argument("--seed", type=int, default=1)
+    args = ap.parse_args()
+    rng = np.random.default_rng(args.seed)
+    true_girth = 2 * np.pi * RADIUS
+    print("gap (deg)  noise (mm)  stray points  strip: mean / largest (mm)  far side mean  girth at Y=0 (mm, off the truth)")
+    with tempfile.TemporaryDirectory() as tmp:
+        for gap, noise, stray in [(0, 0, False), (40, 0, False), (40, 0, True), (0, 0.3, False), (40, 0.3, True),
+                                  (60, 0.3, True)]:
+            src, out = os.path.join(tmp, "c.ply"), os.path.join(tmp, "m.ply")
+            write_ply(src, cloud(gap, noise, stray, rng))
+            subprocess.run([args.bodyscan, "reconstruct", src, "-o", out, "--body", "--ascii", "-q"], check=True)
+            v = read_ply_vertices(out)
+            r = np.hypot(v[:, 0], v[:, 2]) - RADIUS
+            a = np.degrees(np.arctan2(v[:, 2], v[:, 0]))
+            mid = np.abs(v[:, 1]) < 20
+            strip = mid & (np.abs(a) < 20)
+            far = mid & (np.abs(np.abs(a) - 180) < 30)
+            m = json.loads(subprocess.run([args.bodyscan, "measure", out, "--girth-y", "0"], check=True,
+                                          capture_output=True, text=True).stdout)
+            girth = m["measurements"][0]["value_mm"]
+            print("%9d  %10.1f  %12s  %+8.3f / %+6.3f  %+13.3f  %.2f (%+.2f)" %
+                  (gap, noise, "yes" if stray else "no", r[strip].mean(), r[strip].max(), r[far].mean(), girth,
+                   girth - true_girth))
+
+
+if __name__ == "__main__":
+    main()
