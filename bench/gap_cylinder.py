@@ -26,17 +26,17 @@ RADIUS = 27.0
 STEP = 1.5
 
 
-def cloud(gap_deg, noise, stray, rng):
+def cloud(gap_deg, noise, stray, quiet_strays, rng):
     na = int(2 * np.pi * RADIUS / STEP)
     pts = []
     for y in np.arange(-150, 150.01, STEP):
         for i in range(na):
             a = 2 * np.pi * i / na
             deg = np.degrees(a)
-            if abs(y) < 40 and (deg < gap_deg / 2 or deg > 360 - gap_deg / 2):
-                if not (stray and abs((y + 150) % 16) < 0.75 and i % 4 == 0):
-                    continue
-            r = RADIUS + noise * rng.standard_normal()
+            in_strip = abs(y) < 40 and (deg < gap_deg / 2 or deg > 360 - gap_deg / 2)
+            if in_strip and not (stray and abs((y + 150) % 16) < 0.75 and i % 4 == 0):
+                continue
+            r = RADIUS + (0 if in_strip and quiet_strays else noise) * rng.standard_normal()
             pts.append((r * np.cos(a), y, r * np.sin(a)))
     return np.array(pts)
 
@@ -65,11 +65,13 @@ def main():
     rng = np.random.default_rng(args.seed)
     true_girth = 2 * np.pi * RADIUS
     print("gap (deg)  noise (mm)  stray points  strip: mean / largest (mm)  far side mean  girth at Y=0 (mm, off the truth)")
+    # (strip's width, noise, stray points in it, the strays without noise)
     with tempfile.TemporaryDirectory() as tmp:
-        for gap, noise, stray in [(0, 0, False), (40, 0, False), (40, 0, True), (0, 0.3, False), (40, 0.3, True),
-                                  (60, 0.3, True)]:
+        for gap, noise, stray, quiet in [(0, 0, False, False), (40, 0, False, False), (40, 0, True, False),
+                                         (0, 0.3, False, False), (40, 0.3, False, False), (40, 0.3, True, False),
+                                         (40, 0.3, True, True), (60, 0.3, True, False)]:
             src, out = os.path.join(tmp, "c.ply"), os.path.join(tmp, "m.ply")
-            write_ply(src, cloud(gap, noise, stray, rng))
+            write_ply(src, cloud(gap, noise, stray, quiet, rng))
             subprocess.run([args.bodyscan, "reconstruct", src, "-o", out, "--body", "--ascii", "-q"], check=True)
             v = read_ply_vertices(out)
             r = np.hypot(v[:, 0], v[:, 2]) - RADIUS
@@ -81,7 +83,7 @@ def main():
                                           capture_output=True, text=True).stdout)
             girth = m["measurements"][0]["value_mm"]
             print("%9d  %10.1f  %12s  %+8.3f / %+6.3f  %+13.3f  %.2f (%+.2f)" %
-                  (gap, noise, "yes" if stray else "no", r[strip].mean(), r[strip].max(), r[far].mean(), girth,
+                  (gap, noise, ("noise-free" if quiet else "yes") if stray else "no", r[strip].mean(), r[strip].max(), r[far].mean(), girth,
                    girth - true_girth))
 
 
