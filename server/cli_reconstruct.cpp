@@ -42,6 +42,9 @@ void usage(FILE* out) {
       "  --keep-holes           leave the field's zero set open where it is (default: trim\n"
       "                         flaps past the data and fill every hole; filled vertices\n"
       "                         get confidence 0 in the output)\n"
+      "  --trim-distance D      before filling, trim flaps whose vertices lie farther than\n"
+      "                         D from every point (default: the median density sigma\n"
+      "                         plus three noise sigmas)\n"
       "  --ascii                write ASCII PLY (default binary)\n"
       "  -q, --quiet            print only errors\n",
       out);
@@ -121,6 +124,8 @@ int run_reconstruct(int argc, char** argv) {
       // applied before the loop
     } else if (a == "--keep-holes") {
       opt.close_holes = false;
+    } else if (a == "--trim-distance") {
+      number("--trim-distance", &opt.hole_trim_distance, true);
     } else if (a == "--ascii") {
       ascii = true;
     } else if (a == "-q" || a == "--quiet") {

@@ -126,6 +126,25 @@ TEST_F(ReconstructCli, BodyTakesTheScanJobsSettings) {
   float top = -1e9f;
   for (const Vec3f& v : mesh->vertices) top = std::max(top, v.y());
   EXPECT_NEAR(top, 100.f, 10.f);
+
+  // --trim-distance sets how far from every point a flap's vertex must lie to be
+  // peeled before the filling: nearer, more of the flaps goes.
+  auto trimmed = [&](const std::string& d) {
+    const CliResult r = bodyscan(
+        "reconstruct " + quote(path("cap.ply")) + " --body --trim-distance " + d + " -o " + quote(path("t.ply")), dir_);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("surface     closed"), std::string::npos) << r.out;
+    const size_t at = r.out.find(" flap triangles trimmed");
+    const size_t from = r.out.rfind(' ', at - 1);
+    return at == std::string::npos ? -1L : std::stol(r.out.substr(from + 1, at - from - 1));
+  };
+  const long near = trimmed("0.5"), far = trimmed("50");
+  EXPECT_GT(near, far);
+  EXPECT_GE(far, 0);
+  const CliResult bad = bodyscan(
+      "reconstruct " + quote(path("cap.ply")) + " --trim-distance 0 -o " + quote(path("t.ply")), dir_);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--trim-distance expects a positive number"), std::string::npos) << bad.err;
 }
 
 TEST_F(ReconstructCli, MissingInputNamesTheFile) {
