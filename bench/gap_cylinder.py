@@ -41,12 +41,18 @@ def cloud(gap_deg, noise, stray, quiet_strays, rng):
     return np.array(pts)
 
 
-def write_ply(path, pts):
+def write_ply(path, pts, normals=None):
     with open(path, "w") as f:
         f.write("ply\nformat ascii 1.0\nelement vertex %d\n" % len(pts))
-        f.write("property float x\nproperty float y\nproperty float z\nend_header\n")
-        for p in pts:
-            f.write("%.4f %.4f %.4f\n" % tuple(p))
+        f.write("property float x\nproperty float y\nproperty float z\n")
+        if normals is not None:
+            f.write("property float nx\nproperty float ny\nproperty float nz\n")
+        f.write("end_header\n")
+        for i, p in enumerate(pts):
+            if normals is None:
+                f.write("%.4f %.4f %.4f\n" % tuple(p))
+            else:
+                f.write("%.4f %.4f %.4f %.5f %.5f %.5f\n" % (*p, *normals[i]))
 
 
 def read_ply_vertices(path):
@@ -64,15 +70,21 @@ def main():
     args = ap.parse_args()
     rng = np.random.default_rng(args.seed)
     true_girth = 2 * np.pi * RADIUS
-    print("gap (deg)  noise (mm)  stray points  strip: mean / largest (mm)  far side mean  girth at Y=0 (mm, off the truth)")
-    # (strip's width, noise, stray points in it, the strays without noise)
+    print("gap (deg)  noise (mm)  stray points  normals     strip: mean / largest (mm)  far side mean  "
+          "girth at Y=0 (mm, off the truth)")
+    # (strip's width, noise, stray points in it, the strays without noise, the
+    # true normals given instead of those the reconstruction estimates)
     with tempfile.TemporaryDirectory() as tmp:
-        for gap, noise, stray, quiet in [(0, 0, False, False), (40, 0, False, False), (40, 0, True, False),
-                                         (0, 0.3, False, False), (40, 0.3, False, False), (40, 0.3, True, False),
-                                         (40, 0.3, True, True), (60, 0.3, True, False)]:
+        for gap, noise, stray, quiet, given in [
+                (0, 0, False, False, False), (40, 0, False, False, False), (40, 0, True, False, False),
+                (0, 0.3, False, False, False), (40, 0.3, False, False, False), (40, 0.3, False, False, True),
+                (40, 0.3, True, False, False), (40, 0.3, True, True, False), (60, 0.3, True, False, False)]:
             src, out = os.path.join(tmp, "c.ply"), os.path.join(tmp, "m.ply")
-            write_ply(src, cloud(gap, noise, stray, quiet, rng))
-            subprocess.run([args.bodyscan, "reconstruct", src, "-o", out, "--body", "--ascii", "-q"], check=True)
+            pts = cloud(gap, noise, stray, quiet, rng)
+            radial = pts * np.array([1, 0, 1])
+            write_ply(src, pts, radial / np.linalg.norm(radial, axis=1)[:, None] if given else None)
+            subprocess.run([args.bodyscan, "reconstruct", src, "-o", out, "--body", "--ascii", "-q"] +
+                           (["--normals", "input"] if given else []), check=True)
             v = read_ply_vertices(out)
             r = np.hypot(v[:, 0], v[:, 2]) - RADIUS
             a = np.degrees(np.arctan2(v[:, 2], v[:, 0]))
@@ -82,8 +94,9 @@ def main():
             m = json.loads(subprocess.run([args.bodyscan, "measure", out, "--girth-y", "0"], check=True,
                                           capture_output=True, text=True).stdout)
             girth = m["measurements"][0]["value_mm"]
-            print("%9d  %10.1f  %12s  %+8.3f / %+6.3f  %+13.3f  %.2f (%+.2f)" %
-                  (gap, noise, ("noise-free" if quiet else "yes") if stray else "no", r[strip].mean(), r[strip].max(), r[far].mean(), girth,
+            print("%9d  %10.1f  %12s  %-9s  %+8.3f / %+6.3f  %+13.3f  %.2f (%+.2f)" %
+                  (gap, noise, ("noise-free" if quiet else "yes") if stray else "no", "true" if given else "estimated",
+                   r[strip].mean(), r[strip].max(), r[far].mean(), girth,
                    girth - true_girth))
 
 
