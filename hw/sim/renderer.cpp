@@ -469,15 +469,22 @@ Spans spans_near(const std::vector<Spans>& rows, int y, int reach, int widen, in
   return out;
 }
 
+// Both passes over the whole image, rows then columns; `across` keeps the first
+// (`out` may be `in`).
+void blur_image(const std::vector<float>& in, std::vector<float>& across, std::vector<float>& out, int w, int h,
+                const std::vector<float>& k) {
+  across.resize(in.size());
+  out.resize(in.size());
+  tbb::parallel_for(0, h, [&](int y) { blur_across(in, across, w, y, k, 0, w - 1); });
+  tbb::parallel_for(0, h, [&](int y) { blur_down(across, out, w, h, y, k, 0, w - 1); });
+}
+
 }  // namespace
 
 void blur(std::vector<float>& img, int w, int h, double sigma) {
   if (sigma <= 0) return;
-  const std::vector<float> k = blur_kernel(sigma);
-  std::vector<float> tmp(img.size());
-  // Rows, then columns.
-  tbb::parallel_for(0, h, [&](int y) { blur_across(img, tmp, w, y, k, 0, w - 1); });
-  tbb::parallel_for(0, h, [&](int y) { blur_down(tmp, img, w, h, y, k, 0, w - 1); });
+  std::vector<float> tmp;
+  blur_image(img, tmp, img, w, h, blur_kernel(sigma));
 }
 
 Frame expose(const std::vector<float>& irradiance, const CameraDescription& camera, const Exposure& exposure,
@@ -569,12 +576,8 @@ const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Li
   // pass for the next pose.
   cache.unblurred.assign(n, 0.f);
   tbb::parallel_for(0, h, [&](int y) { light(y, 0, w - 1); });
-  cache.irradiance = cache.unblurred;
-  if (blurs) {
-    cache.across.assign(n, 0.f);
-    tbb::parallel_for(0, h, [&](int y) { blur_across(cache.unblurred, cache.across, w, y, k, 0, w - 1); });
-    tbb::parallel_for(0, h, [&](int y) { blur_down(cache.across, cache.irradiance, w, h, y, k, 0, w - 1); });
-  }
+  if (blurs) blur_image(cache.unblurred, cache.across, cache.irradiance, w, h, k);
+  else cache.irradiance = cache.unblurred;
   if (!scene.moves()) {
     cache.unblurred = {};
     cache.across = {};
