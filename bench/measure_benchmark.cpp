@@ -113,11 +113,16 @@ std::string sway_error(const SwayEstimate& est, const std::vector<int32_t>& fram
   Eigen::Vector3d axis;
   double truth = 0;
   error(best, &axis, &truth);
+  char hold[96];
+  if (est.regularization.still) {
+    std::snprintf(hold, sizeof hold, "held still (no path explained held-out skin better)");
+  } else {
+    std::snprintf(hold, sizeof hold, "hold %s, size x%.2g%s", est.regularization.per_axis ? "per axis" : "on all pairs",
+                  est.regularization.ridge_scale, est.regularization.slow_scale > 0 ? ", slow part held" : "");
+  }
   char line[256];
-  std::snprintf(line, sizeof line,
-                "%.2f mm RMS off the simulator's %.2f mm RMS (x %.2f, z %.2f; frame offset %.1f); hold %s, size x%.2g%s",
-                axis.norm(), truth, axis.x(), axis.z(), best, est.regularization.per_axis ? "per axis" : "on all pairs",
-                est.regularization.ridge_scale, est.regularization.slow_scale > 0 ? ", slow part held" : "");
+  std::snprintf(line, sizeof line, "%.2f mm RMS off the simulator's %.2f mm RMS (x %.2f, z %.2f; frame offset %.1f); %s",
+                axis.norm(), truth, axis.x(), axis.z(), best, hold);
   return line;
 }
 

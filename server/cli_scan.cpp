@@ -63,7 +63,11 @@ void usage(FILE* out) {
 
 // What the sway estimate found (pipeline::ScanOptions::compensate_sway).
 void print_sway(const pipeline::ScanStats& scan) {
-  if (!scan.sway.empty()) {
+  if (!scan.sway.empty() && scan.sway.regularization.still) {
+    std::printf("sway: none; where sweeps meet they differ by %.2f mm RMS, and no path explains skin it was not "
+                "fitted to better\n",
+                scan.sway.rms_before_mm);
+  } else if (!scan.sway.empty()) {
     std::printf("sway: up to %.1f mm, undone; where sweeps meet they differ by %.2f mm RMS (%.2f as measured)\n",
                 scan.sway.peak_mm, scan.sway.rms_after_mm, scan.sway.rms_before_mm);
   } else if (!scan.sway_not_estimated.empty()) {

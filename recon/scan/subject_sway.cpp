@@ -261,6 +261,7 @@ Eigen::MatrixXd slow_part(size_t m, const SwayOptions& o) {
 StatusOr<std::vector<Eigen::Vector3d>> solve_path(const System& s, const SwayRegularization& reg, const SwayOptions& o,
                                                   size_t m, const std::vector<int>& axes, const Eigen::MatrixXd& slow) {
   const size_t dims = axes.size();
+  if (reg.still) return std::vector<Eigen::Vector3d>(m, Eigen::Vector3d::Zero());
   Eigen::MatrixXd ata = s.ata;
   const double per_knot = s.total / static_cast<double>(m);
   for (size_t d = 0; d < dims; ++d) {
@@ -322,6 +323,8 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
     return invalid_argument("sway: bad options (no hold to try, or no cubes to fold by)");
   for (const SwayRegularization& r : o.regularizations)
     if (!(r.ridge_scale >= 0) || !(r.slow_scale >= 0)) return invalid_argument("sway: a hold's weights must be >= 0");
+  if (std::all_of(o.regularizations.begin(), o.regularizations.end(), [](const SwayRegularization& r) { return r.still; }))
+    return invalid_argument("sway: every hold stands still; offer one that moves");
   SwayEstimate est;
   est.knot_frames = o.knot_frames;
   int fmin = INT32_MAX, fmax = INT32_MIN;
@@ -400,7 +403,14 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
     if (all.total <= 0) break;
     // Which of the regularisations explains the pairs of skin it was not fitted
     // to best (when there is a choice).
+    // Without a choice by held-out skin the first moving hold is taken: a body is
+    // never taken to stand still unless the skin says so.
     SwayRegularization chosen = o.regularizations.front();
+    for (const SwayRegularization& r : o.regularizations)
+      if (!r.still) {
+        chosen = r;
+        break;
+      }
     if (folds > 1 && o.regularizations.size() > 1) {
       // Each candidate's mean squared distance over each fold's pairs, with the
       // path fitted to the other folds.
@@ -413,6 +423,7 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
         train.add(sys[f], -1);
         if (train.total <= 0 || sys[f].total <= 0) continue;
         for (size_t c = 0; c < o.regularizations.size(); ++c) {
+          if (o.regularizations[c].still && it > 0) continue;
           auto fit = solve_path(train, o.regularizations[c], o, m, axes, slow);
           if (!fit.ok()) return fit.status();
           for (size_t q : in_fold[f]) {
@@ -425,11 +436,16 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
       // hold to the weakest, the first whose excess over it is within one standard
       // error of the folds' differences (a weaker hold must earn its place).
       const auto mean = [&](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / folds; };
+      // Standing still is offered at the first pairing only, made at no sway: once
+      // a path moved the sweeps, their pairs no longer weigh the two fairly.
+      const auto offered = [&](size_t c) { return !(o.regularizations[c].still && it > 0); };
       size_t best = 0;
-      for (size_t c = 1; c < err.size(); ++c)
-        if (mean(err[c]) < mean(err[best])) best = c;
+      while (!offered(best)) ++best;
+      for (size_t c = best + 1; c < err.size(); ++c)
+        if (offered(c) && mean(err[c]) < mean(err[best])) best = c;
       size_t take = best;
       for (size_t c = 0; c < best; ++c) {
+        if (!offered(c)) continue;
         std::vector<double> d(folds);
         for (size_t f = 0; f < folds; ++f) d[f] = err[c][f] - err[best][f];
         const double md = mean(d);
@@ -442,8 +458,10 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
         }
       }
       chosen = o.regularizations[take];
-      est.held_out_rms_mm.clear();
-      for (const std::vector<double>& e : err) est.held_out_rms_mm.push_back(std::sqrt(mean(e)));
+      // A hold not offered this time keeps the figure it had when it was.
+      est.held_out_rms_mm.resize(err.size(), 0.0);
+      for (size_t c = 0; c < err.size(); ++c)
+        if (offered(c)) est.held_out_rms_mm[c] = std::sqrt(mean(err[c]));
     }
     est.regularization = chosen;
     auto fit = solve_path(all, chosen, o, m, axes, slow);
