@@ -418,12 +418,15 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
       for (size_t q = 0; q < pairs.size(); ++q)
         if (weight[q] > 0) in_fold[static_cast<size_t>(pairs[q].fold)].push_back(q);
       std::vector<std::vector<double>> err(o.regularizations.size(), std::vector<double>(folds, 0.0));
+      // Standing still is offered at the first pairing only, made at no sway: once
+      // a path moved the sweeps, their pairs no longer weigh the two fairly.
+      const auto offered = [&](size_t c) { return !(o.regularizations[c].still && it > 0); };
       for (size_t f = 0; f < folds; ++f) {
         System train = all;
         train.add(sys[f], -1);
         if (train.total <= 0 || sys[f].total <= 0) continue;
         for (size_t c = 0; c < o.regularizations.size(); ++c) {
-          if (o.regularizations[c].still && it > 0) continue;
+          if (!offered(c)) continue;
           auto fit = solve_path(train, o.regularizations[c], o, m, axes, slow);
           if (!fit.ok()) return fit.status();
           for (size_t q : in_fold[f]) {
@@ -436,9 +439,6 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
       // hold to the weakest, the first whose excess over it is within one standard
       // error of the folds' differences (a weaker hold must earn its place).
       const auto mean = [&](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / folds; };
-      // Standing still is offered at the first pairing only, made at no sway: once
-      // a path moved the sweeps, their pairs no longer weigh the two fairly.
-      const auto offered = [&](size_t c) { return !(o.regularizations[c].still && it > 0); };
       size_t best = 0;
       while (!offered(best)) ++best;
       for (size_t c = best + 1; c < err.size(); ++c)
