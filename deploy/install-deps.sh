@@ -2,9 +2,14 @@
 # Installs the Debian 12 packages bodyscan needs. Idempotent: packages already
 # present are skipped, so the README commands can call it on every run.
 #
-#   deploy/install-deps.sh            build + test dependencies
+#   deploy/install-deps.sh            build + test dependencies, Node.js for the UI
 #   deploy/install-deps.sh --browser  also Chromium, for the browser UI's tests
 #   deploy/install-deps.sh --bench    also the peers the benchmarks compare with (Open3D)
+#
+# It never removes a package: before installing it asks apt what the install
+# would do, says how many packages and how many megabytes that is, and stops
+# naming the conflict when apt would have to remove anything (the install itself
+# runs with --no-remove as well). Run it as root, or as a user who may sudo.
 #
 # The browser UI's npm packages are installed by deploy/install-web.sh.
 set -euo pipefail
@@ -22,13 +27,19 @@ packages=(
   libcairo2-dev fonts-dejavu-core  # measurement sheets as PDF (storage/formats)
   libsqlite3-dev       # the scan archive's index (storage/archive)
   libsodium-dev        # checksums of archived files; password hashing (server)
-  libboost1.81-dev     # Beast HTTP + WebSocket (server); 1.74 lacks message_generator
+  libboost-dev         # Beast HTTP + WebSocket (server): Debian's default Boost, 1.74
   libssl-dev openssl   # TLS for `bodyscan serve`; the tests make a certificate with openssl
   libaravis-dev aravis-tools  # GenICam cameras (hw/aravis); the tests run arv-fake-gv-camera-0.8
   libusb-1.0-0-dev     # the TMCL controller board over USB (hw/usb)
   libgtest-dev libgmock-dev libbenchmark-dev
   poppler-utils        # pdftotext: the tests read the PDF sheets back
 )
+# The browser UI is bundled and tested with Node.js 18 or newer (Debian 12 has
+# 18.20). A Node.js installed from elsewhere (with its own npm) is used as it is:
+# Debian's npm package would replace it.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  packages+=(nodejs npm)
+fi
 for arg in "$@"; do
   case "$arg" in
     --browser) packages+=(chromium) ;;  # driven headless by playwright-core (web/tests/e2e)
@@ -43,14 +54,49 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
-
-if ((${#missing[@]})); then
-  echo "install-deps: installing ${missing[*]}"
-  SUDO=""
-  if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-else
+if ((${#missing[@]} == 0)); then
   echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
 fi
+
+SUDO=()
+if [[ $(id -u) -ne 0 ]]; then
+  if ! command -v sudo >/dev/null; then
+    echo "install-deps: these packages are missing and installing them needs root: ${missing[*]}" >&2
+    echo "install-deps: run this script as root, or install sudo and run it as a user who may use it" >&2
+    exit 1
+  fi
+  SUDO=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+apt_install=(apt-get install --no-remove --no-install-recommends)
+
+echo "install-deps: missing ${missing[*]}; updating the package lists"
+"${SUDO[@]}" apt-get update -qq
+
+# What apt would do, asked first (a simulation needs no root): the packages it
+# would add with their sizes, and any it would remove.
+if ! plan=$(LC_ALL=C apt-get -s "${apt_install[@]:1}" "${missing[@]}" 2>&1); then
+  echo "$plan" | grep -E '^(E:|  )' >&2 || echo "$plan" >&2
+  echo "install-deps: apt cannot install ${missing[*]} on this machine (above); nothing was changed" >&2
+  exit 1
+fi
+removals=$(awk '$1 == "Remv" { print $2 }' <<<"$plan" | sort -u | xargs)
+if [[ -n $removals ]]; then
+  echo "install-deps: installing ${missing[*]} would remove these packages: $removals" >&2
+  echo "install-deps: nothing was changed. Those packages conflict with what bodyscan needs;" >&2
+  echo "install-deps: resolve the conflict by hand (or install on a machine without them)." >&2
+  exit 1
+fi
+mapfile -t adds < <(awk '$1 == "Inst" { v = $3; gsub(/[()[\]]/, "", v); print $2 "=" v }' <<<"$plan")
+download=0 disk=0
+for pv in "${adds[@]}"; do
+  read -r size installed < <(apt-cache show --no-all-versions "$pv" 2>/dev/null |
+    awk '/^Size:/ { s = $2 } /^Installed-Size:/ { i = $2 } END { print s + 0, i + 0 }')
+  download=$((download + size))
+  disk=$((disk + installed * 1024))
+done
+echo "install-deps: installing ${#adds[@]} packages (${missing[*]} and what they depend on):" \
+  "$((download / 1000000)) MB to download, $((disk / 1000000)) MB on disk"
+"${SUDO[@]}" env DEBIAN_FRONTEND=noninteractive "${apt_install[@]}" -y -qq "${missing[@]}"
+echo "install-deps: done"

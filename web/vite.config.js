@@ -6,7 +6,8 @@
 // server sends to browsers that take gzip.
 import { defineConfig } from 'vite';
 import { readdirSync, readFileSync, statSync, writeFileSync } from 'node:fs';
-import { join, resolve } from 'node:path';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
 import { gzipSync, constants } from 'node:zlib';
 
 function gzipTwins() {
@@ -40,13 +41,15 @@ function gzipTwins() {
 }
 
 export default defineConfig({
-  root: import.meta.dirname,
+  root: dirname(fileURLToPath(import.meta.url)),
   base: '/',
   plugins: [gzipTwins()],
   build: {
     outDir: 'dist',
     emptyOutDir: true,
     target: 'es2022',
+    minify: 'terser',
+    terserOptions: { module: true, ecma: 2020, compress: { passes: 2 } },
     sourcemap: true,
     chunkSizeWarningLimit: 1200,
   },

@@ -14,7 +14,6 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
-#include <boost/version.hpp>
 
 #include <algorithm>
 #include <array>
@@ -23,8 +22,6 @@
 #include <set>
 #include <thread>
 #include <vector>
-
-static_assert(BOOST_VERSION >= 108100, "Beast's message_generator needs Boost 1.81 (libboost1.81-dev)");
 
 namespace bodyscan::server {
 
@@ -98,13 +95,17 @@ void apply(const HttpResponse& r, unsigned version, bool keep_alive, http::respo
   res->keep_alive(keep_alive);
 }
 
-http::message_generator make_message(HttpResponse r, unsigned version, bool keep_alive, bool head) {
-  http::response<http::string_body> res;
-  apply(r, version, keep_alive, &res);
+// Every answer is a whole string body. It is held by a shared pointer until
+// its write completes (async_write keeps a reference, not a copy).
+using Response = http::response<http::string_body>;
+
+std::shared_ptr<Response> make_message(HttpResponse r, unsigned version, bool keep_alive, bool head) {
+  auto res = std::make_shared<Response>();
+  apply(r, version, keep_alive, res.get());
   const size_t size = r.body.size();
-  if (!head) res.body() = std::move(r.body);
-  res.prepare_payload();
-  if (head) res.content_length(size);
+  if (!head) res->body() = std::move(r.body);
+  res->prepare_payload();
+  if (head) res->content_length(size);
   return res;
 }
 
@@ -307,13 +308,15 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     });
   }
 
-  void send(http::message_generator msg, bool keep_alive) {
+  void send(std::shared_ptr<Response> msg, bool keep_alive) {
     tcp().expires_after(shared_.options.timeout);
-    beast::async_write(stream_, std::move(msg),
-                       beast::bind_front_handler(&HttpSession::on_write, this->shared_from_this(), keep_alive));
+    Response& response = *msg;  // taken before the handler takes the pointer
+    http::async_write(stream_, response,
+                      beast::bind_front_handler(&HttpSession::on_write, this->shared_from_this(), std::move(msg),
+                                                keep_alive));
   }
 
-  void on_write(bool keep_alive, beast::error_code ec, size_t) {
+  void on_write(const std::shared_ptr<Response>&, bool keep_alive, beast::error_code ec, size_t) {
     // A client that goes away mid-download ends here; nothing else is held for it.
     if (ec) return fail(ec, "write");
     if (!keep_alive) return do_close();
