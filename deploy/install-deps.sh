@@ -69,15 +69,14 @@ if [[ $(id -u) -ne 0 ]]; then
   SUDO=(sudo)
 fi
 export DEBIAN_FRONTEND=noninteractive
-apt_install=(apt-get install --no-remove --no-install-recommends)
 
 echo "install-deps: missing ${missing[*]}; updating the package lists"
 "${SUDO[@]}" apt-get update -qq
 
 # What apt would do, asked first (a simulation needs no root): the packages it
 # would add with their sizes, and any it would remove.
-if ! plan=$(LC_ALL=C apt-get -s "${apt_install[@]:1}" "${missing[@]}" 2>&1); then
-  echo "$plan" | grep -E '^(E:|  )' >&2 || echo "$plan" >&2
+if ! plan=$(LC_ALL=C apt-get -s install --no-install-recommends "${missing[@]}" 2>&1); then
+  { sed -n '/unmet dependencies/,$p' <<<"$plan" | grep . || grep '^E:' <<<"$plan" || echo "$plan"; } >&2
   echo "install-deps: apt cannot install ${missing[*]} on this machine (above); nothing was changed" >&2
   exit 1
 fi
@@ -89,14 +88,8 @@ if [[ -n $removals ]]; then
   exit 1
 fi
 mapfile -t adds < <(awk '$1 == "Inst" { v = $3; gsub(/[()[\]]/, "", v); print $2 "=" v }' <<<"$plan")
-download=0 disk=0
-for pv in "${adds[@]}"; do
-  read -r size installed < <(apt-cache show --no-all-versions "$pv" 2>/dev/null |
-    awk '/^Size:/ { s = $2 } /^Installed-Size:/ { i = $2 } END { print s + 0, i + 0 }')
-  download=$((download + size))
-  disk=$((disk + installed * 1024))
-done
-echo "install-deps: installing ${#adds[@]} packages (${missing[*]} and what they depend on):" \
-  "$((download / 1000000)) MB to download, $((disk / 1000000)) MB on disk"
-"${SUDO[@]}" env DEBIAN_FRONTEND=noninteractive "${apt_install[@]}" -y -qq "${missing[@]}"
+size=$(apt-cache show --no-all-versions "${adds[@]}" 2>/dev/null | awk '/^Size:/ { s += $2 }
+  /^Installed-Size:/ { i += $2 } END { printf "%.1f MB to download, %.1f MB on disk", s / 1e6, i * 1024 / 1e6 }')
+echo "install-deps: installing ${#adds[@]} packages (${missing[*]} and what they depend on): $size"
+"${SUDO[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install --no-remove --no-install-recommends -y -qq "${missing[@]}"
 echo "install-deps: done"
