@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   }
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  auto sim = pipeline::open_simulated_rig(rig_name, "");
+  auto sim = pipeline::open_simulated_rig(rig_name);
   if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
   if (sway > 0) {
     // The same description, its subject swaying.

@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   }
   if (rigs.empty()) rigs = hw::shipped_rig_names();  // all of them
   for (const std::string& name : rigs) {
-    auto sim = pipeline::open_simulated_rig(name, body);
+    auto sim = pipeline::open_simulated_rig(name, {body});
     if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
     const hw::RigDescription& desc = (*sim)->description();
     const hw::sim::Scene& scene = (*sim)->scene();

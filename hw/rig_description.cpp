@@ -351,12 +351,35 @@ ControllerDescription read_controller(const Reader& r, const std::vector<LaserDe
 }
 
 SimulationDescription read_simulation(const Reader& r, const std::string& source) {
-  r.only({"subject", "subject_offset", "subject_yaw_deg", "motion", "frame_rate_hz", "seed", "room_light",
+  r.only({"subject", "posture", "subject_offset", "subject_yaw_deg", "motion", "frame_rate_hz", "seed", "room_light",
           "ambient_light", "frame_light", "speckle_contrast"});
   SimulationDescription s;
   s.subject = r.text("subject", "");
   if (!s.subject.empty() && std::filesystem::path(s.subject).is_relative()) {
     s.subject = std::filesystem::absolute(std::filesystem::path(source).parent_path() / s.subject).lexically_normal().string();
+  }
+  if (r.has("posture")) {
+    const Reader p = r.child("posture");
+    p.only({"arm_abduction_deg", "ankle_distance_mm"});
+    if (p.has("arm_abduction_deg")) {
+      // One angle for both arms, or [left, right] (null: that arm as in the mesh).
+      const json& a = p.raw().at("arm_abduction_deg");
+      const auto angle = [](const json& x) { return x.is_number() || x.is_null(); };
+      const bool pair = a.is_array() && a.size() == 2 && angle(a[0]) && angle(a[1]);
+      if (!a.is_number() && !pair) p.fail("'arm_abduction_deg' must be degrees or [left, right] in degrees");
+      for (int k = 0; k < 2; ++k) {
+        const json& v = pair ? a[k] : a;
+        if (v.is_null()) continue;
+        const double x = v.get<double>();
+        if (!(x >= 0 && x <= 80)) p.fail("'arm_abduction_deg' must be 0-80 degrees from the vertical");
+        s.posture.arm_abduction_deg[k] = x;
+      }
+    }
+    if (p.has("ankle_distance_mm")) {
+      const double x = p.number("ankle_distance_mm", 0);
+      if (!(x >= 100 && x <= 700)) p.fail("'ankle_distance_mm' must be 100-700 mm");
+      s.posture.ankle_distance_mm = x;
+    }
   }
   s.subject_offset = r.vec3("subject_offset", s.subject_offset);
   s.subject_yaw_deg = r.number("subject_yaw_deg", 0);
@@ -574,7 +597,13 @@ std::string to_json(const RigDescription& rig) {
                        {"watchdog_ms", c.watchdog_ms}};
   }
   const SimulationDescription& s = rig.simulation;
+  json posture = json::object();
+  if (s.posture.arm_abduction_deg[0] || s.posture.arm_abduction_deg[1])
+    for (int k = 0; k < 2; ++k)
+      posture["arm_abduction_deg"][k] = s.posture.arm_abduction_deg[k] ? json(*s.posture.arm_abduction_deg[k]) : json();
+  if (s.posture.ankle_distance_mm) posture["ankle_distance_mm"] = *s.posture.ankle_distance_mm;
   j["simulation"] = {{"subject", s.subject},
+                     {"posture", posture},
                      {"subject_offset", vec(s.subject_offset)},
                      {"subject_yaw_deg", s.subject_yaw_deg},
                      {"motion",

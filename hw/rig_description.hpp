@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstdint>
+#include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -121,10 +123,21 @@ struct SubjectMotion {
   double breathing_mm = 0, breathing_hz = 0.25;  // chest radius change
 };
 
+// How the simulated subject stands, where it differs from its mesh's rest pose
+// (hw/sim/pose_body.hpp poses a MakeHuman body by skinning). Unset: as in the mesh.
+struct SubjectPosture {
+  // Left (+X), right: the upper arm (shoulder joint to elbow joint) from the
+  // downward vertical, degrees, 0-80.
+  std::array<std::optional<double>, 2> arm_abduction_deg;
+  std::optional<double> ankle_distance_mm;  // between the ankle joints' centres, 100-700
+  bool any() const { return arm_abduction_deg[0] || arm_abduction_deg[1] || ankle_distance_mm; }
+};
+
 struct SimulationDescription {
   std::string subject;   // body mesh (PLY, mm, Y up), relative to the description file
+  SubjectPosture posture;                // applied to the mesh first
   Vec3d subject_offset = Vec3d::Zero();  // added to the mesh (after standing it on the floor)
-  double subject_yaw_deg = 0;            // turn about the vertical axis
+  double subject_yaw_deg = 0;            // turn about the vertical axis: + turns the face from +Z toward +X
   SubjectMotion motion;
   double frame_rate_hz = 30;
   uint64_t seed = 1;

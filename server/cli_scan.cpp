@@ -13,6 +13,7 @@
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/scan_job.hpp"
+#include "server/cli_subject.hpp"
 #include "server/pipeline/rig_backend.hpp"
 
 namespace bodyscan::cli {
@@ -20,7 +21,7 @@ namespace bodyscan::cli {
 namespace {
 
 void usage(FILE* out) {
-  std::fputs(
+  std::fprintf(out,
       "usage: bodyscan scan --rig RIG --out DIR [options]\n"
       "\n"
       "Calibrates the rig from what its cameras see (dot grid, frame lights, lasers on\n"
@@ -32,7 +33,7 @@ void usage(FILE* out) {
       "\n"
       "  --rig RIG        sim (the thesis rig and the demo body), thesis, square, tiered,\n"
       "                   or a rig description file (JSON)\n"
-      "  --body BODY.ply  the subject (mm, Y up; default: the rig description's)\n"
+      "%s"
       "  --out DIR        output folder (created)\n"
       "  --every N        scan every Nth laser step only (default 1: all)\n"
       "  --method M       homography (default: the thesis's image-to-laser-plane\n"
@@ -58,7 +59,7 @@ void usage(FILE* out) {
       "\n"
       "Before each real camera a person holds the lens dot-grid board: the request\n"
       "is printed, and Enter (a line on standard input) answers it.\n",
-      out);
+      kSubjectOptionsHelp);
 }
 
 // What the sway estimate found (pipeline::ScanOptions::compensate_sway).
@@ -78,7 +79,8 @@ void print_sway(const pipeline::ScanStats& scan) {
 }  // namespace
 
 int run_scan(int argc, char** argv) {
-  std::string rig_arg, body, out, archive_dir, customer_id, new_customer, operator_name = "cli";
+  pipeline::SimulatedSubject subject;
+  std::string rig_arg, out, archive_dir, customer_id, new_customer, operator_name = "cli";
   pipeline::ScanJobOptions options;
   bool quiet = false, operator_dot_grid = false;
   for (int i = 1; i < argc; ++i) {
@@ -100,12 +102,17 @@ int run_scan(int argc, char** argv) {
       if (a == "--customer") customer_id = v;
       if (a == "--new-customer") new_customer = v;
       if (a == "--operator") operator_name = v;
-    } else if (a == "--rig" || a == "--body" || a == "--out" || a == "--every" || a == "--method" ||
-               a == "--max-view") {
+    } else if (is_subject_option(a)) {
+      const char* v = value();
+      if (!v) return 2;
+      if (Status st = set_subject_option(a, v, &subject); !st.ok()) {
+        std::fprintf(stderr, "bodyscan scan: %s\n", st.message().c_str());
+        return 2;
+      }
+    } else if (a == "--rig" || a == "--out" || a == "--every" || a == "--method" || a == "--max-view") {
       const char* v = value();
       if (!v) return 2;
       if (a == "--rig") rig_arg = v;
-      if (a == "--body") body = v;
       if (a == "--out") out = v;
       if (a == "--every") {
         options.every = std::atoi(v);
@@ -155,7 +162,7 @@ int run_scan(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan scan: --customer and --new-customer go with --archive\n");
     return 2;
   }
-  auto sim = pipeline::open_rig(rig_arg, body);
+  auto sim = pipeline::open_rig(rig_arg, subject);
   if (!sim.ok()) {
     std::fprintf(stderr, "bodyscan scan: %s\n", sim.status().message().c_str());
     return 1;

@@ -12,6 +12,7 @@
 #include "recon/io/atomic_file.hpp"
 #include "server/api/api.hpp"
 #include "server/net/http_server.hpp"
+#include "server/cli_subject.hpp"
 #include "server/workstation/workstation.hpp"
 
 namespace bodyscan::cli {
@@ -19,7 +20,7 @@ namespace bodyscan::cli {
 namespace {
 
 void usage(FILE* out) {
-  std::fputs(
+  std::fprintf(out,
       "usage: bodyscan serve [options]\n"
       "\n"
       "Runs the workstation: the rig (calibration, scans, reconstruction), the\n"
@@ -31,7 +32,7 @@ void usage(FILE* out) {
       "  --port N           (default 8080; 0 picks a free port)\n"
       "  --data DIR         the archive and accounts (default ./bodyscan-data)\n"
       "  --rig RIG          sim (default), thesis, square, tiered or a rig description file\n"
-      "  --body BODY.ply    the simulated subject (mm, Y up)\n"
+      "%s"
       "  --every N          scans use every Nth laser step unless asked otherwise\n"
       "                     (default 1)\n"
       "  --operator-dot-grid\n"
@@ -48,7 +49,7 @@ void usage(FILE* out) {
       "                     up, printed once and kept in DATA/first-admin-password\n"
       "                     (mode 0600) until changed\n"
       "  --workers N        threads for requests' work (default 3)\n",
-      out);
+      kSubjectOptionsHelp);
 }
 
 std::string random_password() {
@@ -104,7 +105,12 @@ int run_serve(int argc, char** argv) {
       no.port = static_cast<uint16_t>(*n);
     } else if (a == "--data") wo.data_dir = v;
     else if (a == "--rig") wo.rig = v;
-    else if (a == "--body") wo.body = v;
+    else if (is_subject_option(a)) {
+      if (Status st = set_subject_option(a, v, &wo.subject); !st.ok()) {
+        std::fprintf(stderr, "bodyscan serve: %s\n", st.message().c_str());
+        return 2;
+      }
+    }
     else if (a == "--every") {
       auto n = number(1, 1000);
       if (!n) return 2;

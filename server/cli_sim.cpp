@@ -10,6 +10,7 @@
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/png_image.hpp"
 #include "server/pipeline/acquire.hpp"
+#include "server/cli_subject.hpp"
 #include "server/pipeline/rig_backend.hpp"
 
 namespace bodyscan::cli {
@@ -17,7 +18,7 @@ namespace bodyscan::cli {
 namespace {
 
 void usage(FILE* out) {
-  std::fputs(
+  std::fprintf(out,
       "usage: bodyscan sim render --rig RIG --out DIR [options]\n"
       "\n"
       "Renders what the simulated rig's cameras see during one calibration (the\n"
@@ -27,11 +28,11 @@ void usage(FILE* out) {
       "images in DIR with DIR/index.json listing them.\n"
       "\n"
       "  --rig RIG        thesis, square, tiered, or a rig description file (JSON)\n"
-      "  --body BODY.ply  the subject (default: the rig description's)\n"
+      "%s"
       "  --out DIR        output folder (created)\n"
       "  --every N        render every Nth laser step only (default 1)\n"
       "  -q, --quiet      print only errors\n",
-      out);
+      kSubjectOptionsHelp);
 }
 
 }  // namespace
@@ -45,7 +46,8 @@ int run_sim(int argc, char** argv) {
     std::fprintf(stderr, "bodyscan sim: unknown subcommand '%s' (known: render)\n", argv[1]);
     return 2;
   }
-  std::string rig_arg, body, out;
+  pipeline::SimulatedSubject subject;
+  std::string rig_arg, out;
   int every = 1;
   bool quiet = false;
   for (int i = 2; i < argc; ++i) {
@@ -64,10 +66,13 @@ int run_sim(int argc, char** argv) {
       const char* v = value();
       if (!v) return 2;
       rig_arg = v;
-    } else if (a == "--body") {
+    } else if (is_subject_option(a)) {
       const char* v = value();
       if (!v) return 2;
-      body = v;
+      if (Status st = set_subject_option(a, v, &subject); !st.ok()) {
+        std::fprintf(stderr, "bodyscan sim render: %s\n", st.message().c_str());
+        return 2;
+      }
     } else if (a == "--out") {
       const char* v = value();
       if (!v) return 2;
@@ -92,7 +97,7 @@ int run_sim(int argc, char** argv) {
     usage(stderr);
     return 2;
   }
-  auto made = pipeline::open_simulated_rig(rig_arg, body);
+  auto made = pipeline::open_simulated_rig(rig_arg, subject);
   if (!made.ok()) {
     std::fprintf(stderr, "bodyscan sim render: %s\n", made.status().message().c_str());
     return 1;

@@ -1,5 +1,7 @@
 #include "hw/sim/sim_rig.hpp"
 
+#include "hw/sim/pose_body.hpp"
+
 #include <optional>
 
 #include "recon/io/ply.hpp"
@@ -166,7 +168,14 @@ StatusOr<std::unique_ptr<SimulatedRig>> SimulatedRig::create(const RigDescriptio
 StatusOr<std::unique_ptr<SimulatedRig>> SimulatedRig::create(const RigDescription& rig, const TriangleMesh& subject) {
   std::unique_ptr<SimulatedRig> r(new SimulatedRig());
   r->rig_ = rig;
-  ASSIGN_OR_RETURN(r->scene_, Scene::create(r->rig_, subject));
+  if (rig.simulation.posture.any() && !subject.triangles.empty()) {
+    ASSIGN_OR_RETURN(const BodyPoser* poser, BodyPoser::shipped());
+    StatusOr<PosedBody> posed = poser->pose(subject, rig.simulation.posture);
+    if (!posed.ok()) return posed.status().with_context("posing the simulated subject");
+    ASSIGN_OR_RETURN(r->scene_, Scene::create(r->rig_, posed->mesh));
+  } else {
+    ASSIGN_OR_RETURN(r->scene_, Scene::create(r->rig_, subject));
+  }
   for (const CameraDescription& c : r->rig_.cameras) r->renderers_.push_back(std::make_unique<Renderer>(c, r->rig_.simulation));
   r->controller_ = std::make_unique<SimController>(r->rig_);
   for (size_t i = 0; i < r->rig_.cameras.size(); ++i) {

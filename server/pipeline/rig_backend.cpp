@@ -14,10 +14,20 @@ StatusOr<hw::RigDescription> load_rig(const std::string& rig) {
 }
 }  // namespace
 
-StatusOr<std::unique_ptr<hw::DeviceRig>> open_rig(const std::string& rig, const std::string& body) {
-  ASSIGN_OR_RETURN(const hw::RigDescription desc, load_rig(rig));
-  if (body.empty()) return hw::DeviceRig::open(desc);
-  ASSIGN_OR_RETURN(const TriangleMesh mesh, read_ply_mesh(body));
+hw::RigDescription SimulatedSubject::applied_to(hw::RigDescription rig) const {
+  for (int s = 0; s < 2; ++s)
+    if (posture.arm_abduction_deg[s]) rig.simulation.posture.arm_abduction_deg[s] = posture.arm_abduction_deg[s];
+  if (posture.ankle_distance_mm) rig.simulation.posture.ankle_distance_mm = posture.ankle_distance_mm;
+  if (turn_deg) rig.simulation.subject_yaw_deg = *turn_deg;
+  if (position_mm) rig.simulation.subject_offset = {position_mm->x(), 0, position_mm->y()};
+  return rig;
+}
+
+StatusOr<std::unique_ptr<hw::DeviceRig>> open_rig(const std::string& rig, const SimulatedSubject& subject) {
+  ASSIGN_OR_RETURN(const hw::RigDescription loaded, load_rig(rig));
+  const hw::RigDescription desc = subject.applied_to(loaded);
+  if (subject.body.empty()) return hw::DeviceRig::open(desc);
+  ASSIGN_OR_RETURN(const TriangleMesh mesh, read_ply_mesh(subject.body));
   return hw::DeviceRig::open(desc, &mesh);
 }
 
@@ -72,13 +82,15 @@ Rig rig_handle(hw::DeviceRig& devices, AskOperator ask, bool ask_for_simulated) 
   return r;
 }
 
-StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> open_simulated_rig(const std::string& rig, const std::string& body) {
-  ASSIGN_OR_RETURN(const hw::RigDescription desc, load_rig(rig));
+StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> open_simulated_rig(const std::string& rig,
+                                                                     const SimulatedSubject& subject) {
+  ASSIGN_OR_RETURN(const hw::RigDescription loaded, load_rig(rig));
+  const hw::RigDescription desc = subject.applied_to(loaded);
   if (desc.has_real_devices()) {
     return invalid_argument(desc.source + " describes real devices; this command runs on the simulated rig only");
   }
-  if (body.empty()) return hw::sim::SimulatedRig::create(desc);
-  ASSIGN_OR_RETURN(const TriangleMesh mesh, read_ply_mesh(body));
+  if (subject.body.empty()) return hw::sim::SimulatedRig::create(desc);
+  ASSIGN_OR_RETURN(const TriangleMesh mesh, read_ply_mesh(subject.body));
   return hw::sim::SimulatedRig::create(desc, mesh);
 }
 

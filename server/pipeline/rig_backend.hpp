@@ -3,8 +3,10 @@
 // description says - and the Rig handle the sequences drive.
 #pragma once
 
+#include <Eigen/Core>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "hw/device_rig.hpp"
@@ -13,14 +15,25 @@
 
 namespace bodyscan::pipeline {
 
-// "sim" is the thesis rig with the shipped demo body; other names are shipped
-// layouts; anything with a '/' or ending in .json is a description file. `body`
-// (a PLY mesh, mm, Y up) replaces the description's subject when not empty.
-StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> open_simulated_rig(const std::string& rig, const std::string& body);
+// Who the simulated rig scans and how they stand, where it differs from the rig
+// description's simulation: each field set replaces the description's.
+struct SimulatedSubject {
+  std::string body;  // a PLY mesh, mm, Y up; "" the description's
+  // Arms and feet, by skinning (hw/sim/pose_body.hpp): a MakeHuman body only.
+  hw::SubjectPosture posture;
+  std::optional<double> turn_deg;             // about the vertical: + turns the face from +Z toward +X
+  std::optional<Eigen::Vector2d> position_mm;  // (X, Z) on the floor where the body's centre stands
+  // The description with these applied.
+  hw::RigDescription applied_to(hw::RigDescription rig) const;
+};
 
-// The description's devices, whatever they are. `body` replaces the simulated
-// subject when not empty.
-StatusOr<std::unique_ptr<hw::DeviceRig>> open_rig(const std::string& rig, const std::string& body);
+// "sim" is the thesis rig with the shipped demo body; other names are shipped
+// layouts; anything with a '/' or ending in .json is a description file.
+StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> open_simulated_rig(const std::string& rig,
+                                                                     const SimulatedSubject& subject = {});
+
+// The description's devices, whatever they are; `subject` changes the simulated one.
+StatusOr<std::unique_ptr<hw::DeviceRig>> open_rig(const std::string& rig, const SimulatedSubject& subject = {});
 
 // What a person is asked to do during a calibration: hold the lens dot-grid
 // board before a camera (again, when `why` says the last picture could not be

@@ -304,7 +304,7 @@ StatusOr<std::unique_ptr<Workstation>> Workstation::open(const WorkstationOption
   if (ec) return io_error(options.data_dir + ": cannot create the data folder: " + ec.message());
   ASSIGN_OR_RETURN(impl->archive, storage::Archive::open(options.data_dir));
   ASSIGN_OR_RETURN(impl->auth, AuthStore::open(options.data_dir + "/accounts.db", options.auth));
-  ASSIGN_OR_RETURN(impl->devices, pipeline::open_rig(options.rig, options.body));
+  ASSIGN_OR_RETURN(impl->devices, pipeline::open_rig(options.rig, options.subject));
   Impl* ip = impl.get();
   impl->rig = pipeline::rig_handle(
       *impl->devices, [ip](const pipeline::OperatorRequest& r) { return ip->ask_operator(r); },

@@ -21,6 +21,7 @@
 #include "recon/core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 #include "server/auth/auth_store.hpp"
+#include "server/pipeline/rig_backend.hpp"
 #include "storage/archive/archive.hpp"
 
 namespace bodyscan::server {
@@ -28,7 +29,7 @@ namespace bodyscan::server {
 struct WorkstationOptions {
   std::string data_dir = "bodyscan-data";  // archive.db, scans/, accounts.db, workstation/
   std::string rig = "sim";                 // sim | thesis | square | a rig description file
-  std::string body;                        // the simulated subject (PLY, mm); "" the description's
+  pipeline::SimulatedSubject subject;      // the simulated subject, its posture and place
   AuthOptions auth;
   int default_every = 1;                   // scan every Nth laser step unless a request says
   // Live camera previews during a scan: at most one per camera this often, this wide.

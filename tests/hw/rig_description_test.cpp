@@ -131,6 +131,34 @@ TEST(RigDescription, RoundTripsThroughJson) {
   EXPECT_EQ(nlohmann::json::parse(to_json(*c))["processing"]["max_view_deg"], 75.0);
 }
 
+TEST(RigDescription, TheSubjectsPostureIsReadCheckedAndWrittenBack) {
+  auto j = thesis_json();
+  j["simulation"]["posture"] = {{"arm_abduction_deg", 20}, {"ankle_distance_mm", 250}};
+  auto r = parse_rig_description(j.dump(), "test.json");
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->simulation.posture.arm_abduction_deg[0], 20.0);
+  EXPECT_EQ(r->simulation.posture.arm_abduction_deg[1], 20.0);
+  EXPECT_EQ(r->simulation.posture.ankle_distance_mm, 250.0);
+  j["simulation"]["posture"] = {{"arm_abduction_deg", {nullptr, 30}}};
+  r = parse_rig_description(j.dump(), "test.json");
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_FALSE(r->simulation.posture.arm_abduction_deg[0]);
+  EXPECT_EQ(r->simulation.posture.arm_abduction_deg[1], 30.0);
+  auto again = parse_rig_description(to_json(*r), "again");
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_EQ(to_json(*again), to_json(*r));
+  EXPECT_FALSE(load_shipped("thesis").simulation.posture.any());
+  j["simulation"]["posture"] = {{"arm_abduction_deg", 95}};
+  EXPECT_NE(parse_error(j).find("rig.simulation.posture: 'arm_abduction_deg' must be 0-80"), std::string::npos)
+      << parse_error(j);
+  j["simulation"]["posture"] = {{"arm_abduction_deg", {10, 20, 30}}};
+  EXPECT_NE(parse_error(j).find("[left, right]"), std::string::npos) << parse_error(j);
+  j["simulation"]["posture"] = {{"ankle_distance_mm", 50}};
+  EXPECT_NE(parse_error(j).find("'ankle_distance_mm' must be 100-700"), std::string::npos) << parse_error(j);
+  j["simulation"]["posture"] = {{"knees", 5}};
+  EXPECT_NE(parse_error(j).find("unknown field 'knees'"), std::string::npos) << parse_error(j);
+}
+
 TEST(RigDescription, ErrorsNameTheField) {
   EXPECT_NE(parse_error(nlohmann::json::parse("{}")).find("missing field 'frame'"), std::string::npos);
   {

@@ -1,5 +1,9 @@
 #include "hw/sim/sim_rig.hpp"
 
+#include <Eigen/Geometry>
+
+#include "hw/sim/pose_body.hpp"
+
 #include "recon/io/ply.hpp"
 
 #include <gtest/gtest.h>
@@ -111,6 +115,41 @@ TEST(SimulatedRig, CameraThatStopsAnsweringReportsIt) {
   ASSERT_FALSE(gone.ok());
   EXPECT_EQ(gone.status().code(), StatusCode::kUnavailable);
   EXPECT_TRUE(rig->camera(0).grab().ok());  // the others go on
+}
+
+TEST(SimulatedRig, PosesTurnsAndPlacesItsSubjectAsDescribed) {
+  auto desc = load_rig_description(*shipped_rig_path("thesis"));
+  ASSERT_TRUE(desc.ok());
+  desc->simulation.posture.arm_abduction_deg = {20.0, 25.0};
+  desc->simulation.posture.ankle_distance_mm = 250;
+  desc->simulation.subject_yaw_deg = 30;
+  desc->simulation.subject_offset = {120, 0, -80};
+  auto rig = SimulatedRig::create(*desc);
+  ASSERT_TRUE(rig.ok()) << rig.status().message();
+  auto rest = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply");
+  auto poser = BodyPoser::shipped();
+  ASSERT_TRUE(rest.ok() && poser.ok());
+  auto posed = (*poser)->pose(*rest, desc->simulation.posture);
+  ASSERT_TRUE(posed.ok()) << posed.status().message();
+  // The scene's subject is the posed body, turned by 30 degrees about the vertical
+  // (the face from +Z toward +X) and moved: vertex for vertex, up to where it stands.
+  const TriangleMesh& subject = (*rig)->scene().subject();
+  ASSERT_EQ(subject.vertices.size(), posed->mesh.vertices.size());
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(30 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::Vector3d shift = subject.vertices[0].cast<double>() - turn * posed->mesh.vertices[0].cast<double>();
+  for (size_t i = 0; i < subject.vertices.size(); i += 101)
+    EXPECT_LT((subject.vertices[i].cast<double>() - turn * posed->mesh.vertices[i].cast<double>() - shift).norm(), 0.01);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Vec3f& v : subject.vertices) mean += v.cast<double>();
+  mean /= static_cast<double>(subject.vertices.size());
+  EXPECT_NEAR(mean.x(), 120, 0.01);
+  EXPECT_NEAR(mean.z(), -80, 0.01);
+  // A mesh that is not a MakeHuman body cannot be posed: a clear error.
+  auto bunny = read_ply_mesh(BODYSCAN_SOURCE_DIR "/tests/data/bunny.ply");
+  ASSERT_TRUE(bunny.ok());
+  auto refused = SimulatedRig::create(*desc, *bunny);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("posing the simulated subject"), std::string::npos);
 }
 
 TEST(SimulatedRig, ShippedRigsTakeAStandingAdultOfTwoMetres) {
