@@ -17,7 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 deploy/install-deps.sh
 deploy/install-web.sh
-deploy/build.sh
+BUILD_TARGETS="bodyscan web" deploy/build.sh  # the program and the UI; tests come with run-tests.sh
 OUT=${OUT:-out/demo}
 DATA=${DATA:-out/data}
 PORT=${PORT:-8080}

@@ -13,6 +13,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "recon/measure/body_frame.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "recon/measure/girth.hpp"
 #include "recon/measure/surface_path.hpp"
@@ -1656,9 +1657,25 @@ std::optional<Girth> bridged_part(const Ring& ring, double xc, int side) {
 }
 
 StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeasureOptions& options) {
+  BodyFrameOptions frame_options;
+  frame_options.floor_y = options.floor_y;
+  ASSIGN_OR_RETURN(const BodyFrame frame, find_body_frame(mesh, frame_options));
+  // The rules read the body facing +Z, its left at +X, standing on Y = 0.
+  const TriangleMesh body = transformed(mesh, frame.body_from_world());
+  BodyMeasureOptions in_body = options;
+  in_body.floor_y = 0;
   BodyMeasurements out;
-  Finder finder(mesh, options, &out);
+  Finder finder(body, in_body, &out);
   RETURN_IF_ERROR(finder.run());
+  const Eigen::Isometry3d& to_world = frame.world_from_body;
+  for (BodyLandmark& l : out.landmarks) l.position = to_world * l.position;
+  for (BodyMeasurement& m : out.measurements) {
+    for (Eigen::Vector3d& p : m.path) p = to_world * p;
+    for (Eigen::Vector3d& p : m.loop) p = to_world * p;
+    if (m.plane) m.plane = Plane{to_world * m.plane->point, to_world.linear() * m.plane->normal};
+  }
+  out.floor_y = frame.floor_y;
+  out.frame = frame;
   return out;
 }
 

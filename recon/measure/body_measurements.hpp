@@ -3,8 +3,10 @@
 // needs to check it (the tape's loop, the path on the skin, the plane, the
 // landmarks) and a flag where it crosses surface the scan did not see.
 //
-// The body stands on the floor, Y up, facing +Z, its left side at +X, arms held
-// away from the sides and feet apart (the scanning pose, thesis §2.3). Landmarks
+// The body stands on the floor, Y up, anywhere and facing any way: the rules are
+// applied in its own frame (body_frame.hpp), facing +Z with its left side at +X,
+// and everything is given back in the mesh's frame. Arms held away from the sides
+// and feet apart (the scanning pose, thesis §2.3). Landmarks
 // come from horizontal cuts (BodySlicer) and are geometric stand-ins for the
 // anatomical ones ISO 8559-1 §3 palpates (docs/measurements.md gives each rule):
 //   crotch        the lowest level where one loop spans the body's midline;
@@ -31,6 +33,7 @@
 
 #include "recon/core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
+#include "recon/measure/body_frame.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "recon/measure/girth.hpp"
 #include "recon/measure/plane_section.hpp"
@@ -77,6 +80,9 @@ struct BodyMeasureOptions {
 
 struct BodyMeasurements {
   double floor_y = 0;
+  // Where the body stood and which way it faced: the rules were applied in this
+  // frame, and everything below is given back in the mesh's (world) frame.
+  BodyFrame frame;
   std::vector<BodyLandmark> landmarks;
   std::vector<BodyMeasurement> measurements;
   // Measurements that could not be taken, and why.
