@@ -33,6 +33,7 @@
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_frame.hpp"
 #include "recon/measure/body_measurements.hpp"
+#include "recon/measure/body_posture.hpp"
 
 using namespace bodyscan;
 
@@ -223,8 +224,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   nlohmann::json all = nlohmann::json::array();
-  std::printf("| body | variant | heights | torso girths | limb and neck girths | lengths | unmoved skin: within half the allowance | outer arm length vs its points | landmarks to their vertices: median / largest |\n");
-  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---|\n");
+  std::printf("| body | variant | heights | torso girths | limb and neck girths | lengths | unmoved skin: within half the allowance | outer arm length vs its points | landmarks to their vertices: median / largest | arms found - true (left / right) | ankles found - true | turn found |\n");
+  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n");
   for (const std::string& path : bodies) {
     auto mesh = read_ply_mesh(path);
     if (!mesh.ok()) {
@@ -256,7 +257,13 @@ int main(int argc, char** argv) {
       TriangleMesh mesh;
       Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
       bool posed = false;
+      hw::sim::PostureJoints joints;  // the skeleton's, for the posture found
     };
+    auto rest_pose = (*poser)->pose(ref.mesh, {});
+    if (!rest_pose.ok()) {
+      std::fprintf(stderr, "posture_benchmark: %s: %s\n", ref.name.c_str(), rest_pose.status().message().c_str());
+      return 1;
+    }
     std::vector<Variant> variants;
     for (double t : turns) {
       Variant v;
@@ -267,6 +274,7 @@ int main(int argc, char** argv) {
       v.motion = Eigen::Translation3d(shift * std::cos(3 * dir), 0, shift * std::sin(3 * dir)) *
                  Eigen::AngleAxisd(dir, Eigen::Vector3d::UnitY());
       v.mesh = transformed(ref.mesh, v.motion);
+      v.joints = rest_pose->rest;
       variants.push_back(std::move(v));
     }
     auto pose = [&](const std::string& name, const hw::SubjectPosture& p) {
@@ -276,7 +284,7 @@ int main(int argc, char** argv) {
                      posed.status().message().c_str());
         return;
       }
-      variants.push_back({name, std::move(posed->mesh), Eigen::Isometry3d::Identity(), true});
+      variants.push_back({name, std::move(posed->mesh), Eigen::Isometry3d::Identity(), true, posed->posed});
     };
     for (double a : arms) {
       hw::SubjectPosture p;
@@ -297,7 +305,7 @@ int main(int argc, char** argv) {
     for (Variant& v : variants) {
       auto got = measure_body(v.mesh);
       if (!got.ok()) {
-        std::printf("| %s | %s | not measured: %s |||||||\n", ref.name.c_str(), v.name.c_str(),
+        std::printf("| %s | %s | not measured: %s ||||||||||\n", ref.name.c_str(), v.name.c_str(),
                     got.status().message().c_str());
         all.push_back({{"body", ref.name}, {"variant", v.name}, {"error", got.status().message()}});
         continue;
@@ -311,9 +319,18 @@ int main(int argc, char** argv) {
         std::printf(" %.1f |", x);
         j["largest_change_mm"][f] = {{"value", x}, {"measurement", it == r.largest.end() ? "" : it->second.second}};
       }
-      std::printf(" %zu / %zu | %s | %.1f / %.1f (%s) |\n", r.unmoved_within_half, r.unmoved,
+      std::printf(" %zu / %zu | %s | %.1f / %.1f (%s) |", r.unmoved_within_half, r.unmoved,
                   v.posed ? (std::to_string(r.arm_length_error).substr(0, 4) + " mm").c_str() : "-", r.landmark_median,
                   r.landmark_max, r.landmark_worst.c_str());
+      const BodyPosture& found = got->posture;
+      double arm_error[2] = {NAN, NAN};
+      for (int k = 0; k < 2; ++k)
+        if (found.arm_abduction_deg[k]) arm_error[k] = *found.arm_abduction_deg[k] - v.joints.arm_abduction_deg(k);
+      const double ankle_error =
+          found.ankle_distance_mm ? *found.ankle_distance_mm - v.joints.ankle_distance_mm() : NAN;
+      std::printf(" %+.1f / %+.1f | %+.0f mm | %+.1f |\n", arm_error[0], arm_error[1], ankle_error, found.turn_deg);
+      j["arm_abduction_error_deg"] = {arm_error[0], arm_error[1]};
+      j["ankle_distance_error_mm"] = ankle_error;
       j["unmoved_values"] = r.unmoved;
       j["unmoved_within_half_allowance"] = r.unmoved_within_half;
       j["landmark_median_mm"] = r.landmark_median;
@@ -322,7 +339,7 @@ int main(int argc, char** argv) {
       if (v.posed) j["outer_arm_length_error_mm"] = r.arm_length_error;
       j["turn_found_deg"] = got->frame.turn_deg;
       all.push_back(j);
-      for (const std::string& d : r.detail) std::printf("|   | %s |||||||\n", d.c_str());
+      for (const std::string& d : r.detail) std::printf("|   | %s ||||||||||\n", d.c_str());
     }
     std::fflush(stdout);
   }

@@ -111,6 +111,9 @@ constexpr double kLevelKneesMm = 10;
 constexpr double kSecondNarrowMm = 2;
 // A deeper fold is a crease: its level is the centroid of its bottom this deep (mm).
 constexpr double kCreaseDepthMm = 2;
+// The ankles' height, a fraction of the stature: the stance is read from the legs'
+// centres there (BodyPosture::ankle_distance_mm).
+constexpr double kAnkleLevel = 0.05;
 
 // The loop that spans the midline X = xc (torso, neck, head), the longest if several.
 const Ring* midline(const std::vector<Ring>& rings, double xc) {
@@ -424,6 +427,8 @@ class Finder {
     for (int s : {1, -1}) measure_leg(s);
     for (int s : {1, -1}) measure_arm(s);
     measure_lengths();
+    find_head_axis();
+    if (ankle_[0] && ankle_[1]) out_->posture.ankle_distance_mm = (*ankle_[0] - *ankle_[1]).norm();
     return Status();
   }
 
@@ -771,6 +776,21 @@ class Finder {
     return Status();
   }
 
+  // The head's axis: a line through the centres of the cranium's cuts (the top
+  // 1.5-6 % of the height: above the face and the jaw, whose shape would tilt
+  // the line on a level head), as tilts from the vertical.
+  void find_head_axis() {
+    std::vector<Eigen::Vector3d> c;
+    const double y0 = floor_ + h_ - 0.06 * h_, y1 = floor_ + h_ - 0.015 * h_;
+    prefetch(y0, y1, 2);
+    for (double y = y0; y <= y1; y += 2)
+      if (const Ring* m = midline(rings(y), xc_)) c.push_back(m->centroid);
+    if (c.size() < 5) return;
+    const Eigen::Vector3d d = fit_line(c, 0, c.size()).second;
+    out_->posture.head_tilt_deg = std::atan2(d.z(), d.y()) * 180 / M_PI;
+    out_->posture.head_side_tilt_deg = std::atan2(d.x(), d.y()) * 180 / M_PI;
+  }
+
   void find_neck_points() {
     const double y_snp = 0.5 * (lm("side_neck_point_left").y() + lm("side_neck_point_right").y());
     double f = neck_c_.z(), b = neck_c_.z();
@@ -968,13 +988,10 @@ class Finder {
     // bodies, now 0.5-1.05, and the hip girth 0.7-1.1, now 0.5-1.0.
     hip_y_ = profile(crotch_y_ + 0.01 * h_, crotch_y_ + 0.16 * h_, [](const Ring& m) { return m.z_min; }, false, 0.5,
                      crotch_y_ + 0.08 * h_, kHipHalf * h_, true);
+    // The hip's back point is on the tape at the centre back: the tape spans the
+    // cleft between the buttocks at their backmost, wherever on either side that is.
     Eigen::Vector3d hip_point(xc_, hip_y_, zc_);
-    {
-      const std::vector<Ring>& r = rings(hip_y_);
-      if (const Ring* m = midline(r, xc_))
-        for (const Eigen::Vector3d& p : m->points)
-          if (p.z() == m->z_min) hip_point = p;
-    }
+    if (const Ring* m = midline(rings(hip_y_), xc_)) hip_point.z() = m->z_min;
     landmark("hip_back_point", hip_point);
     // Waist: the narrowest torso between hip and under-bust. Where the front has no
     // fold below the bust (a belly's dome, whose top is the most forward point:
@@ -1271,6 +1288,7 @@ class Finder {
                       : "horizontal, halfway between crotch and kneecap");
     girth("calf_girth_" + sd, "Calf girth (" + sd + ")", "5.3.24", level_girth(cy, cc), {"knee_" + sd},
           "horizontal, the largest between ankle and knee");
+    if (const Ring* a = leg(rings(at(kAnkleLevel)), s)) ankle_[s > 0 ? 0 : 1] = a->centroid;
     double ay = at(0.06);
     const Eigen::Vector3d ac = extreme(at(0.04), cy, false, &ay);
     girth("min_leg_girth_" + sd, "Minimum leg girth (" + sd + ")", "5.3.25", level_girth(ay, ac), {},
@@ -1311,6 +1329,8 @@ class Finder {
     }
     const auto [uc, ud] = fit_line(c, 0, e + 1);
     const auto [fc, fd] = fit_line(c, e, w + 1);
+    out_->posture.arm_abduction_deg[s > 0 ? 0 : 1] = std::acos(std::clamp(ud.y(), -1.0, 1.0)) * 180 / M_PI;
+    out_->posture.elbow_bend_deg[s > 0 ? 0 : 1] = std::acos(std::min(1.0, std::abs(ud.dot(fd)))) * 180 / M_PI;
     auto on_axis = [](const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& p) {
       return (o + (p - o).dot(d) * d).eval();
     };
@@ -1520,6 +1540,7 @@ class Finder {
   double floor_ = 0, h_ = 0, xc_ = 0, zc_ = 0;
   double vault_y_[2] = {0, 0};  // where each armpit's join is kJoinDepth deep (the chest is cut below)
   std::optional<Knee> knee_[2];  // left, right
+  std::optional<Eigen::Vector3d> ankle_[2];  // the legs' centres at kAnkleLevel
   double crotch_y_ = 0, armpit_y_[2] = {0, 0}, neck_y_ = 0, neck_r_ = 0, neck_tilt_ = 0;
   double arm_apart_y_[2] = {0, 0};  // where each arm's own loop ends (the armpit below a filled bridge)
   double bust_y_ = 0, underbust_y_ = 0, waist_y_ = 0, hip_y_ = 0;
@@ -1676,6 +1697,16 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
   }
   out.floor_y = frame.floor_y;
   out.frame = frame;
+  out.posture.turn_deg = frame.turn_deg;
+  out.posture.position_x_mm = frame.world_from_body.translation().x();
+  out.posture.position_z_mm = frame.world_from_body.translation().z();
+  out.posture_checks = check_posture(out.posture);
+  for (BodyMeasurement& m : out.measurements) {
+    m.posture_assumed = posture_assumed(m.name);
+    for (const std::string& part : posture_parts(m.name))
+      for (const PostureCheck& c : out.posture_checks)
+        if (c.part == part && !c.ok) m.outside_posture = true;
+  }
   return out;
 }
 

@@ -34,6 +34,7 @@
 #include "recon/core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 #include "recon/measure/body_frame.hpp"
+#include "recon/measure/body_posture.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "recon/measure/girth.hpp"
 #include "recon/measure/plane_section.hpp"
@@ -70,6 +71,10 @@ struct BodyMeasurement {
   std::string definition;              // how it was taken, one sentence
   float min_confidence = 1;            // lowest mesh confidence along it and at its landmarks
   bool crosses_filled_hole() const { return min_confidence < kMeasuredConfidence; }
+  // What its definition assumes of the posture ("" nothing), and whether the body
+  // stood outside that (body_posture.hpp): then the value is not the standard's.
+  std::string posture_assumed;
+  bool outside_posture = false;
 };
 
 struct BodyMeasureOptions {
@@ -83,6 +88,10 @@ struct BodyMeasurements {
   // Where the body stood and which way it faced: the rules were applied in this
   // frame, and everything below is given back in the mesh's (world) frame.
   BodyFrame frame;
+  // How the body stood, and each part of that checked against the scanning
+  // posture the rules assume.
+  BodyPosture posture;
+  std::vector<PostureCheck> posture_checks;
   std::vector<BodyLandmark> landmarks;
   std::vector<BodyMeasurement> measurements;
   // Measurements that could not be taken, and why.

@@ -248,7 +248,17 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                          ASSIGN_OR_RETURN(std::vector<storage::MeasurementRecord> ms, ws.archive().measurements(id));
                          nlohmann::json out = nlohmann::json::array();
                          for (const auto& m : ms) out.push_back(measurement_json(m));
-                         return nlohmann::json{{"scan_id", id}, {"version", r.current_version}, {"measurements", out}}
+                         // How the customer stood, as the measurements read it (scan.json).
+                         nlohmann::json posture = nullptr;
+                         if (auto path = ws.archive().file_path(id, 0, "scan.json"); path.ok())
+                           if (auto scan = read_whole_file(*path); scan.ok()) {
+                             const nlohmann::json j = nlohmann::json::parse(*scan, nullptr, false);
+                             if (j.is_object() && j.contains("posture")) posture = j["posture"];
+                           }
+                         return nlohmann::json{{"scan_id", id},
+                                               {"version", r.current_version},
+                                               {"measurements", out},
+                                               {"posture", posture}}
                              .dump();
                        });
                        if (!text.ok()) return error_response(text.status());

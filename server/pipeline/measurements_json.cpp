@@ -50,6 +50,29 @@ nlohmann::json to_json(const BodyMeasurement& m) {
                                                                                       : kSurfaceAlgorithm)}};
   if (m.plane) j["plane"] = plane_json(*m.plane);
   if (!m.loop.empty()) j["loop"] = polyline_json(m.loop);
+  if (!m.posture_assumed.empty()) {
+    j["posture_assumed"] = m.posture_assumed;
+    j["outside_posture"] = m.outside_posture;
+  }
+  return j;
+}
+
+nlohmann::json to_json(const BodyPosture& p, const std::vector<PostureCheck>& checks) {
+  const auto optional = [](const std::optional<double>& x) { return x ? nlohmann::json(*x) : nlohmann::json(nullptr); };
+  nlohmann::json j = {{"turn_deg", p.turn_deg},
+                      {"position_mm", {p.position_x_mm, p.position_z_mm}},
+                      {"arm_abduction_deg", {optional(p.arm_abduction_deg[0]), optional(p.arm_abduction_deg[1])}},
+                      {"elbow_bend_deg", {optional(p.elbow_bend_deg[0]), optional(p.elbow_bend_deg[1])}},
+                      {"ankle_distance_mm", optional(p.ankle_distance_mm)},
+                      {"head_tilt_deg", optional(p.head_tilt_deg)},
+                      {"head_side_tilt_deg", optional(p.head_side_tilt_deg)},
+                      {"checks", nlohmann::json::array()}};
+  bool ok = true;
+  for (const PostureCheck& c : checks) {
+    j["checks"].push_back({{"part", c.part}, {"ok", c.ok}, {"message", c.message}});
+    ok = ok && c.ok;
+  }
+  j["ok"] = ok;
   return j;
 }
 
@@ -57,6 +80,7 @@ void add_body_measurements(const BodyMeasurements& body, nlohmann::json* documen
   nlohmann::json& d = *document;
   d["algorithm"] = kBodyMeasurementsAlgorithm;
   d["floor_y_mm"] = body.floor_y;
+  d["posture"] = to_json(body.posture, body.posture_checks);
   d["landmarks"] = nlohmann::json::array();
   for (const BodyLandmark& l : body.landmarks)
     d["landmarks"].push_back({{"name", l.name}, {"position", point_json(l.position)}, {"confidence", l.confidence}});

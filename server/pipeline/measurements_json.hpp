@@ -29,6 +29,10 @@ nlohmann::json measurements_document(const std::string& file, const std::string&
 nlohmann::json to_json(const BodyMeasurement& m);
 void add_body_measurements(const BodyMeasurements& body, nlohmann::json* document);
 
+// How the body stood (arms, feet, head, turn, place) and each part checked
+// against the scanning posture; "ok" when every part is inside it.
+nlohmann::json to_json(const BodyPosture& posture, const std::vector<PostureCheck>& checks);
+
 // A surface length between two points.
 nlohmann::json to_json(const SurfacePath& p, const std::string& name);
 

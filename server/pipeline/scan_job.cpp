@@ -138,6 +138,7 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
   }
   nlohmann::json j;
   j["points"] = r.cloud.size();
+  if (r.body) j["posture"] = to_json(r.body->posture, r.body->posture_checks);
   if (!glb.is_null()) j["mesh_glb"] = glb;
   j["frames"] = r.scan.frames;
   j["frames_unseen"] = r.scan.frames_unseen;

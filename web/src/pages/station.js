@@ -5,6 +5,7 @@
 import { enc, get, post, query } from '../api.js';
 import { overallFraction, stageText } from '../progress.js';
 import { ago, clear, errorText, h, toast, when } from '../ui/dom.js';
+import { wantedPostureCard } from '../viewer/posture.js';
 
 
 export async function mount(container, _params, ctx) {
@@ -188,7 +189,8 @@ export async function mount(container, _params, ctx) {
       modeSwitch,
       modeNew,
       modeExisting,
-      h('p', { class: 'muted small' }, 'Ask the customer to stand on the marks, arms slightly away from the body, and to hold still for about two minutes.'),
+      wantedPostureCard(),
+      h('p', { class: 'muted small' }, 'Ask the customer to stand on the marks like the picture and to hold still for about two minutes.'),
       startButton,
     ),
   );

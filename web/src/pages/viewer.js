@@ -7,6 +7,7 @@ import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 import { BodyView, ModelDecoding } from '../viewer/body-view.js';
 import { MeasureTool, TOOLS } from '../viewer/measure-tool.js';
 import { COLOURS, drawMeasurement, KIND_LABEL, measurementTable, slug } from '../viewer/measurement-table.js';
+import { postureCard } from '../viewer/posture.js';
 import { shareDialog } from './share-dialog.js';
 
 // The model's bytes, asked for at once (the current version, revalidated by its
@@ -33,7 +34,7 @@ export async function mount(container, { id }, ctx) {
   const nextTask = () => new Promise((r) => setTimeout(r, 0));
   await Promise.race([bytes.then(nextTask, () => {}), new Promise((r) => setTimeout(r, 250))]);
   const role = ctx.session.role;
-  const state = { unit: preferredUnit(), selected: null, fresh: null, measurements: [], scan: null, customer: null };
+  const state = { unit: preferredUnit(), selected: null, fresh: null, measurements: [], posture: null, scan: null, customer: null };
 
   const viewport = h('div', { class: 'viewport', id: 'viewport' });
   const hint = h('p', { class: 'hint', role: 'status' }, TOOLS.rotate.hint);
@@ -41,8 +42,9 @@ export async function mount(container, { id }, ctx) {
   const heading = h('div', { class: 'scan-heading' }, h('h1', {}, 'Scan'));
   const resultBox = h('div', { class: 'result card', hidden: true, 'aria-live': 'polite' });
   const tableBox = h('div', { class: 'table-box' });
+  const postureBox = h('div', { class: 'posture-box' });
   const actions = h('div', { class: 'actions' });
-  const side = h('aside', { class: 'viewer-side' }, heading, resultBox, h('h2', {}, 'Measurements'), tableBox, h('h2', {}, 'Sheet and sharing'), actions);
+  const side = h('aside', { class: 'viewer-side' }, heading, postureBox, resultBox, h('h2', {}, 'Measurements'), tableBox, h('h2', {}, 'Sheet and sharing'), actions);
   const page = h('section', { class: 'page viewer-page' }, h('div', { class: 'viewer-main' }, toolbar, viewport, hint), side);
   container.append(page);
 
@@ -101,6 +103,8 @@ export async function mount(container, { id }, ctx) {
   async function loadMeasurements() {
     const m = await get(`/api/scans/${enc(id)}/measurements`);
     state.measurements = m.measurements;
+    state.posture = m.posture || null;
+    clear(postureBox, postureCard(state.posture, state.measurements));
     renderTable();
     renderActions();
   }

@@ -13,6 +13,8 @@ export const KIND_LABEL = {
 
 export const FILLED_NOTE = 'Part of this line crosses skin the cameras did not see (filled in by the reconstruction): check it with a tape if it matters.';
 
+export const POSTURE_NOTE = 'Taken outside the posture its definition assumes (see Posture): not the standard’s value.';
+
 export const COLOURS = { selected: 0xd6336c, fresh: 0x0b7a75, compare: 0x7048e8 };
 
 // Draws a measurement's geometry on a BodyView under `key`.
@@ -81,6 +83,7 @@ export function measurementTable({
       h(
         'td',
         { class: 'num value' },
+        g.outside_posture ? h('span', { class: 'posture-flag', title: POSTURE_NOTE, 'aria-label': POSTURE_NOTE }, '⚑ ') : null,
         g.crosses_filled_hole ? h('span', { class: 'filled', title: FILLED_NOTE }, '≈ ') : null,
         formatLength(m.value_mm, unit),
       ),

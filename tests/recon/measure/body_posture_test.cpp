@@ -1,0 +1,173 @@
+#include "recon/measure/body_posture.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+
+#include "hw/sim/pose_body.hpp"
+#include "recon/io/ply.hpp"
+#include "recon/measure/body_frame.hpp"
+#include "recon/measure/body_measurements.hpp"
+
+namespace bodyscan {
+namespace {
+
+// The shipped bodies, posed by skinning (hw/sim/pose_body.hpp): the skeleton's
+// joints are the ground truth for the posture, and vertex i stays the same point.
+struct Posed {
+  hw::sim::PosedBody body;
+  BodyMeasurements measured;
+};
+
+const Posed& posed(const std::string& file, double arms, double ankles) {
+  static std::map<std::string, Posed> cache;
+  const std::string key = file + "/" + std::to_string(arms) + "/" + std::to_string(ankles);
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    auto rest = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/" + file);
+    EXPECT_TRUE(rest.ok());
+    auto poser = hw::sim::BodyPoser::shipped();
+    EXPECT_TRUE(poser.ok());
+    hw::SubjectPosture p;
+    if (arms > 0) p.arm_abduction_deg = {arms, arms};
+    if (ankles > 0) p.ankle_distance_mm = ankles;
+    auto body = (*poser)->pose(*rest, p);
+    EXPECT_TRUE(body.ok()) << body.status().message();
+    auto measured = measure_body(body->mesh);
+    EXPECT_TRUE(measured.ok()) << measured.status().message();
+    it = cache.emplace(key, Posed{std::move(*body), measured.ok() ? *measured : BodyMeasurements{}}).first;
+  }
+  return it->second;
+}
+
+const PostureCheck* check(const BodyMeasurements& b, const std::string& part) {
+  for (const PostureCheck& c : b.posture_checks)
+    if (c.part == part) return &c;
+  return nullptr;
+}
+
+class BodyPostureTest : public ::testing::TestWithParam<const char*> {};
+
+// The upper arm's skin axis lies within a few degrees of the bone (shoulder joint
+// to elbow joint), and the legs' centres at the ankles within 15 mm of the joints'
+// distance, over the postures a shop sees.
+TEST_P(BodyPostureTest, IsReadFromTheSurface) {
+  for (const auto& [arms, ankles] : {std::pair{20.0, 250.0}, {30.0, 350.0}, {45.0, 450.0}, {0.0, 0.0}}) {
+    const Posed& p = posed(GetParam(), arms, ankles);
+    const BodyPosture& found = p.measured.posture;
+    for (int s = 0; s < 2; ++s) {
+      ASSERT_TRUE(found.arm_abduction_deg[s]) << arms;
+      EXPECT_NEAR(*found.arm_abduction_deg[s], p.body.posed.arm_abduction_deg(s), 6) << arms;
+      ASSERT_TRUE(found.elbow_bend_deg[s]);
+      EXPECT_GT(*found.elbow_bend_deg[s], 0);
+      EXPECT_LT(*found.elbow_bend_deg[s], 45);  // the MakeHuman arms are slightly bent
+    }
+    ASSERT_TRUE(found.ankle_distance_mm);
+    EXPECT_NEAR(*found.ankle_distance_mm, p.body.posed.ankle_distance_mm(), 15) << ankles;
+    ASSERT_TRUE(found.head_tilt_deg && found.head_side_tilt_deg);
+    EXPECT_NEAR(*found.head_side_tilt_deg, 0, 0.5);  // a symmetric body
+    EXPECT_LT(std::abs(*found.head_tilt_deg), 10);
+    EXPECT_NEAR(found.turn_deg, 0, 0.05);
+  }
+}
+
+TEST_P(BodyPostureTest, TurningAndMovingTheBodyChangesOnlyTheTurnAndThePlace) {
+  const Posed& p = posed(GetParam(), 25, 300);
+  const Eigen::Isometry3d m =
+      Eigen::Translation3d(-200, 0, 150) * Eigen::AngleAxisd(-25 * M_PI / 180, Eigen::Vector3d::UnitY());
+  auto moved = measure_body(transformed(p.body.mesh, m));
+  ASSERT_TRUE(moved.ok()) << moved.status().message();
+  const BodyPosture &a = p.measured.posture, &b = moved->posture;
+  EXPECT_NEAR(b.turn_deg, -25, 0.05);
+  const Eigen::Vector3d place = m * Eigen::Vector3d(a.position_x_mm, 0, a.position_z_mm);
+  EXPECT_NEAR(b.position_x_mm, place.x(), 0.5);
+  EXPECT_NEAR(b.position_z_mm, place.z(), 0.5);
+  for (int s = 0; s < 2; ++s) EXPECT_NEAR(*b.arm_abduction_deg[s], *a.arm_abduction_deg[s], 0.05);
+  EXPECT_NEAR(*b.ankle_distance_mm, *a.ankle_distance_mm, 0.05);
+}
+
+// Arms lowered to 20 degrees and the feet 25 cm apart: the checks say what to ask,
+// and exactly the values whose definitions depend on those parts are flagged.
+TEST_P(BodyPostureTest, AskForTheScanningPostureAndFlagWhatDependsOnIt) {
+  const BodyMeasurements& low = posed(GetParam(), 20, 250).measured;
+  for (const char* part : {"arm_left", "arm_right", "feet"}) {
+    const PostureCheck* c = check(low, part);
+    ASSERT_NE(c, nullptr) << part;
+    EXPECT_FALSE(c->ok) << part;
+  }
+  EXPECT_NE(check(low, "arm_left")->message.find("raise it to 35–50°"), std::string::npos) << check(low, "arm_left")->message;
+  EXPECT_NE(check(low, "feet")->message.find("300–450 mm apart"), std::string::npos) << check(low, "feet")->message;
+  EXPECT_TRUE(check(low, "head")->ok);
+  EXPECT_TRUE(check(low, "turn")->ok);
+  for (const BodyMeasurement& m : low.measurements)
+    EXPECT_EQ(m.outside_posture, !posture_parts(m.name).empty()) << m.name;
+  EXPECT_TRUE(low.find("outer_arm_length_left")->outside_posture);
+  EXPECT_FALSE(low.find("waist_girth")->outside_posture);
+  EXPECT_EQ(low.find("outer_arm_length_left")->posture_assumed, "the left arm 35–50° from the vertical");
+  EXPECT_EQ(low.find("hip_girth")->posture_assumed, "the ankles 300–450 mm apart");
+  EXPECT_EQ(low.find("waist_girth")->posture_assumed, "");
+
+  // In the posture: nothing flagged.
+  const BodyMeasurements& within = posed(GetParam(), 42, 380).measured;
+  for (const PostureCheck& c : within.posture_checks) EXPECT_TRUE(c.ok) << c.part << ": " << c.message;
+  for (const BodyMeasurement& m : within.measurements) EXPECT_FALSE(m.outside_posture) << m.name;
+}
+
+// Vertex i is the same anatomical point in every posture: each landmark found on
+// the rest body marks a vertex, and in another posture the landmark found there
+// lies near that vertex's new place. The shoulder points are left out: their rule
+// (the corner of the shoulder's outline) holds for arms 35-50 degrees only, and
+// the values that use them are flagged outside that (docs/measurements.md,
+// "Posture"); the armpits lie in the crease, where skinning is not anatomical.
+TEST_P(BodyPostureTest, LandmarksKeepToTheirAnatomicalPointsAcrossArmsAndStances) {
+  const Posed& rest = posed(GetParam(), 0, 0);
+  for (const auto& [arms, ankles] : {std::pair{25.0, 0.0}, {35.0, 0.0}, {45.0, 0.0}, {0.0, 300.0}, {0.0, 420.0}}) {
+    const Posed& p = posed(GetParam(), arms, ankles);
+    for (const BodyLandmark& l : rest.measured.landmarks) {
+      if (l.name.rfind("shoulder_point", 0) == 0 || l.name.rfind("armpit", 0) == 0 || l.name == "crotch" ||
+          l.name == "neck_level")
+        continue;
+      size_t v = 0;
+      double best = INFINITY;
+      for (size_t i = 0; i < rest.body.mesh.vertices.size(); ++i)
+        if (const double d = (rest.body.mesh.vertices[i].cast<double>() - l.position).norm(); d < best) best = d, v = i;
+      const Eigen::Vector3d offset = l.position - rest.body.mesh.vertices[v].cast<double>();
+      const BodyLandmark* found = p.measured.landmark(l.name);
+      ASSERT_NE(found, nullptr) << l.name;
+      EXPECT_LT((found->position - p.body.mesh.vertices[v].cast<double>() - offset).norm(), 10)
+          << l.name << " arms " << arms << " ankles " << ankles;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(ShippedBodies, BodyPostureTest, ::testing::Values("male_average.ply", "female_average.ply"));
+
+TEST(PostureChecks, SayWhatToAskOfTheCustomer) {
+  BodyPosture p;
+  p.arm_abduction_deg[0] = 60;
+  p.arm_abduction_deg[1] = 40;
+  p.ankle_distance_mm = 520;
+  p.head_tilt_deg = -20;
+  p.head_side_tilt_deg = 3;
+  p.turn_deg = 45;
+  const std::vector<PostureCheck> c = check_posture(p);
+  ASSERT_EQ(c.size(), 5u);
+  EXPECT_EQ(c[0].part, "arm_left");
+  EXPECT_FALSE(c[0].ok);
+  EXPECT_NE(c[0].message.find("lower it to 35–50°"), std::string::npos) << c[0].message;
+  EXPECT_TRUE(c[1].ok);
+  EXPECT_TRUE(c[1].message.empty());
+  EXPECT_FALSE(c[2].ok);
+  EXPECT_NE(c[2].message.find("520 mm apart"), std::string::npos);
+  EXPECT_FALSE(c[3].ok);
+  EXPECT_NE(c[3].message.find("20° back"), std::string::npos) << c[3].message;
+  EXPECT_FALSE(c[4].ok);
+  EXPECT_NE(c[4].message.find("turn to face it"), std::string::npos);
+  // Parts not found are not checked; the turn always is.
+  EXPECT_EQ(check_posture(BodyPosture{}).size(), 1u);
+}
+
+}  // namespace
+}  // namespace bodyscan
