@@ -428,7 +428,7 @@ class Finder {
     for (int s : {1, -1}) measure_arm(s);
     measure_lengths();
     find_head_axis();
-    if (ankle_[0] && ankle_[1]) out_->posture.ankle_distance_mm = (*ankle_[0] - *ankle_[1]).norm();
+    find_stance();
     return Status();
   }
 
@@ -774,6 +774,25 @@ class Finder {
              middle_of_extreme(at_u[0].empty() ? column[std::min(nb - 1, static_cast<size_t>((us[k] - u0) / bin))] : at_u[0],
                                Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), kRidgeBand, true));
     return Status();
+  }
+
+  // The stance: the distance between the legs' centres at the ankles, each leg the
+  // longest loop wholly on its side of the midline (a scrap the surface left by a
+  // foot is not it), read at the first level from kAnkleLevel up where both are.
+  void find_stance() {
+    for (double f = kAnkleLevel; f <= kAnkleLevel + 0.03 + 1e-9; f += 0.01) {
+      const std::vector<Ring>& r = rings(at(f));
+      const Ring* legs[2] = {nullptr, nullptr};
+      for (const Ring& x : r) {
+        if (x.spans_x(xc_)) continue;
+        const Ring*& l = legs[x.centroid.x() > xc_ ? 0 : 1];
+        if (!l || x.girth > l->girth) l = &x;
+      }
+      if (legs[0] && legs[1]) {
+        out_->posture.ankle_distance_mm = (legs[0]->centroid - legs[1]->centroid).norm();
+        return;
+      }
+    }
   }
 
   // The head's axis: a line through the centres of the cranium's cuts (the top
@@ -1288,7 +1307,6 @@ class Finder {
                       : "horizontal, halfway between crotch and kneecap");
     girth("calf_girth_" + sd, "Calf girth (" + sd + ")", "5.3.24", level_girth(cy, cc), {"knee_" + sd},
           "horizontal, the largest between ankle and knee");
-    if (const Ring* a = leg(rings(at(kAnkleLevel)), s)) ankle_[s > 0 ? 0 : 1] = a->centroid;
     double ay = at(0.06);
     const Eigen::Vector3d ac = extreme(at(0.04), cy, false, &ay);
     girth("min_leg_girth_" + sd, "Minimum leg girth (" + sd + ")", "5.3.25", level_girth(ay, ac), {},
@@ -1540,7 +1558,6 @@ class Finder {
   double floor_ = 0, h_ = 0, xc_ = 0, zc_ = 0;
   double vault_y_[2] = {0, 0};  // where each armpit's join is kJoinDepth deep (the chest is cut below)
   std::optional<Knee> knee_[2];  // left, right
-  std::optional<Eigen::Vector3d> ankle_[2];  // the legs' centres at kAnkleLevel
   double crotch_y_ = 0, armpit_y_[2] = {0, 0}, neck_y_ = 0, neck_r_ = 0, neck_tilt_ = 0;
   double arm_apart_y_[2] = {0, 0};  // where each arm's own loop ends (the armpit below a filled bridge)
   double bust_y_ = 0, underbust_y_ = 0, waist_y_ = 0, hip_y_ = 0;

@@ -129,6 +129,8 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.match(await page.locator('#rig-status').innerText(), /front-left/);
     await page.fill('input[name=name]', 'Ada Lovelace');
     await page.fill('input[name=contact]', 'ada@example.org');
+    // The posture to ask for, as a picture.
+    assert.match(await page.locator('.wanted-posture svg').getAttribute('aria-label'), /Stand like this/);
     await shot(page, 'station');
     const run = await runScanFromStation('first');
     console.log(`first scan (with calibration) through the UI: ${run.seconds.toFixed(0)} s, stages ${[...run.stages].join(', ')}`);
@@ -157,6 +159,14 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     const covered = await coverage(page, '#viewport canvas');
     assert.ok(covered > 0.04, `the body covers ${(covered * 100).toFixed(1)} % of the view`);
     await page.locator('table.measurements tr[data-name=waist_girth]').waitFor();
+    // The demo body stands in the scanning posture, facing the front: read from the
+    // scan, checked, nothing flagged.
+    const posture = page.locator('#posture');
+    await posture.waitFor();
+    assert.equal(await posture.getAttribute('data-ok'), 'true', await posture.innerText());
+    assert.deepEqual(await posture.locator('li').evaluateAll((li) => li.map((x) => x.dataset.part)), ['arm_left', 'arm_right', 'feet', 'head', 'turn']);
+    assert.match(await posture.innerText(), /Facing the front/);
+    assert.equal(await page.locator('table.measurements .posture-flag').count(), 0);
     await shot(page, 'viewer-operator');
     // A row highlights its line: the picture changes.
     const before = await coverage(page, '#viewport canvas');
