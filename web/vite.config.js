@@ -3,12 +3,13 @@
 // Hashed bundles go to assets/ (the server marks them immutable), the Draco
 // decoder of the `three` package among them (DRACOLoader finds it by
 // import.meta.url). Every text and wasm file also gets a .gz twin, which the
-// server sends to browsers that take gzip.
+// server sends to browsers that take gzip: made by Zopfli, whose deflate streams
+// any gzip reader takes and come out 4 % smaller than zlib's best.
 import { defineConfig } from 'vite';
 import { readdirSync, readFileSync, statSync, writeFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { gzipSync, constants } from 'node:zlib';
+import { gzipAsync } from '@gfx/zopfli';
 
 function gzipTwins() {
   const compressible = /\.(js|mjs|css|html|svg|json|wasm|txt)$/;
@@ -27,12 +28,12 @@ function gzipTwins() {
     closeBundle: {
       order: 'post',
       sequential: true,
-      handler() {
+      async handler() {
         for (const file of walk(outDir)) {
           if (!compressible.test(file)) continue;
           const raw = readFileSync(file);
           if (raw.length < 1024) continue;
-          const gz = gzipSync(raw, { level: constants.Z_BEST_COMPRESSION });
+          const gz = Buffer.from(await gzipAsync(raw, { numiterations: 15 }));
           if (gz.length < raw.length * 0.9) writeFileSync(`${file}.gz`, gz);
         }
       },
