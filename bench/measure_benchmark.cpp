@@ -55,18 +55,6 @@ namespace {
 
 double secs(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// ISO 20685-1 allowance for a measurement (mm).
-double allowance(const BodyMeasurement& m) {
-  static const char* large[] = {"chest_girth", "bust_girth", "underbust_girth", "waist_girth", "hip_girth", "max_hip_girth"};
-  if (m.kind == "girth") {
-    for (const char* l : large)
-      if (m.name == l) return 9;
-    return 4;
-  }
-  if (m.kind == "height") return 4;
-  return 5;
-}
-
 struct Scan {
   TriangleMesh mesh, truth;
   PointCloud cloud;
@@ -239,7 +227,7 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
       std::printf("%-24s missing on the scan\n", m.name.c_str());
       continue;
     }
-    const double d = s->value_mm - m.value_mm, al = allowance(m);
+    const double d = s->value_mm - m.value_mm, al = iso20685_allowance_mm(m);
     ++n;
     iso += std::abs(d) <= al;
     must += std::abs(d) <= al / 2;

@@ -39,20 +39,8 @@ using namespace bodyscan;
 
 namespace {
 
-// ISO 20685-1 allowance for a measurement (mm), as measure_benchmark takes it.
-double allowance(const BodyMeasurement& m) {
-  static const char* large[] = {"chest_girth", "bust_girth", "underbust_girth", "waist_girth", "hip_girth", "max_hip_girth"};
-  if (m.kind == "girth") {
-    for (const char* l : large)
-      if (m.name == l) return 9;
-    return 4;
-  }
-  if (m.kind == "height") return 4;
-  return 5;
-}
-
 std::string family(const BodyMeasurement& m) {
-  if (m.kind == "girth") return allowance(m) > 4 ? "torso girths" : "limb and neck girths";
+  if (m.kind == "girth") return iso20685_allowance_mm(m) > 4 ? "torso girths" : "limb and neck girths";
   if (m.kind == "height") return "heights";
   return "lengths";
 }
@@ -135,11 +123,11 @@ Row compare(const Reference& ref, const std::string& variant, const TriangleMesh
     }
     if (skin < 0.5) {
       ++row.unmoved;
-      if (std::abs(change) <= 0.5 * allowance(m)) ++row.unmoved_within_half;
+      if (std::abs(change) <= 0.5 * iso20685_allowance_mm(m)) ++row.unmoved_within_half;
     }
-    if (detail && std::abs(change) > 0.5 * allowance(m)) {
+    if (detail && std::abs(change) > 0.5 * iso20685_allowance_mm(m)) {
       char b[160];
-      std::snprintf(b, sizeof b, "%s %+.1f (allowance %.0f; skin moved %.1f mm)", m.name.c_str(), change, allowance(m), skin);
+      std::snprintf(b, sizeof b, "%s %+.1f (allowance %.0f; skin moved %.1f mm)", m.name.c_str(), change, iso20685_allowance_mm(m), skin);
       row.detail.push_back(b);
     }
     if (posed && m.name.rfind("outer_arm_length", 0) == 0) {

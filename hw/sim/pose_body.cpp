@@ -199,6 +199,11 @@ StatusOr<std::vector<std::vector<std::pair<int, float>>>> BodyPoser::vertex_weig
 StatusOr<TriangleMesh> BodyPoser::skin(const TriangleMesh& rest,
                                        const std::map<std::string, std::pair<Eigen::Vector3d, double>>& rotations) const {
   ASSIGN_OR_RETURN(const Match m, recognise(rest));
+  return skin(rest, m, rotations);
+}
+
+StatusOr<TriangleMesh> BodyPoser::skin(const TriangleMesh& rest, const Match& m,
+                                       const std::map<std::string, std::pair<Eigen::Vector3d, double>>& rotations) const {
   ASSIGN_OR_RETURN(const auto weights, vertex_weights(rest));
   std::vector<Eigen::Isometry3d> local(bones_.size(), Eigen::Isometry3d::Identity());
   for (const auto& [bone, rot] : rotations) {
@@ -264,21 +269,21 @@ StatusOr<PosedBody> BodyPoser::pose(const TriangleMesh& rest, const Posture& pos
   if (posture.ankle_distance_mm) {
     const double want = *posture.ankle_distance_mm;
     if (!(want >= 100 && want <= 700)) return invalid_argument("the ankles' distance must be 100-700 mm");
-    // Adduction a turns the left leg by -a about +Z and the right by +a: the
-    // ankles come closer as a grows.
-    const auto distance = [&](double a) {
-      return (turned(out.rest.ankle[0], out.rest.hip[0], -a) - turned(out.rest.ankle[1], out.rest.hip[1], a)).norm();
+    // Spreading the legs by a turns the left leg (+X) by +a about +Z and the right
+    // by -a: the ankles part as a grows (until then they cross).
+    const auto apart = [&](double a) {
+      return (turned(out.rest.ankle[0], out.rest.hip[0], a) - turned(out.rest.ankle[1], out.rest.hip[1], -a)).norm();
     };
-    const std::optional<double> a = solve_rising([&](double a) { return distance(-a); }, -30, 30, want, 1e-5);
-    if (!a) return invalid_argument("an ankle distance of " + std::to_string(want) + " mm is out of reach");
-    out.hip_adduction_deg = -*a;
-    rotations["upperleg01.L"] = {z, *a};
-    rotations["upperleg01.R"] = {z, -*a};
+    const std::optional<double> spread = solve_rising(apart, -30, 30, want, 1e-5);
+    if (!spread) return invalid_argument("an ankle distance of " + std::to_string(want) + " mm is out of reach");
+    out.hip_adduction_deg = -*spread;
+    rotations["upperleg01.L"] = {z, *spread};
+    rotations["upperleg01.R"] = {z, -*spread};
     // The feet turn back about the ankles: their soles stay flat.
-    rotations["foot.L"] = {z, -*a};
-    rotations["foot.R"] = {z, *a};
+    rotations["foot.L"] = {z, -*spread};
+    rotations["foot.R"] = {z, *spread};
   }
-  ASSIGN_OR_RETURN(out.mesh, skin(rest, rotations));
+  ASSIGN_OR_RETURN(out.mesh, skin(rest, m, rotations));
   // Standing on the floor again: the lowest point where the rest mesh's was.
   float rest_low = std::numeric_limits<float>::infinity(), posed_low = rest_low;
   for (const Vec3f& v : rest.vertices) rest_low = std::min(rest_low, v.y());

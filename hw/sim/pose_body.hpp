@@ -74,6 +74,8 @@ class BodyPoser {
     Eigen::Vector3d shift;  // mesh frame = joints.json frame + shift
   };
   StatusOr<Match> recognise(const TriangleMesh& rest) const;
+  StatusOr<TriangleMesh> skin(const TriangleMesh& rest, const Match& m,
+                              const std::map<std::string, std::pair<Eigen::Vector3d, double>>& rotations) const;
   Eigen::Vector3d joint(const Match& m, const std::string& name) const;
   // The skinning weights of every vertex of a 53,514-vertex body: (bone, weight).
   StatusOr<std::vector<std::vector<std::pair<int, float>>>> vertex_weights(const TriangleMesh& rest) const;

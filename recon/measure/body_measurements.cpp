@@ -32,6 +32,13 @@ const BodyLandmark* BodyMeasurements::landmark(const std::string& name) const {
   return nullptr;
 }
 
+double iso20685_allowance_mm(const BodyMeasurement& m) {
+  static const char* const kTorso[] = {"chest_girth", "bust_girth",     "underbust_girth",
+                                       "waist_girth", "hip_girth", "max_hip_girth"};
+  if (m.kind == "girth") return std::find(std::begin(kTorso), std::end(kTorso), m.name) != std::end(kTorso) ? 9 : 4;
+  return m.kind == "height" ? 4 : 5;
+}
+
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();

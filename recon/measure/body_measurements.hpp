@@ -100,6 +100,12 @@ struct BodyMeasurements {
   const BodyLandmark* landmark(const std::string& name) const;
 };
 
+// How far ISO 20685-1 lets a scan-derived value of the automatic set lie from the
+// same value measured by hand, mm: 9 for the torso's girths, 4 for the other
+// girths and the heights, 5 for lengths and distances. The benchmarks judge the
+// set by it.
+double iso20685_allowance_mm(const BodyMeasurement& m);
+
 // Errors when the mesh is empty or the body's main parts (legs, torso, arms, neck)
 // cannot be told apart; single measurements that fail are listed in `skipped`.
 StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeasureOptions& options = {});
