@@ -154,15 +154,6 @@ size_t parts_near(const std::vector<Ring>& rings, const Ring& part, double reach
   return n;
 }
 
-// The boundary between lo (pred false) and hi (pred true), to `tol`.
-double bisect(double lo, double hi, const std::function<bool(double)>& pred, double tol = 0.25) {
-  while (std::abs(hi - lo) > tol) {
-    const double mid = 0.5 * (lo + hi);
-    (pred(mid) ? hi : lo) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
 // The middle of a flat extreme: of the points whose height along `dir` lies within
 // `band` of the highest, the one nearest (along `across`) to the vertex of the
 // parabola least-squares fitted to their heights, or to the middle of their span
@@ -207,7 +198,6 @@ Eigen::Vector3d middle_of_extreme(const std::vector<Eigen::Vector3d>& pts, const
   }
   return best;
 }
-
 
 // Where the ray from `origin` along `dir` last leaves a closed loop lying in a plane
 // through `origin` that holds `dir` and `across`: the loop's outermost crossing of
@@ -258,133 +248,6 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Ve
   if (d.y() < 0) d = -d;
   if (residual) *residual = es.eigenvalues()(0) + es.eigenvalues()(1);
   return {c, d};
-}
-
-// Where a sampled profile's extreme is, made stable where the profile is flat (a
-// heavy waist, a wrist): the middle of the run of samples round sample k within
-// `tol` of it. The arg-min of a flat profile wanders with the scan's noise; the
-// middle of the flat run does not.
-size_t settle(const std::vector<double>& v, size_t k, double tol) {
-  size_t a = k, b = k;
-  while (a > 0 && std::abs(v[a - 1] - v[k]) <= tol) --a;
-  while (b + 1 < v.size() && std::abs(v[b + 1] - v[k]) <= tol) ++b;
-  return (a + b) / 2;
-}
-
-// A flat minimum of v over x (x ascending) at v[k]: where v first rises `rise`
-// above v[k] on either side (interpolated between samples), (lower x, upper x).
-// Nothing when either side never rises that far.
-std::optional<std::pair<double, double>> flat_bottom_span(const std::vector<double>& x, const std::vector<double>& v,
-                                                          size_t k, double rise) {
-  const double level = v[k] + rise;
-  std::optional<double> lo, hi;
-  for (size_t i = k; i > 0 && !lo; --i)
-    if (v[i - 1] >= level) lo = x[i - 1] + (level - v[i - 1]) / (v[i] - v[i - 1]) * (x[i] - x[i - 1]);
-  for (size_t i = k; i + 1 < v.size() && !hi; ++i)
-    if (v[i + 1] >= level) hi = x[i] + (level - v[i]) / (v[i + 1] - v[i]) * (x[i + 1] - x[i]);
-  if (!lo || !hi) return std::nullopt;
-  return std::make_pair(*lo, *hi);
-}
-
-// The middle of that flat minimum: halfway between the two rises.
-std::optional<double> flat_bottom_middle(const std::vector<double>& x, const std::vector<double>& v, size_t k,
-                                         double rise) {
-  const auto span = flat_bottom_span(x, v, k, rise);
-  if (!span) return std::nullopt;
-  return 0.5 * (span->first + span->second);
-}
-
-// The parabola a t^2 + b t + c in t = x - centre least-squares fitted to the samples
-// (x[i], v[i]) within `half` of `centre`: its coefficients (a, b, c), and how many
-// samples it rests on. Each sample weighs 1, or with `biweight` (1 - (t/half)^2)^2,
-// which reaches zero at `half`.
-struct LocalParabola {
-  Eigen::Vector3d coef = Eigen::Vector3d::Zero();
-  int samples = 0;
-};
-LocalParabola local_parabola(const std::vector<double>& x, const std::vector<double>& v, double centre, double half,
-                             bool biweight) {
-  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-  LocalParabola p;
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double t = x[i] - centre, u = t / half;
-    if (biweight ? std::abs(u) >= 1 : std::abs(t) > half) continue;
-    const double w = biweight ? (1 - u * u) * (1 - u * u) : 1.0;
-    const Eigen::Vector3d row(t * t, t, 1);
-    ata += w * row * row.transpose();
-    atb += w * row * v[i];
-    ++p.samples;
-  }
-  if (p.samples > 0) p.coef = ata.ldlt().solve(atb);
-  return p;
-}
-
-// The vertex of the parabola least-squares fitted to the samples (x[i], v[i]) within
-// `half` of x[k]: where a shallow, noisy profile bottoms out (`lowest`) or tops out.
-// Nothing when fewer than 7 samples lie there, the fit opens the other way (or is
-// flat), or its vertex falls outside the window.
-std::optional<double> parabola_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k,
-                                      double half, bool lowest) {
-  const LocalParabola p = local_parabola(x, v, x[k], half, false);
-  if (p.samples < 7) return std::nullopt;
-  const Eigen::Vector3d& c = p.coef;
-  if (!((lowest ? c(0) : -c(0)) > 1e-9)) return std::nullopt;
-  const double t = -c(1) / (2 * c(0));
-  if (!(std::abs(t) <= half)) return std::nullopt;
-  return x[k] + t;
-}
-
-size_t arg_extreme(const std::vector<double>& v, bool largest) {
-  return static_cast<size_t>((largest ? std::max_element(v.begin(), v.end()) : std::min_element(v.begin(), v.end())) -
-                             v.begin());
-}
-
-// A notch in a front profile sampled as (y, z) from top to bottom (the front neck
-// point, the fold under the bust): the sample lying farthest behind (at smaller Z
-// than) the chord joining the profile's ends, which count at depth 0; its depth
-// (<= 0, mm); and the vertex of a parabola fitted to the depths over `half` of y
-// either side (parabola_vertex), where the fit finds one.
-struct Notch {
-  size_t k = 0;
-  double depth = 0;
-  std::optional<double> vertex_y;
-  std::vector<double> ys, depths;  // the profile's levels and their depths
-};
-Notch deepest_behind_chord(const std::vector<Eigen::Vector2d>& c, double half) {
-  const Eigen::Vector2d a = c.front(), e = c.back();
-  std::vector<double> ys, depth;
-  for (const Eigen::Vector2d& q : c)
-    ys.push_back(q.x()), depth.push_back(q.y() - (a.y() + (q.x() - a.x()) / (e.x() - a.x()) * (e.y() - a.y())));
-  Notch n;
-  n.k = arg_extreme(depth, false);
-  n.depth = depth[n.k];
-  n.vertex_y = parabola_vertex(ys, depth, n.k, half, true);
-  n.ys = std::move(ys), n.depths = std::move(depth);
-  return n;
-}
-
-// The corner of a smooth curve sampled as (x[i], v[i]) and walked until v passed
-// `v_end`: the sample farthest from the chord from the first sample to where v
-// reaches v_end (interpolated between the last two: the last sample jumps with the
-// walk's step, and the chord's end with it), refined to the vertex of a parabola
-// fitted to that distance with weights reaching zero `half` of x either side of the
-// vertex (settled_vertex). Only samples on the
-// chord's left (above an outline) count. Returns the sample and the refined x; the
-// sample is 0 where nothing lies on that side.
-std::pair<size_t, double> refined_corner(const std::vector<double>& x, const std::vector<double>& v, double v_end,
-                                         double half) {
-  const size_t n = x.size();
-  Eigen::Vector2d end(x[n - 1], v[n - 1]);
-  if ((v[n - 1] - v_end) * (v[n - 2] - v_end) < 0) {
-    const double t = (v_end - v[n - 2]) / (v[n - 1] - v[n - 2]);
-    end = {x[n - 2] + t * (x[n - 1] - x[n - 2]), v_end};
-  }
-  const Eigen::Vector2d a(x[0], v[0]), d = (end - a).normalized();
-  std::vector<double> dist;
-  for (size_t i = 0; i < n; ++i) dist.push_back(d.x() * (v[i] - a.y()) - d.y() * (x[i] - a.x()));
-  const size_t k = arg_extreme(dist, true);
-  return {k, settled_vertex(x, dist, k, half, false).value_or(x[k])};
 }
 
 // Whether a loop in the plane with normal n winds round p (the loop is the limb's
@@ -1575,74 +1438,12 @@ class Finder {
 
 }  // namespace
 
-std::vector<double> despiked(const std::vector<double>& v, size_t half, double tol) {
-  std::vector<double> out(v), window;
-  for (size_t i = 0; i < v.size(); ++i) {
-    const size_t a = i > half ? i - half : 0, b = std::min(v.size() - 1, i + half);
-    window.assign(v.begin() + static_cast<std::ptrdiff_t>(a), v.begin() + static_cast<std::ptrdiff_t>(b) + 1);
-    std::nth_element(window.begin(), window.begin() + static_cast<std::ptrdiff_t>(window.size() / 2), window.end());
-    if (const double m = window[window.size() / 2]; std::abs(v[i] - m) > tol) out[i] = m;
-  }
-  return out;
-}
-
 double knee_reading_level(double own_y, std::optional<double> other_y) {
   return other_y && std::abs(*other_y - own_y) <= kLevelKneesMm ? 0.5 * (own_y + *other_y) : own_y;
 }
 
 double breast_reach(double fold_depth_mm) {
   return std::clamp((fold_depth_mm - kChestFoldMm) / (kBreastFoldMm - kChestFoldMm), 0.0, 1.0);
-}
-
-double minimum_centroid(const std::vector<double>& x, const std::vector<double>& v, size_t k, double depth) {
-  const double level = v[k] + depth;
-  size_t a = k, b = k;
-  while (a > 0 && v[a - 1] < level) --a;
-  while (b + 1 < v.size() && v[b + 1] < level) ++b;
-  // Segments [i, i + 1] from the one rising out on the left to the one on the right.
-  const size_t first = a > 0 ? a - 1 : 0, last = b + 1 < v.size() ? b + 1 : b;
-  double area = 0, moment = 0;
-  for (size_t i = first; i < last; ++i) {
-    double x0 = x[i], x1 = x[i + 1], f0 = level - v[i], f1 = level - v[i + 1];
-    // Clip the segment to where it lies under the level.
-    if (f0 < 0) x0 = x0 + (x1 - x0) * (-f0) / (f1 - f0), f0 = 0;
-    if (f1 < 0) x1 = x1 - (x1 - x0) * (-f1) / (f0 - f1), f1 = 0;
-    const double dx = x1 - x0;
-    area += 0.5 * (f0 + f1) * dx;
-    moment += dx / 6 * (2 * x0 * f0 + x0 * f1 + x1 * f0 + 2 * x1 * f1);
-  }
-  return area != 0 ? moment / area : x[k];
-}
-
-std::optional<double> settled_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
-                                     bool lowest) {
-  double c = x[k];
-  for (int it = 0; it < 30; ++it) {
-    const LocalParabola p = local_parabola(x, v, c, half, true);
-    if (p.samples < 7) return std::nullopt;
-    const Eigen::Vector3d& q = p.coef;
-    if (!((lowest ? q(0) : -q(0)) > 1e-9)) return std::nullopt;
-    const double step = std::clamp(-q(1) / (2 * q(0)), -0.5 * half, 0.5 * half);
-    c += step;
-    if (!(c >= std::min(x.front(), x.back()) && c <= std::max(x.front(), x.back()))) return std::nullopt;
-    if (std::abs(step) < 1e-3) break;
-  }
-  return c;
-}
-
-std::optional<double> flat_top_vertex(const std::vector<double>& x, const std::vector<double>& v, double drop,
-                                      double min_span) {
-  if (x.size() != v.size() || x.empty()) return std::nullopt;
-  std::vector<double> below = v;
-  for (double& b : below) b = -b;
-  const size_t k = arg_extreme(v, true);
-  const auto span = flat_bottom_span(x, below, k, drop);
-  if (!span || span->second - span->first <= min_span) return std::nullopt;
-  const double mid = 0.5 * (span->first + span->second);
-  size_t km = k;
-  for (size_t i = 0; i < x.size(); ++i)
-    if (std::abs(x[i] - mid) < std::abs(x[km] - mid)) km = i;
-  return settled_vertex(x, v, km, 0.5 * (span->second - span->first), false);
 }
 
 size_t wrist_cut(const std::vector<double>& g, double palm_rise) {

@@ -38,6 +38,7 @@
 #include "recon/measure/body_slicer.hpp"
 #include "recon/measure/girth.hpp"
 #include "recon/measure/plane_section.hpp"
+#include "recon/measure/profile.hpp"
 
 namespace bodyscan {
 
@@ -121,35 +122,6 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
 // measure_body passes 0.6 % of the stature.
 size_t wrist_cut(const std::vector<double>& girths, double palm_rise);
 
-// The centre of a dip in a profile v sampled over x (x monotonic), around its lowest
-// sample k: the centroid of the area between v, taken as linear between samples,
-// and the level v[k] + depth, over the stretch round k that stays below that level
-// (a side that never rises to it ends at the last sample). Unlike the lowest sample
-// or the middle of the samples near it, it moves smoothly as the profile does,
-// which a flat bottom's noise otherwise carries from sample to sample. The waist's
-// level (measure_body).
-double minimum_centroid(const std::vector<double>& x, const std::vector<double>& v, size_t k, double depth);
-
-// Where a shallow, noisy profile v sampled over x (x monotonic) bottoms out
-// (`lowest`) or tops out, starting from its extreme sample k: the vertex of a
-// parabola fitted with weights that fall smoothly to zero `half` either side of the
-// vertex itself (a biweight), found by moving the window's centre to the vertex
-// until it stays. A window centred on the extreme sample moves with that sample,
-// which jumps with a scan's noise, and samples enter and leave it whole; this
-// vertex moves smoothly with the profile. Nothing when a fit has fewer than 7
-// samples, opens the other way, or leaves the samples' range. The shoulder's
-// corner, the wrist along the forearm and the hip's level (measure_body).
-std::optional<double> settled_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
-                                     bool lowest);
-
-// The level (x) of a flat top of the profile v over x (x ascending): where v falls
-// `drop` below its largest on both sides, over more than `min_span` of x, the vertex
-// of a parabola whose weights reach zero half that span either side of itself
-// (settled_vertex), fitted over the whole top. Nothing where the top is narrower,
-// or does not fall that far on both sides (a chest rising into the armpits).
-std::optional<double> flat_top_vertex(const std::vector<double>& x, const std::vector<double>& v, double drop,
-                                      double min_span);
-
 // How far the fold under a chest, `fold_depth_mm` behind its chord, is a breast's
 // crease: 0 up to 6 mm (a man's fold: 0-6 mm on the shipped bodies), 1 from 14 mm
 // (their breasts' creases: 17-46 mm), in proportion between. Over a breast the bust
@@ -157,14 +129,6 @@ std::optional<double> flat_top_vertex(const std::vector<double>& x, const std::v
 // a small breast's girth then does not jump between the apex's reading and the
 // fullest as its crease's depth moves with a scan's noise (measure_body).
 double breast_reach(double fold_depth_mm);
-
-// A sampled profile with each sample that stands more than `tol` off the median of
-// the samples within `half` of it (fewer at the ends) replaced by that median: a
-// bump or dent at most `half` samples long is gone, a smooth profile keeps every
-// sample. The bust's level is read from the front's profile despiked over two 2 mm
-// samples either side: a heavy man's front is flat within 0.5 mm over 40 mm, and a
-// stray bump there 1-3 mm proud was its foremost point (measure_body).
-std::vector<double> despiked(const std::vector<double>& v, size_t half, double tol);
 
 // The level a leg's knee height and mid-thigh read the knee at: standing, both
 // knees are at one height, so where the other knee's level (`other_y`, if found)
