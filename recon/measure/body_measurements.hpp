@@ -6,9 +6,11 @@
 // The body stands on the floor, Y up, anywhere and facing any way: the rules are
 // applied in its own frame (body_frame.hpp), facing +Z with its left side at +X,
 // and everything is given back in the mesh's frame. Arms held away from the sides
-// and feet apart (the scanning pose, thesis §2.3). Landmarks
-// come from horizontal cuts (BodySlicer) and are geometric stand-ins for the
-// anatomical ones ISO 8559-1 §3 palpates (docs/measurements.md gives each rule):
+// and feet apart (the scanning pose, thesis §2.3; body_posture.hpp checks it).
+// Landmarks come from horizontal cuts (BodySlicer) and are geometric stand-ins for
+// the anatomical ones ISO 8559-1 §3 palpates. The rules live by body region in
+// recon/measure/rules/ (trunk, neck and shoulders, legs, arms); docs/measurements.md
+// gives each:
 //   crotch        the lowest level where one loop spans the body's midline;
 //   armpits       the highest level where that side's arm is still its own loop;
 //   neck          the level of the smallest loop between the armpits and the head;
@@ -110,42 +112,5 @@ double iso20685_allowance_mm(const BodyMeasurement& m);
 // Errors when the mesh is empty or the body's main parts (legs, torso, arms, neck)
 // cannot be told apart; single measurements that fail are listed in `skipped`.
 StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeasureOptions& options = {});
-
-// The wrist among an arm's horizontal cuts, armpit downwards (`girths`: their tapes,
-// mm), as an index: the narrowest in the lower 45 % above the last three cuts. A
-// scan can fuse the fingers, so that the arm's track runs on past the palm into
-// them, and they are narrower than the wrist. Where the cuts widen by more than
-// `palm_rise` over the narrowest above them (the palm), the wrist is the narrowest
-// above that rise. Where the forearm narrows a second time nearer the hand, past a
-// rise of more than 2 mm and to within 2 mm of the narrowest (a heavy forearm, and
-// the narrowest flips between the two with a scan's noise), that second narrow.
-// measure_body passes 0.6 % of the stature.
-size_t wrist_cut(const std::vector<double>& girths, double palm_rise);
-
-// How far the fold under a chest, `fold_depth_mm` behind its chord, is a breast's
-// crease: 0 up to 6 mm (a man's fold: 0-6 mm on the shipped bodies), 1 from 14 mm
-// (their breasts' creases: 17-46 mm), in proportion between. Over a breast the bust
-// girth is the fullest within 1.2 % of the height of the apex's level, times this:
-// a small breast's girth then does not jump between the apex's reading and the
-// fullest as its crease's depth moves with a scan's noise (measure_body).
-double breast_reach(double fold_depth_mm);
-
-// The level a leg's knee height and mid-thigh read the knee at: standing, both
-// knees are at one height, so where the other knee's level (`other_y`, if found)
-// lies within 10 mm of this knee's (`own_y`), the two knees' mean; else this knee's
-// own. Each knee's level is a shallow girth profile's bottom and moves 1-2.5 mm RMS
-// with a scan's noise, the two independently: their mean moves about 1/sqrt(2) as
-// much (measure_body).
-double knee_reading_level(double own_y, std::optional<double> other_y);
-
-// One leg's tape in a horizontal cut where hole filling has bridged the gap between
-// the thighs (`ring` spans the midline X = xc and crosses it on invented surface
-// only, mesh confidence under 0.5 front and back): round the measured skin
-// (confidence 0.5 or more) on side `side` (+1: X > xc), in the ring's plane. The
-// tape bridges the unseen inner side as a tape bridges any hollow; its
-// min_confidence is the lowest on that side, so the girth is flagged as crossing
-// the fill. Nothing where the ring crosses the midline on measured skin (the
-// trunk, above the crotch), or keeps no measured skin on that side.
-std::optional<Girth> bridged_part(const Ring& ring, double xc, int side);
 
 }  // namespace bodyscan

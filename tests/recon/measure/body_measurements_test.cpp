@@ -15,11 +15,20 @@
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "recon/measure/girth.hpp"
+#include "recon/measure/rules/arms.hpp"
+#include "recon/measure/rules/legs.hpp"
+#include "recon/measure/rules/trunk.hpp"
 #include "tests/shapes.hpp"
 #include "tests/test_meshes.hpp"
 
 namespace bodyscan {
 namespace {
+
+using rules::breast_reach;
+using rules::bridged_part;
+using rules::knee_reading_level;
+using rules::Side;
+using rules::wrist_cut;
 
 // MakeHuman's joint centres for the shipped bodies (../shared/data/bodies/manifest.json,
 // "landmarks_mm_approx"; soles at Y = 0) and its indicative torso girths.
@@ -1113,7 +1122,7 @@ TEST(BodyMeasurements, AThighsTapeThroughAFilledBridgeGoesRoundItsMeasuredSkin) 
   const double missing = 2 * std::acos(-65.0 / 80);  // the arc beyond x = 25
   const double expected = 2 * M_PI * 80 - 80 * (2 * M_PI - missing) + 2 * 80 * std::sin((2 * M_PI - missing) / 2);
   for (int s : {1, -1}) {
-    const std::optional<Girth> g = bridged_part(ring, 0, s);
+    const std::optional<Girth> g = bridged_part(ring, 0, s > 0 ? Side::kLeft : Side::kRight);
     ASSERT_TRUE(g) << "side " << s;
     EXPECT_NEAR(g->value_mm, expected, 0.5) << "side " << s;
     EXPECT_TRUE(g->min_confidence < 0.5f) << "side " << s;  // flagged: it crosses the fill
@@ -1121,7 +1130,7 @@ TEST(BodyMeasurements, AThighsTapeThroughAFilledBridgeGoesRoundItsMeasuredSkin) 
   }
   // Where the ring crosses the midline on measured skin (the trunk) it is no bridge.
   std::fill(ring.confidence.begin(), ring.confidence.end(), 1.f);
-  EXPECT_FALSE(bridged_part(ring, 0, 1));
+  EXPECT_FALSE(bridged_part(ring, 0, Side::kLeft));
 }
 
 TEST(BodyMeasurements, ALegCutInPiecesIsNoLevelToMeasureAt) {

@@ -1,0 +1,270 @@
+#include "recon/measure/rules/arms.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "recon/measure/profile.hpp"
+
+namespace bodyscan::rules {
+
+namespace {
+
+// How far below a flat extreme a point still counts as on it, mm.
+constexpr double kFlatBand = 3;
+// The middle of the forearm's flat minimum is halfway between where the tape has
+// grown by this much (mm) either side (flat_bottom_middle).
+constexpr double kFlatRiseMm = 3;
+// The least bend (radians) between upper arm and forearm at which the elbow is
+// where their axes meet.
+constexpr double kMinElbowBend = 10 * M_PI / 180;
+// The wrist's level along the forearm: the fit's weights reach zero this far either
+// side of its vertex, as a fraction of the stature.
+constexpr double kWristHalf = 0.014;
+// The wrist is this fraction of the stature back toward the elbow from where the
+// tape, cut by cut toward the hand, has grown kWristFlareMm (mm) over the forearm's
+// narrowest cut.
+constexpr double kWristBeforeFlare = 0.01;
+constexpr double kWristFlareMm = 7;
+// A second narrowing of the forearm's cuts nearer the hand, past a rise of more
+// than this (mm) and within this of the narrowest, is the wrist (wrist_cut).
+constexpr double kSecondNarrowMm = 2;
+// The arm's horizontal cuts, mm apart.
+constexpr double kArmStepMm = 3;
+// The cuts across the forearm near the wrist, mm apart.
+constexpr double kForearmStepMm = 4;
+
+// The arm's horizontal cuts from just below where its own loop ends, down to where
+// it ends, splits into fingers, thins under 40 % of its largest, or (past the
+// crotch) nears the leg: each cut's centroid and tape.
+struct ArmTrack {
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<double> girths;
+};
+ArmTrack follow_arm(const BodyCuts& cuts, double arm_apart_y, double crotch_y, Side side) {
+  const double mid_x = cuts.midline_x(), stature = cuts.stature();
+  ArmTrack track;
+  cuts.prefetch(arm_apart_y - kArmStepMm, crotch_y - 0.05 * stature, -kArmStepMm);  // where a hanging arm ends
+  for (double y = arm_apart_y - kArmStepMm; y > 0; y -= kArmStepMm) {
+    const std::vector<Ring>& cut = cuts.at(y);
+    const Ring* a = side_ring(cut, mid_x, side, true);
+    if (!a || (y < crotch_y && std::abs(a->centroid.x() - mid_x) < 0.1 * stature)) break;
+    if (parts_near(cut, *a, 0.06 * stature) > 0) break;
+    if (!track.girths.empty() && a->girth < 0.4 * *std::max_element(track.girths.begin(), track.girths.end())) break;
+    track.centres.push_back(a->centroid);
+    track.girths.push_back(a->girth);
+  }
+  return track;
+}
+
+Eigen::Vector3d on_axis(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Eigen::Vector3d& p) {
+  return origin + (p - origin).dot(dir) * dir;
+}
+
+// A girth perpendicular to `axis` through p, if it is a loop round p no longer than
+// a quarter of the stature (a wrist's, not a neighbour's).
+StatusOr<Girth> limb_cut(const BodyCuts& cuts, const Eigen::Vector3d& p, const Eigen::Vector3d& axis,
+                         const std::vector<uint32_t>& triangles) {
+  StatusOr<Girth> g = mesh_girth(cuts.mesh(), Plane{p, axis}, p, &triangles);
+  if (!g.ok()) return g;
+  if (!winds_round(g->loop, p, axis) || g->value_mm > 0.25 * cuts.stature())
+    return not_found("the cut is not the wrist's alone");
+  return g;
+}
+
+// The wrist along the forearm's axis (`forearm`, through `wrist_c`, the horizontal
+// cuts' narrowest): the narrowest perpendicular cut within 3 % of the stature
+// either side (an inclined forearm blurs the horizontal ones), read at a stable
+// level. `hand` is +1 where the hand lies along +forearm from the elbow, else -1.
+// Moves *wrist_c to the wrist and returns its cut.
+StatusOr<Girth> wrist_girth(const BodyCuts& cuts, const Eigen::Vector3d& forearm, double hand, Eigen::Vector3d* wrist_c) {
+  const double stature = cuts.stature();
+  const std::vector<uint32_t> triangles = cuts.triangles_near(*wrist_c, 0.07 * stature);
+  std::vector<double> gs, ts;  // the cuts' tapes and offsets along the forearm from wrist_c
+  std::vector<Girth> found;
+  for (double t = -0.03 * stature; t <= 0.03 * stature; t += kForearmStepMm) {
+    StatusOr<Girth> g = limb_cut(cuts, *wrist_c + t * forearm, forearm, triangles);
+    if (!g.ok()) continue;
+    gs.push_back(g->value_mm);
+    found.push_back(std::move(*g));
+    ts.push_back(t);
+  }
+  if (gs.empty()) return not_found("no loop round the wrist");
+  // Along the forearm the tape is flat over 10-20 mm at its narrowest, and its
+  // narrowest cut moves along the arm with the skin's noise. The hand's side is
+  // steep: the wrist is kWristBeforeFlare of the stature back from where the tape,
+  // cut by cut toward the hand, has grown kWristFlareMm over the narrowest cut (past
+  // the window's end if need be). Where no flare is reached, the vertex of a
+  // parabola whose weights fall to zero kWristHalf of the stature either side of
+  // the vertex itself; where that fit fails, the middle of the flat minimum.
+  const size_t low = arg_extreme(gs, false);
+  std::optional<double> t = settled_vertex(ts, gs, low, kWristHalf * stature, true);
+  if (!t) t = flat_bottom_middle(ts, gs, low, kFlatRiseMm);
+  {
+    const double flare = gs[low] + kWristFlareMm;
+    std::vector<double> ht, hg;  // from the narrowest cut toward the hand
+    for (size_t i = low;; i = hand > 0 ? i + 1 : i - 1) {
+      ht.push_back(ts[i]), hg.push_back(gs[i]);
+      if (hand > 0 ? i + 1 >= ts.size() : i == 0) break;
+    }
+    for (double tt = ht.back() + hand * kForearmStepMm; std::abs(tt) <= 0.055 * stature && hg.back() < flare;
+         tt += hand * kForearmStepMm) {
+      StatusOr<Girth> g = limb_cut(cuts, *wrist_c + tt * forearm, forearm, triangles);
+      if (!g.ok()) continue;
+      ht.push_back(tt), hg.push_back(g->value_mm);
+    }
+    for (size_t i = 0; i + 1 < ht.size(); ++i)
+      if (hg[i + 1] >= flare) {
+        t = ht[i] + (flare - hg[i]) / (hg[i + 1] - hg[i]) * (ht[i + 1] - ht[i]) - hand * kWristBeforeFlare * stature;
+        break;
+      }
+  }
+  if (t) {
+    const Eigen::Vector3d p = *wrist_c + *t * forearm;
+    if (StatusOr<Girth> at = limb_cut(cuts, p, forearm, triangles); at.ok()) {
+      *wrist_c = p;
+      return at;
+    }
+  }
+  const size_t k = settle(gs, arg_extreme(gs, false), 1.0);
+  *wrist_c += ts[k] * forearm;
+  return std::move(found[k]);
+}
+
+// The upper arm's girth perpendicular to its axis halfway between the shoulder
+// point and the elbow. Close to the armpit the cut can reach the chest: then it
+// slides toward the elbow until its loop is the arm's alone (winds round the axis,
+// and reaches no farther than 5 % of the stature from its own centre). Every cut's
+// triangles come from one search round the whole slide.
+StatusOr<Girth> upper_arm_girth(const BodyCuts& cuts, const Eigen::Vector3d& mid, const Eigen::Vector3d& upper_arm) {
+  const double stature = cuts.stature();
+  const double cut_radius = 0.07 * stature, slide = 0.08 * stature;
+  const std::vector<uint32_t> slide_tris = cuts.triangles_near(mid, cut_radius + slide);
+  for (double off = 0; off <= slide; off += 4) {
+    const Eigen::Vector3d p = mid - off * upper_arm;
+    // Cut within reach of the axis only: a loop running out of it is open, so the
+    // chest never joins.
+    const std::vector<uint32_t> near_p = cuts.triangles_near(p, cut_radius, slide_tris);
+    StatusOr<Girth> g = mesh_girth(cuts.mesh(), Plane{p, upper_arm}, p, &near_p);
+    if (!g.ok() || !winds_round(g->loop, p, upper_arm)) continue;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& q : g->loop) centre += q;
+    centre /= static_cast<double>(g->loop.size());
+    double reach = 0;
+    for (const Eigen::Vector3d& q : g->loop) reach = std::max(reach, (q - centre).norm());
+    if (reach < 0.05 * stature) return g;
+  }
+  return not_found("the cut never clears the chest");
+}
+
+}  // namespace
+
+void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y, double crotch_y, Side side) {
+  const std::string sd = side_name(side);
+  const double stature = cuts.stature();
+  const ArmTrack track = follow_arm(cuts, arm_apart_y, crotch_y, side);
+  const std::vector<Eigen::Vector3d>& c = track.centres;
+  if (c.size() < 30) {
+    sheet.skip("upper_arm_girth_" + sd, "the " + sd + " arm is too short to follow");
+    return;
+  }
+  // Wrist: the narrowest cut in the lower part of the arm, above the palm.
+  const size_t w = settle(track.girths, wrist_cut(track.girths, 0.006 * stature), 1.0);
+  // Elbow: where the axis bends; two lines fitted to the centroids, wrist to
+  // armpit, split where together they fit best.
+  size_t e = w / 2;
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t k = w / 5; k < w * 4 / 5; ++k) {
+    double r1 = 0, r2 = 0;
+    fit_line(c, 0, k + 1, &r1);
+    fit_line(c, k, w + 1, &r2);
+    if (r1 + r2 < best) best = r1 + r2, e = k;
+  }
+  const auto [uc, ud] = fit_line(c, 0, e + 1);  // the upper arm's axis
+  const auto [fc, fd] = fit_line(c, e, w + 1);  // the forearm's
+  const size_t index = side == Side::kLeft ? 0 : 1;
+  sheet.posture().arm_abduction_deg[index] = std::acos(std::clamp(ud.y(), -1.0, 1.0)) * 180 / M_PI;
+  sheet.posture().elbow_bend_deg[index] = std::acos(std::min(1.0, std::abs(ud.dot(fd)))) * 180 / M_PI;
+  // The elbow's centre: where the upper arm's axis passes closest to the forearm's.
+  // The bend's cut c[e] moves in the cuts' steps, and with the armpit's level,
+  // where they start; where two lines meet moves with the skin. An arm nearly
+  // straight has no meeting point to speak of: there c[e] stands.
+  Eigen::Vector3d elbow_c = on_axis(uc, ud, c[e]);
+  if (const double cross = 1 - std::pow(ud.dot(fd), 2); cross > std::pow(std::sin(kMinElbowBend), 2)) {
+    const Eigen::Vector3d w0 = uc - fc;
+    const Eigen::Vector3d meet = uc + (ud.dot(fd) * fd.dot(w0) - ud.dot(w0)) / cross * ud;
+    if ((meet - elbow_c).norm() < 0.03 * stature) elbow_c = meet;
+  }
+  Eigen::Vector3d wrist_c = on_axis(fc, fd, c[w]);
+  // Outward: across the arm, in the frontal plane, away from the body.
+  auto outward = [&](const Eigen::Vector3d& d) {
+    Eigen::Vector3d o = -Eigen::Vector3d::UnitZ().cross(d);
+    if (sign(side) * o.x() < 0) o = -o;
+    return o.normalized().eval();
+  };
+  // A cut's outer point: where the ray from its centre straight out leaves it (the
+  // middle of a limb's flat outer side slides round it with the skin's noise; the
+  // ray's crossing moves as far as the skin does). The flat side's middle stays
+  // for a cut the ray misses.
+  auto outer_point = [&](const Girth& g, const Eigen::Vector3d& axis, const Eigen::Vector3d& out) {
+    const Eigen::Vector3d across = axis.cross(out).normalized();
+    if (std::optional<Eigen::Vector3d> p = ray_exit(g.loop, loop_centre(g.loop), out, across)) return *p;
+    return middle_of_extreme(g.loop, out, across, kFlatBand);
+  };
+  const double hand = (c[w] - c[e]).dot(fd) > 0 ? 1 : -1;
+  const StatusOr<Girth> wg = wrist_girth(cuts, fd, hand, &wrist_c);
+  const std::vector<uint32_t> elbow_tris = cuts.triangles_near(elbow_c, 0.08 * stature);
+  const StatusOr<Girth> eg = mesh_girth(cuts.mesh(), Plane{elbow_c, ud}, elbow_c, &elbow_tris);
+  const Eigen::Vector3d wrist_p = wg.ok() && !wg->loop.empty() ? outer_point(*wg, fd, outward(fd)) : wrist_c;
+  const Eigen::Vector3d elbow_p = eg.ok() && !eg->loop.empty() ? outer_point(*eg, ud, outward(ud)) : elbow_c;
+  sheet.landmark("wrist_point_" + sd, wrist_p);
+  sheet.landmark("elbow_point_" + sd, elbow_p);
+  sheet.girth("wrist_girth_" + sd, "Wrist girth (" + sd + ")", "5.3.19", wg, {"wrist_point_" + sd},
+              "the narrowest cut above the hand, perpendicular to the forearm's axis");
+  const Eigen::Vector3d shoulder = sheet.position("shoulder_point_" + sd);
+  sheet.girth("upper_arm_girth_" + sd, "Upper-arm girth (" + sd + ")", "5.3.16",
+              upper_arm_girth(cuts, on_axis(uc, ud, 0.5 * (shoulder + elbow_c)), ud),
+              {"shoulder_point_" + sd, "elbow_point_" + sd},
+              "perpendicular to the upper arm's axis, halfway between shoulder point and elbow (moved toward the "
+              "elbow until the cut clears the chest)");
+  sheet.surface("outer_arm_length_" + sd, "Outer arm length (" + sd + ")", "5.7.8", {shoulder, elbow_p, wrist_p},
+                {"shoulder_point_" + sd, "elbow_point_" + sd, "wrist_point_" + sd},
+                "over the skin from the shoulder point by the elbow's outer side to the wrist");
+}
+
+size_t wrist_cut(const std::vector<double>& g, double palm_rise) {
+  const size_t n = g.size();
+  if (n < 4) return 0;
+  const size_t from = std::min(n * 55 / 100, n - 4);
+  size_t w = n - 4;
+  for (size_t i = from; i + 3 < n; ++i)
+    if (g[i] < g[w]) w = i;
+  // Between there and the narrowest, the largest widening over the narrowest above it.
+  size_t low = from, palm = from;
+  double rise = 0;
+  for (size_t i = from; i < w; ++i) {
+    if (g[i] < g[low]) low = i;
+    if (g[i] - g[low] > rise) rise = g[i] - g[low], palm = i;
+  }
+  if (rise > palm_rise)
+    w = static_cast<size_t>(std::min_element(g.begin() + static_cast<std::ptrdiff_t>(from),
+                                             g.begin() + static_cast<std::ptrdiff_t>(palm)) -
+                            g.begin());
+  // A heavy forearm narrows twice above the hand, a few cm apart and within a mm or
+  // two of each other, and the narrowest flips between them with the skin's noise
+  // (the forearm's axis, fitted down to it, and the elbow with it). A second narrow
+  // nearer the hand, past a rise of more than kSecondNarrowMm and within that of
+  // the first, before the palm, is the wrist.
+  size_t second = w;
+  bool rose = false;
+  for (size_t k = w + 1; k + 3 < n && g[k] - g[w] <= palm_rise; ++k) {
+    rose = rose || g[k] - g[w] > kSecondNarrowMm;
+    if (rose && g[k] - g[w] <= kSecondNarrowMm && (second == w || g[k] < g[second])) second = k;
+  }
+  return second;
+}
+
+}  // namespace bodyscan::rules

@@ -1,0 +1,32 @@
+// The arms' rules: each arm followed cut by cut from the armpit to the hand, its
+// axis, elbow and wrist, the upper-arm and wrist girths, the outer arm length, and
+// the arm's posture (abduction, elbow bend) (docs/measurements.md).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "recon/measure/rules/body_cuts.hpp"
+#include "recon/measure/rules/sheet.hpp"
+
+namespace bodyscan::rules {
+
+// The arm on `side`, followed down from `arm_apart_y` (where its own loop ends)
+// until it ends, thins, or parts into fingers, or past the crotch (`crotch_y`)
+// into the leg. Records `wrist_point_<side>` and `elbow_point_<side>`, the wrist
+// and upper-arm girths and the outer arm length (from `shoulder_point_<side>`),
+// and the arm's abduction and elbow bend into the sheet's posture.
+void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y, double crotch_y, Side side);
+
+// The wrist among an arm's horizontal cuts, armpit downwards (`girths`: their tapes,
+// mm), as an index: the narrowest in the lower 45 % above the last three cuts. A
+// scan can fuse the fingers, so that the arm's track runs on past the palm into
+// them, and they are narrower than the wrist. Where the cuts widen by more than
+// `palm_rise` over the narrowest above them (the palm), the wrist is the narrowest
+// above that rise. Where the forearm narrows a second time nearer the hand, past a
+// rise of more than 2 mm and to within 2 mm of the narrowest (a heavy forearm, and
+// the narrowest flips between the two with a scan's noise), that second narrow.
+// measure_arm passes 0.6 % of the stature.
+size_t wrist_cut(const std::vector<double>& girths, double palm_rise);
+
+}  // namespace bodyscan::rules
