@@ -60,7 +60,19 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
     const double higher_armpit_y = std::max(arms.left.armpit_y, arms.right.armpit_y);
     ASSIGN_OR_RETURN(const rules::NeckLevel neck, rules::find_neck(cuts, sheet, higher_armpit_y));
     for (Side side : kBothSides) RETURN_IF_ERROR(rules::find_side_neck_point(cuts, sheet, neck, higher_armpit_y, side));
-    for (Side side : kBothSides) RETURN_IF_ERROR(rules::find_shoulder_point(cuts, sheet, arms[side].apart_y, side));
+    rules::PerSide<std::optional<rules::ArmAxes>> arm_axes;
+    for (Side side : kBothSides) arm_axes[side] = rules::find_arm_axes(cuts, sheet, arms[side].apart_y, crotch_y, side);
+    for (Side side : kBothSides) {
+      // An arm lost against the flank borrows the other's axis, mirrored: customers
+      // hold both arms alike.
+      std::optional<Eigen::Vector3d> upper_arm;
+      if (arm_axes[side]) {
+        upper_arm = arm_axes[side]->upper_dir;
+      } else if (const auto& other = arm_axes[rules::opposite(side)]) {
+        upper_arm = Eigen::Vector3d(-other->upper_dir.x(), other->upper_dir.y(), other->upper_dir.z());
+      }
+      RETURN_IF_ERROR(rules::find_shoulder_point(cuts, sheet, arms[side].apart_y, upper_arm, side));
+    }
     rules::find_neck_points(cuts, sheet, neck);
     const rules::TrunkLevels levels = rules::find_trunk_levels(cuts, sheet, crotch_y, arms);
 
@@ -75,7 +87,7 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
     rules::PerSide<std::optional<rules::Knee>> knees;
     for (Side side : kBothSides) knees[side] = rules::find_knee(cuts, side);
     for (Side side : kBothSides) rules::measure_leg(cuts, sheet, crotch_y, knees, side);
-    for (Side side : kBothSides) rules::measure_arm(cuts, sheet, arms[side].apart_y, crotch_y, side);
+    for (Side side : kBothSides) rules::measure_arm(cuts, sheet, arm_axes[side], side);
     rules::measure_across_back(sheet);
     rules::read_head_tilt(cuts, &out.posture);
     rules::read_stance(cuts, &out.posture);

@@ -44,7 +44,7 @@
 
 namespace bodyscan {
 
-inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-14";
+inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-15";
 
 // A mesh vertex at or above this confidence is measured skin; below, hole filling
 // invented it.

@@ -33,9 +33,15 @@ bool starts_with(const std::string& s, const char* prefix) { return s.rfind(pref
 std::vector<PostureCheck> check_posture(const BodyPosture& p, const PostureRange& r) {
   std::vector<PostureCheck> out;
   for (int s = 0; s < 2; ++s) {
+    const std::string side = s == 0 ? "left" : "right";
+    if (p.arm_against_body[s]) {
+      out.push_back({"arm_" + side, false,
+                     "the " + side + " arm rests against the body: hold it " +
+                         range(r.arm_min_deg, r.arm_max_deg, "°") + " from the body"});
+      continue;
+    }
     if (!p.arm_abduction_deg[s]) continue;
     const double a = *p.arm_abduction_deg[s];
-    const std::string side = s == 0 ? "left" : "right";
     PostureCheck c{"arm_" + side, a >= r.arm_min_deg && a <= r.arm_max_deg, ""};
     if (a < r.arm_min_deg)
       c.message = "the " + side + " arm hangs " + degrees(a) + " from the body: raise it to " +

@@ -21,6 +21,9 @@ struct BodyPosture {
   // the forearm's axes (0: straight).
   std::optional<double> arm_abduction_deg[2];
   std::optional<double> elbow_bend_deg[2];
+  // Left, right: the arm could not be followed down from the armpit as a part of
+  // its own (it lies against the flank); its angles are then unknown.
+  bool arm_against_body[2] = {false, false};
   // The distance between the legs' centres at ankle height (5 % of the stature), mm.
   std::optional<double> ankle_distance_mm;
   // The head's axis (the centres of its cuts from the neck to the crown) from the
@@ -46,7 +49,8 @@ struct PostureCheck {
   std::string message;
 };
 
-// Every part found, checked against `range`; a part not found is not checked.
+// Every part found, checked against `range`; a part not found is not checked,
+// but an arm against the body fails its check.
 std::vector<PostureCheck> check_posture(const BodyPosture& posture, const PostureRange& range = kScanningPosture);
 
 // The parts of the posture a measurement of the automatic set depends on, by its

@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include "recon/measure/profile.hpp"
@@ -162,19 +163,19 @@ StatusOr<Girth> upper_arm_girth(const BodyCuts& cuts, const Eigen::Vector3d& mid
 
 }  // namespace
 
-void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y, double crotch_y, Side side) {
-  const std::string sd = side_name(side);
-  const double stature = cuts.stature();
-  const ArmTrack track = follow_arm(cuts, arm_apart_y, crotch_y, side);
-  const std::vector<Eigen::Vector3d>& c = track.centres;
-  if (c.size() < 30) {
-    sheet.skip("upper_arm_girth_" + sd, "the " + sd + " arm is too short to follow");
-    return;
+std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y,
+                                     double crotch_y, Side side) {
+  ArmTrack track = follow_arm(cuts, arm_apart_y, crotch_y, side);
+  if (track.centres.size() < 30) {
+    sheet.posture().arm_against_body[side == Side::kLeft ? 0 : 1] = true;
+    return std::nullopt;
   }
+  ArmAxes arm;
+  arm.centres = std::move(track.centres);
+  arm.girths = std::move(track.girths);
+  const std::vector<Eigen::Vector3d>& c = arm.centres;
   // Wrist: the narrowest cut in the lower part of the arm, above the palm.
-  const size_t w = settle(track.girths, wrist_cut(track.girths, 0.006 * stature), 1.0);
-  // Elbow: where the axis bends; two lines fitted to the centroids, wrist to
-  // armpit, split where together they fit best.
+  const size_t w = settle(arm.girths, wrist_cut(arm.girths, 0.006 * cuts.stature()), 1.0);
   size_t e = w / 2;
   double best = std::numeric_limits<double>::infinity();
   for (size_t k = w / 5; k < w * 4 / 5; ++k) {
@@ -183,11 +184,27 @@ void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart
     fit_line(c, k, w + 1, &r2);
     if (r1 + r2 < best) best = r1 + r2, e = k;
   }
-  const auto [uc, ud] = fit_line(c, 0, e + 1);  // the upper arm's axis
-  const auto [fc, fd] = fit_line(c, e, w + 1);  // the forearm's
+  arm.wrist = w, arm.elbow = e;
+  std::tie(arm.upper_centre, arm.upper_dir) = fit_line(c, 0, e + 1);
+  std::tie(arm.fore_centre, arm.fore_dir) = fit_line(c, e, w + 1);
   const size_t index = side == Side::kLeft ? 0 : 1;
-  sheet.posture().arm_abduction_deg[index] = std::acos(std::clamp(ud.y(), -1.0, 1.0)) * 180 / M_PI;
-  sheet.posture().elbow_bend_deg[index] = std::acos(std::min(1.0, std::abs(ud.dot(fd)))) * 180 / M_PI;
+  sheet.posture().arm_abduction_deg[index] = std::acos(std::clamp(arm.upper_dir.y(), -1.0, 1.0)) * 180 / M_PI;
+  sheet.posture().elbow_bend_deg[index] =
+      std::acos(std::min(1.0, std::abs(arm.upper_dir.dot(arm.fore_dir)))) * 180 / M_PI;
+  return arm;
+}
+
+void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, const std::optional<ArmAxes>& axes, Side side) {
+  const std::string sd = side_name(side);
+  const double stature = cuts.stature();
+  if (!axes) {
+    sheet.skip("upper_arm_girth_" + sd, "the " + sd + " arm is too short to follow");
+    return;
+  }
+  const std::vector<Eigen::Vector3d>& c = axes->centres;
+  const size_t w = axes->wrist, e = axes->elbow;
+  const Eigen::Vector3d &uc = axes->upper_centre, &ud = axes->upper_dir;
+  const Eigen::Vector3d &fc = axes->fore_centre, &fd = axes->fore_dir;
   // The elbow's centre: where the upper arm's axis passes closest to the forearm's.
   // The bend's cut c[e] moves in the cuts' steps, and with the armpit's level,
   // where they start; where two lines meet moves with the skin. An arm nearly

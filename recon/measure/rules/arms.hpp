@@ -3,7 +3,9 @@
 // the arm's posture (abduction, elbow bend) (docs/measurements.md).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "recon/measure/rules/body_cuts.hpp"
@@ -11,12 +13,30 @@
 
 namespace bodyscan::rules {
 
+// An arm's horizontal cuts, armpit downwards, and the axes of its two segments.
+struct ArmAxes {
+  std::vector<Eigen::Vector3d> centres;  // the cuts' centroids
+  std::vector<double> girths;            // their tapes, mm
+  size_t elbow = 0, wrist = 0;           // indices of the bend's and the wrist's cuts
+  // Each segment's axis: a point on it and its unit direction (pointing up).
+  Eigen::Vector3d upper_centre = Eigen::Vector3d::Zero(), upper_dir = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d fore_centre = Eigen::Vector3d::Zero(), fore_dir = Eigen::Vector3d::UnitY();
+};
+
 // The arm on `side`, followed down from `arm_apart_y` (where its own loop ends)
 // until it ends, thins, or parts into fingers, or past the crotch (`crotch_y`)
-// into the leg. Records `wrist_point_<side>` and `elbow_point_<side>`, the wrist
-// and upper-arm girths and the outer arm length (from `shoulder_point_<side>`),
-// and the arm's abduction and elbow bend into the sheet's posture.
-void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y, double crotch_y, Side side);
+// into the leg; its wrist's cut (wrist_cut) and where its axis bends (two lines
+// fitted to the centroids, wrist to armpit, split where together they fit best).
+// Records the arm's abduction and elbow bend into the sheet's posture. Nothing
+// when the arm is too short to follow (under 30 cuts: it lies against the flank,
+// which the posture records).
+std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y,
+                                     double crotch_y, Side side);
+
+// The arm on `side` from its axes: records `wrist_point_<side>` and
+// `elbow_point_<side>`, the wrist and upper-arm girths and the outer arm length
+// (from `shoulder_point_<side>`).
+void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, const std::optional<ArmAxes>& axes, Side side);
 
 // The wrist among an arm's horizontal cuts, armpit downwards (`girths`: their tapes,
 // mm), as an index: the narrowest in the lower 45 % above the last three cuts. A

@@ -26,9 +26,21 @@ constexpr double kNeckBaseWidth = 1.3;
 constexpr double kNeckSideBand = 5;
 // The same for the top of the shoulder, which is broad front to back.
 constexpr double kRidgeBand = 10;
-// The shoulder's corner: the fit's weights reach zero this far either side of its
-// vertex, as a fraction of the stature.
+// The shoulder's corner without the arm's axis: the fit's weights reach zero this
+// far either side of its vertex, as a fraction of the stature.
 constexpr double kCornerHalf = 0.04;
+// The shoulder point with the arm's axis (arm_side_corner): where the outline's
+// normal has turned this share of the way from the shoulder top's slope to the
+// arm's outer side, the slope read over this fraction of the stature from the
+// neck, and how far (a fraction of the stature) back toward the neck the point
+// lies from there. Skinned bodies keep the point on its skin for any share from
+// 0.75 to 0.85 and any distance back (docs/measurements.md); the distance puts it
+// over the acromion, where the outline's own corner lies with the arms at 42°.
+constexpr double kArmSideTurn = 0.8;
+constexpr double kShoulderTopStretch = 0.03;
+constexpr double kAcromionBack = 0.013;
+// How far below the outline's extreme along a normal (mm) it still counts as on it.
+constexpr double kArmSideBandMm = 10;
 // Columns of the shoulder's top outline, mm wide.
 constexpr double kOutlineColumnMm = 3;
 
@@ -55,6 +67,57 @@ std::vector<std::vector<Eigen::Vector3d>> vertical_sections(const TriangleMesh& 
       }
     }
   return column;
+}
+
+// The shoulder's corner on the top outline seen from the front, (u[i], top[i]) from
+// the side neck point out (u: mm out from the midline), without the arm's axis:
+// the corner bulging above the chord from the neck to where the outline is well
+// down the arm (`y_arm`), the vertex of a parabola fitted to the height above the
+// chord with weights falling smoothly to zero kCornerHalf of the stature either
+// side of the vertex itself (refined_corner). Nothing where no sample lies above
+// the chord.
+std::optional<double> outline_corner(const std::vector<double>& u, const std::vector<double>& top, double y_arm,
+                                     double stature) {
+  const auto [k, corner] = refined_corner(u, top, y_arm, kCornerHalf * stature);
+  if (k == 0) return std::nullopt;
+  return corner;
+}
+
+// The shoulder's corner on the same outline, given the upper arm's axis
+// (`upper_arm`, unit, pointing up; s the side's sign). Skinned or real, the skin
+// over the shoulder's cap turns with the arm, the more the nearer the arm, so a
+// corner read from the outline's shape alone slides along the skin as the arm
+// comes down. Two steps hold it:
+// - Where the outline turns onto the arm: the point whose outward normal has
+//   turned kArmSideTurn of the way from the shoulder top's slope (a line through
+//   the outline's first kShoulderTopStretch of the stature) to the normal of the
+//   arm's outer side (90 degrees less the arm's abduction in the frontal plane).
+//   That skin turns with the arm, and the point keeps its place on it.
+// - From there back toward the neck along the outline by kAcromionBack of the
+//   stature: the top of the shoulder over the acromion.
+std::optional<double> arm_side_corner(const std::vector<double>& u, const std::vector<double>& top,
+                                      const Eigen::Vector3d& upper_arm, double s, double stature) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
+  for (size_t i = 1; i < u.size() && u[i] <= u[1] + kShoulderTopStretch * stature; ++i)
+    sx += u[i], sy += top[i], sxx += u[i] * u[i], sxy += u[i] * top[i], n += 1;
+  if (n < 3) return std::nullopt;
+  const double top_deg = std::atan(-(n * sxy - sx * sy) / (n * sxx - sx * sx)) * 180 / M_PI;
+  const double arm_deg = std::atan2(-s * upper_arm.x(), upper_arm.y()) * 180 / M_PI;
+  const double turn = (top_deg + kArmSideTurn * (90 - arm_deg - top_deg)) * M_PI / 180;
+  std::vector<Eigen::Vector3d> outline;  // (u, top, 0)
+  for (size_t i = 1; i < u.size(); ++i) outline.emplace_back(u[i], top[i], 0);
+  const Eigen::Vector3d normal(std::sin(turn), std::cos(turn), 0), along(std::cos(turn), -std::sin(turn), 0);
+  const Eigen::Vector3d arm_side = middle_of_extreme(outline, normal, along, kArmSideBandMm, true);
+  // Back toward the neck along the outline.
+  size_t i = 1;
+  while (i + 1 < u.size() && u[i + 1] < arm_side.x()) ++i;
+  double left = kAcromionBack * stature, cu = arm_side.x(), cy = arm_side.y();
+  for (size_t j = i; j >= 1 && left > 0; --j) {
+    const double du = cu - u[j], dy = cy - top[j], step = std::hypot(du, dy);
+    if (step >= left) return cu - du * left / step;
+    left -= step, cu = u[j], cy = top[j];
+  }
+  return cu;
 }
 
 }  // namespace
@@ -108,7 +171,8 @@ Status find_side_neck_point(const BodyCuts& cuts, MeasurementSheet& sheet, const
   return Status();
 }
 
-Status find_shoulder_point(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y, Side side) {
+Status find_shoulder_point(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y,
+                           const std::optional<Eigen::Vector3d>& upper_arm, Side side) {
   const double mid_x = cuts.midline_x(), stature = cuts.stature(), s = sign(side);
   const std::string name = "shoulder_point_" + side_name(side);
   const Eigen::Vector3d side_neck = sheet.position("side_neck_point_" + side_name(side));
@@ -119,7 +183,7 @@ Status find_shoulder_point(const BodyCuts& cuts, MeasurementSheet& sheet, double
   const auto columns = static_cast<size_t>((u1 - u0) / kOutlineColumnMm) + 1;
   // The top outline seen from the front, exact on the mesh: the highest point of
   // the section in each column's central plane (a column's highest vertex drops
-  // wherever a coarse mesh has no vertex near the top).
+  // wherever a coarse mesh has no vertex near the top). u: out from the midline.
   const std::vector<std::vector<Eigen::Vector3d>> column = vertical_sections(
       cuts.mesh(), mid_x, s, arm_apart_y, y_hi, [&](size_t c) { return u0 + (c + 0.5) * kOutlineColumnMm; },
       columns);
@@ -132,26 +196,25 @@ Status find_shoulder_point(const BodyCuts& cuts, MeasurementSheet& sheet, double
     us.push_back(u0 + (c + 0.5) * kOutlineColumnMm), tops.push_back(top);
   }
   if (us.size() < 4) return not_found("measure: no " + side_name(side) + " shoulder outline");
-  // The shoulder's corner bulges above the chord from the neck to where the
-  // outline is well down the arm: the vertex of a parabola fitted to the height
-  // above the chord, with weights falling smoothly to zero kCornerHalf of the
-  // stature either side of the vertex itself (refined_corner). The outline is a
-  // smooth curve there, and its highest sample above the chord follows the skin's
-  // noise.
-  const auto [k, u] = refined_corner(us, tops, y_arm, kCornerHalf * stature);
-  if (k == 0) {
+  const std::optional<double> corner =
+      upper_arm ? arm_side_corner(us, tops, *upper_arm, s, stature) : outline_corner(us, tops, y_arm, stature);
+  if (!corner) {
     sheet.landmark(name, side_neck);
     return Status();
   }
   // The top of the shoulder runs front to back: its middle there, between the
-  // section's points. (A copy: clang before 16 cannot capture a structured binding.)
-  const double corner = u;
+  // section's points.
+  const double u = *corner;
   const std::vector<std::vector<Eigen::Vector3d>> at_corner =
-      vertical_sections(cuts.mesh(), mid_x, s, arm_apart_y, y_hi, [corner](size_t) { return corner; }, 1);
+      vertical_sections(cuts.mesh(), mid_x, s, arm_apart_y, y_hi, [u](size_t) { return u; }, 1);
   const std::vector<Eigen::Vector3d>& top =
       at_corner[0].empty()
-          ? column[std::min(columns - 1, static_cast<size_t>((us[k] - u0) / kOutlineColumnMm))]
+          ? column[std::min(columns - 1, static_cast<size_t>(std::max(0.0, (u - u0) / kOutlineColumnMm)))]
           : at_corner[0];
+  if (top.empty()) {
+    sheet.landmark(name, side_neck);
+    return Status();
+  }
   sheet.landmark(name, middle_of_extreme(top, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), kRidgeBand, true));
   return Status();
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 
 #include "recon/core/status.hpp"
 #include "recon/measure/body_posture.hpp"
@@ -31,8 +32,12 @@ Status find_side_neck_point(const BodyCuts& cuts, MeasurementSheet& sheet, const
 
 // The shoulder point on `side`: the corner of the shoulder's top outline seen from
 // the front, from the side neck point out and down the arm to a quarter of the way
-// to `arm_apart_y` (where the arm's own loop ends). Records `shoulder_point_<side>`.
-Status find_shoulder_point(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y, Side side);
+// to `arm_apart_y` (where the arm's own loop ends). With the upper arm's axis
+// (`upper_arm`: unit, pointing up), the corner is found where the skin keeps it
+// whatever the arm's angle; without, where the outline bends most (which slides
+// out along the skin as the arm comes down). Records `shoulder_point_<side>`.
+Status find_shoulder_point(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y,
+                           const std::optional<Eigen::Vector3d>& upper_arm, Side side);
 
 // The back neck point (the centre back at the side neck points' level) and the
 // front neck point (the notch of the front midline below the neck).
