@@ -34,14 +34,49 @@ const Ring* leg_loop(const BodyCuts& cuts, const std::vector<Ring>& cut, Side si
   return l && parts_near(cut, *l, 0.06 * cuts.stature()) == 0 ? l : nullptr;
 }
 
-// The thigh's tape at a level below the crotch where hole filling bridges the gap
-// between the thighs (bridged_part), if it is a leg's (6 % of the stature round).
+// The tape round the part of `ring` on `side` of the midline X = mid_x, in the
+// ring's plane: a tape round one of two thighs pressed together runs between them.
+std::optional<Girth> side_part(const Ring& ring, double mid_x, Side side) {
+  const double s = sign(side);
+  const double y = ring.points.empty() ? 0 : ring.points.front().y();
+  Girth g;
+  g.plane = Plane{Eigen::Vector3d(0, y, 0), Eigen::Vector3d::UnitY()};
+  g.loops_cut = 1;
+  std::vector<Eigen::Vector2d> flat;
+  for (size_t i = 0; i < ring.points.size(); ++i) {
+    if (s * (ring.points[i].x() - mid_x) <= 0) continue;
+    if (i < ring.confidence.size()) g.min_confidence = std::min(g.min_confidence, ring.confidence[i]);
+    g.loop.push_back(ring.points[i]);
+    flat.emplace_back(ring.points[i].x(), ring.points[i].z());
+  }
+  const std::vector<Eigen::Vector2d> hull = convex_hull(std::move(flat));
+  if (hull.size() < 3) return std::nullopt;
+  g.value_mm = closed_length(hull);
+  g.loop_length_mm = closed_length(g.loop);
+  for (const Eigen::Vector2d& q : hull) g.tape.emplace_back(q.x(), y, q.y());
+  return g;
+}
+
+// The thigh's tape at a level below the crotch where a loop spans the midline:
+// hole filling bridges the gap between the thighs (bridged_part, round the leg's
+// measured skin), or the thighs press together (side_part). Of the loops spanning
+// the midline, this side's own where each leg's loop crosses it (skinned legs
+// pass through each other), else the longest (one loop round both). Nothing
+// unless the tape is a leg's (6 % of the stature round).
 std::optional<Girth> bridged_leg(const BodyCuts& cuts, double crotch_y, double y, Side side) {
   if (y >= crotch_y) return std::nullopt;
   const std::vector<Ring>& cut = cuts.at(y);
-  const Ring* m = midline_ring(cut, cuts.midline_x());
+  const double mid_x = cuts.midline_x();
+  const Ring* m = nullptr;
+  for (const Ring& r : cut) {
+    if (!r.spans_x(mid_x) || r.girth < 0.06 * cuts.stature()) continue;
+    const bool own = sign(side) * (r.centroid.x() - mid_x) > 0;
+    const bool m_own = m && sign(side) * (m->centroid.x() - mid_x) > 0;
+    if (!m || (own && !m_own) || (own == m_own && r.girth > m->girth)) m = &r;
+  }
   if (!m) return std::nullopt;
-  std::optional<Girth> g = bridged_part(*m, cuts.midline_x(), side);
+  std::optional<Girth> g = bridged_part(*m, mid_x, side);
+  if (!g) g = side_part(*m, mid_x, side);
   if (!g || g->value_mm < 0.06 * cuts.stature()) return std::nullopt;
   g->loops_cut = cut.size();
   return g;

@@ -198,30 +198,41 @@ Eigen::Vector3d bust_point(const BodyCuts& cuts, double bust_y, Side side) {
 StatusOr<double> find_crotch(const BodyCuts& cuts, MeasurementSheet& sheet) {
   const double mid_x = cuts.midline_x(), stature = cuts.stature();
   auto merged = [&](double y) { return cuts.midline_loop(y) != nullptr; };
+  // Down from the trunk, the first level where no loop spans the midline: the legs
+  // apart. Walked down rather than up, since legs held close can touch lower down
+  // (knees, calves) and join there again; the crotch is where the trunk's loop
+  // parts, not where the legs first meet.
   const double step = 5;
-  double prev = cuts.level(0.25);
-  if (merged(prev)) return not_found("measure: the legs are not apart at a quarter of the height; stand with feet apart");
-  cuts.prefetch(prev + step, cuts.level(0.55), step);
-  for (double y = prev + step; y <= cuts.level(0.65); y += step) {
-    if (merged(y)) {
-      double crotch_y = bisect(prev, y, merged);
-      // Where the thighs nearly touch no camera sees between them, and the surface
-      // bridges the gap below the real crotch; the real crotch's front and back are
-      // seen. Up from the first join, the first level whose midline crossings are
-      // measured skin, within 5 % of the stature.
-      crotch_y = above_bridge(cuts, crotch_y, mid_x, 0.05 * stature);
-      // A smooth surface rounds the corner where measured thighs meet, closing their
-      // gap a few mm below the crotch in a narrow saddle: the crotch is where the
-      // join has grown kJoinDepth of the stature long.
-      crotch_y = widened(cuts, crotch_y, mid_x, kJoinDepth * stature, 0.02 * stature);
-      double f = cuts.midline_z(), b = cuts.midline_z();
-      if (const Ring* m = cuts.midline_loop(crotch_y + 0.5)) m->crossing_z(mid_x, &f, &b);
-      sheet.landmark("crotch", {mid_x, crotch_y, 0.5 * (f + b)});
-      return crotch_y;
+  const double top = cuts.level(0.55), bottom = cuts.level(0.25);
+  cuts.prefetch(top, bottom, -step);
+  double above = top;
+  double crotch_y = -1;
+  for (double y = top - step; y >= bottom; y -= step) {
+    if (!merged(y)) {
+      crotch_y = bisect(y, above, merged);
+      break;
     }
-    prev = y;
+    above = y;
   }
-  return not_found("measure: no crotch found between 25 % and 65 % of the height");
+  if (crotch_y < 0)
+    return not_found("measure: the legs are not apart below the trunk down to a quarter of the height; stand with "
+                     "feet apart");
+  // Where the thighs nearly touch no camera sees between them, and the surface
+  // bridges the gap below the real crotch; the real crotch's front and back are
+  // seen. Up from the join, the first level whose midline crossings are measured
+  // skin, within 5 % of the stature.
+  crotch_y = above_bridge(cuts, crotch_y, mid_x, 0.05 * stature);
+  // A smooth surface rounds the corner where measured thighs meet, closing their
+  // gap a few mm below the crotch in a narrow saddle: the crotch is where the join
+  // has grown kJoinDepth of the stature long.
+  crotch_y = widened(cuts, crotch_y, mid_x, kJoinDepth * stature, 0.02 * stature);
+  // Front to back, the middle of the join's first kJoinDepth from its back: the
+  // join's front runs into the notch between the thighs, and jumps out of it as the
+  // notch closes over a fraction of a millimetre of height.
+  double f = cuts.midline_z(), b = cuts.midline_z();
+  if (const Ring* m = cuts.midline_loop(crotch_y + 0.5)) m->crossing_z(mid_x, &f, &b);
+  sheet.landmark("crotch", {mid_x, crotch_y, b + 0.5 * std::min(f - b, kJoinDepth * stature)});
+  return crotch_y;
 }
 
 StatusOr<ArmJoin> find_arm_join(const BodyCuts& cuts, MeasurementSheet& sheet, double crotch_y, Side side) {

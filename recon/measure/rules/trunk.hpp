@@ -32,10 +32,10 @@ struct TrunkLevels {
   double breast = 0;            // breast_reach of that fold's depth
 };
 
-// The crotch: the lowest level where one loop spans the midline (the legs join),
-// raised past a filled bridge and a rounded corner. Records the `crotch`
-// landmark; errors when the legs are not apart at a quarter of the stature or join
-// nowhere below 65 % of it.
+// The crotch: down from the trunk (55 % of the stature), the first level where no
+// loop spans the midline (the legs part), raised past a filled bridge and a
+// rounded corner. Records the `crotch` landmark; errors when the legs are not
+// apart anywhere down to a quarter of the stature.
 StatusOr<double> find_crotch(const BodyCuts& cuts, MeasurementSheet& sheet);
 
 // Where the arm on `side` meets the trunk, up from just above the crotch. Records
