@@ -5,9 +5,9 @@
 // For the swaying scan it also prints how far the sway the scan job estimated (and
 // undid) lies from the simulator's.
 //
-//   measure_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--repeat]
+//   measure_benchmark [--rig thesis|square|tiered|FILE]... [--body BODY.ply]... [--repeat]
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR | --saved DIR]
-//                     [--resurface] [--seed N] [--min-weight W]
+//                     [--resurface] [--seed N] [--min-weight W] [--posture ARMS,FEET,TURN]
 //   measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body BODY.ply...
 //
 // --save writes each scan's surface, its point cloud and the posed true body as PLY
@@ -18,6 +18,13 @@
 // cloud with today's reconstruction (as the scan job does, half a minute a scan),
 // so a change to the surface is judged on the same scans.
 // --min-weight sets the surface's ReconstructOptions::min_relative_weight.
+// --posture ARMS,FEET,TURN has the simulated subject of every scan stand otherwise
+// than the rig description says, as `bodyscan scan --arms --feet --turn` does
+// (pipeline::SimulatedSubject): both upper arms ARMS degrees from the downward
+// vertical, the ankle joints FEET mm apart (hw/sim/pose_body.hpp: a MakeHuman body
+// only), turned TURN degrees about the vertical (+ turns the face from +Z toward +X).
+// The truth is then the posed body exactly as the simulator rendered it (posture,
+// turn and place), and --save keeps that one.
 // --noise-study N measures each body's own mesh N times under smooth skin noise
 // (recon/geometry/skin_noise.hpp: fields at 40 and 10 mm, each --noise-rms RMS, default
 // 0.25 mm) and ranks the measurements and landmarks by how far they move: no scan,
@@ -28,7 +35,10 @@
 // 9 mm off on large girths, 4 mm on small girths and heights, 5 mm on lengths. The
 // issue's must for the fixed planes is half of that, its aim a sixth; for the
 // automatic set the must is the allowance itself. Marks: aim (a sixth), must
-// (half), iso (the allowance), OVER.
+// (half), iso (the allowance), OVER; "crosses fill" where the scan's value runs
+// over surface hole filling invented, "outside posture" where the body stood
+// outside the posture the value's definition assumes (body_posture.hpp), as the
+// truth's set or the scan's reads it. The posture both sets read is printed too.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -120,6 +130,19 @@ ReconstructOptions g_surface = pipeline::body_surface_options();
 std::string g_save;
 bool g_resurface = false;
 uint64_t g_seed = 1;
+// --posture: applied over every scan's rig description.
+pipeline::SimulatedSubject g_subject;
+
+// "ARMS,FEET,TURN" into g_subject; false when it is not three numbers.
+bool parse_posture(const char* text) {
+  double arms = 0, feet = 0, turn = 0;
+  char end = 0;
+  if (std::sscanf(text, "%lf,%lf,%lf%c", &arms, &feet, &turn, &end) != 3) return false;
+  g_subject.posture.arm_abduction_deg = {arms, arms};
+  g_subject.posture.ankle_distance_mm = feet;
+  g_subject.turn_deg = turn;
+  return true;
+}
 
 // A shipped rig by name, or a description file.
 StatusOr<hw::RigDescription> rig_description(const std::string& rig_name) {
@@ -131,7 +154,8 @@ StatusOr<hw::RigDescription> rig_description(const std::string& rig_name) {
 }
 
 StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64_t seed, double sway, int every) {
-  ASSIGN_OR_RETURN(hw::RigDescription desc, rig_description(rig_name));
+  ASSIGN_OR_RETURN(hw::RigDescription loaded, rig_description(rig_name));
+  hw::RigDescription desc = g_subject.applied_to(std::move(loaded));
   desc.simulation.seed = seed;
   desc.simulation.motion.sway_mm = sway;
   TriangleMesh subject;
@@ -151,10 +175,22 @@ StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64
   s.voxel = r.surface.voxel_size;
   s.body = std::move(r.body);
   if (!s.body) return internal_error("measurements: " + r.measure_error);
-  s.truth = sim->scene().subject();  // still for the first scan (no sway)
+  // The subject as the scene holds it: the body posed (SimulatedRig::create poses
+  // it before the scene stands, turns and places it), at the last frame's moment.
+  // For a still subject (the first scan: no sway, and the shipped rigs do not
+  // breathe) that is what every frame rendered.
+  s.truth = sim->scene().subject();
   s.floor = -0.5 * desc.frame.tube;
   if (sway > 0) s.sway = sway_error(r.scan.sway, s.cloud.frame, desc.simulation.motion, desc.simulation.frame_rate_hz);
   return s;
+}
+
+// One part of the posture as the truth's set and the scan's read it.
+std::string posture_pair(const std::optional<double>& truth, const std::optional<double>& scan) {
+  char t[32] = "-", s[32] = "-";
+  if (truth) std::snprintf(t, sizeof t, "%.1f", *truth);
+  if (scan) std::snprintf(s, sizeof s, "%.1f", *scan);
+  return std::string(t) + " / " + s;
 }
 
 const char* mark(double diff, double allow) {
@@ -179,6 +215,12 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
   std::printf("automatic set: %.3f s on the scan (%zu triangles), %.3f s on the truth (%zu triangles)\n", t_scan,
               mesh.triangles.size(), t_truth, truth_mesh.triangles.size());
   if (!again.ok()) return std::fprintf(stderr, "scan set: %s\n", again.status().message().c_str()), 1;
+  const BodyPosture &tp = truth->posture, &sp = scan_body.posture;
+  std::printf("posture, truth / scan: turn %s deg, arms left %s, right %s deg, ankles %s mm\n",
+              posture_pair(tp.turn_deg, sp.turn_deg).c_str(),
+              posture_pair(tp.arm_abduction_deg[0], sp.arm_abduction_deg[0]).c_str(),
+              posture_pair(tp.arm_abduction_deg[1], sp.arm_abduction_deg[1]).c_str(),
+              posture_pair(tp.ankle_distance_mm, sp.ankle_distance_mm).c_str());
 
   // Fixed planes: horizontal girths at fractions of the stature, round the torso and
   // each leg as the truth's cut finds them.
@@ -232,9 +274,9 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
     iso += std::abs(d) <= al;
     must += std::abs(d) <= al / 2;
     aim += std::abs(d) <= al / 6;
-    std::printf("%-24s %6s %8.1f %8.1f %+7.2f %6.1f  %s%s\n", m.name.c_str(), m.iso_clause.c_str(), m.value_mm,
+    std::printf("%-24s %6s %8.1f %8.1f %+7.2f %6.1f  %s%s%s\n", m.name.c_str(), m.iso_clause.c_str(), m.value_mm,
                 s->value_mm, d, al, std::abs(d) <= al ? (std::abs(d) <= al / 2 ? mark(d, al) : "iso") : "OVER",
-                s->crosses_filled_hole() ? "  (crosses fill)" : "");
+                s->crosses_filled_hole() ? "  (crosses fill)" : "", m.outside_posture || s->outside_posture ? "  (outside posture)" : "");
   }
   std::printf("%zu measurements: %zu within the ISO allowance, %zu within half, %zu within a sixth\n", n, iso, must,
               aim);
@@ -262,7 +304,11 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
 }
 
 int run(const std::string& rig, const std::string& body, bool repeat, double sway, int every) {
-  std::printf("\n== rig %s, body %s\n", rig.c_str(), body.empty() ? "(the rig's)" : body.c_str());
+  std::printf("\n== rig %s, body %s", rig.c_str(), body.empty() ? "(the rig's)" : body.c_str());
+  if (g_subject.turn_deg)
+    std::printf(", posture arms %g deg, feet %g mm, turn %g deg", *g_subject.posture.arm_abduction_deg[0],
+                *g_subject.posture.ankle_distance_mm, *g_subject.turn_deg);
+  std::printf("\n");
   auto t0 = Clock::now();
   auto a = scan(rig, body, g_seed, 0, every);
   if (!a.ok()) return std::fprintf(stderr, "scan: %s\n", a.status().message().c_str()), 1;
@@ -425,12 +471,14 @@ int main(int argc, char** argv) {
     else if (a == "--noisy-out" && i + 1 < argc) noisy_out = argv[++i];
     else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--min-weight" && i + 1 < argc) g_surface.min_relative_weight = std::strtof(argv[++i], nullptr);
+    else if (a == "--posture" && i + 1 < argc && parse_posture(argv[i + 1])) ++i;
     else if (a == "--fairing" && i + 1 < argc) {
       const std::string f = argv[++i];
       g_surface.hole_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
     }
     else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
-                        "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W]\n"
+                        "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W] "
+                        "[--posture ARMS,FEET,TURN]\n"
                         "       measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body B...\n"), 2;
   }
   if (noise_fields > 0) {
