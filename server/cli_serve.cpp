@@ -1,6 +1,7 @@
 // `bodyscan serve`: the workstation. Opens the archive, the accounts and the rig,
-// serves the API and the browser UI, and on SIGINT/SIGTERM cancels the running
-// job (marked as such in the archive), turns the lasers off and closes cleanly.
+// serves the API and the browser UI, and on SIGINT, SIGTERM, SIGHUP, SIGQUIT or
+// SIGUSR1 cancels the running job (marked as such in the archive), turns the
+// lasers off and closes cleanly.
 #include <signal.h>
 #include <sodium.h>
 #include <sys/stat.h>
@@ -18,6 +19,19 @@
 namespace bodyscan::cli {
 
 namespace {
+
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1};
+
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    case SIGQUIT: return "SIGQUIT";
+    case SIGUSR1: return "SIGUSR1";
+    default: return "signal";
+  }
+}
 
 void usage(FILE* out) {
   std::fprintf(out,
@@ -132,12 +146,14 @@ int run_serve(int argc, char** argv) {
   }
   if (!no.tls_cert.empty()) ao.secure_cookies = true;
 
-  // SIGINT and SIGTERM are taken by this thread alone (sigwait below): every
-  // thread started from here on inherits the block.
+  // The signals that end a process by default and that a person or the system
+  // sends to stop it (Ctrl-C, kill, a closed terminal or ssh session, Ctrl-\,
+  // a stray SIGUSR1) are taken by this thread alone (sigwait below) and stop the
+  // workstation in order, lasers off: every thread started from here on inherits
+  // the block.
   sigset_t stop_signals;
   sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
+  for (int stop : kStopSignals) sigaddset(&stop_signals, stop);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
 
@@ -181,7 +197,7 @@ int run_serve(int argc, char** argv) {
 
   int sig = 0;
   sigwait(&stop_signals, &sig);
-  std::printf("bodyscan serve: %s: stopping (lasers off, the running job cancelled)\n", sig == SIGINT ? "SIGINT" : "SIGTERM");
+  std::printf("bodyscan serve: %s: stopping (lasers off, the running job cancelled)\n", signal_name(sig));
   std::fflush(stdout);
   // The job first, so that browsers still hear it was cancelled; then the network.
   (*ws)->shutdown("the workstation stopped");

@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   // Lasers off on a crash, and on Ctrl-C or kill in every command but `serve`, which
-  // takes SIGINT and SIGTERM itself and stops in order.
+  // takes the stopping signals itself and stops in order.
   bodyscan::hw::install_laser_safety_handlers(cmd != "serve");
   if (cmd == "reconstruct") return bodyscan::cli::run_reconstruct(argc - 1, argv + 1);
   if (cmd == "scan") return bodyscan::cli::run_scan(argc - 1, argv + 1);

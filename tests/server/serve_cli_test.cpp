@@ -8,6 +8,7 @@
 
 #include <cstdio>
 #include <thread>
+#include <utility>
 
 #include "storage/archive/archive.hpp"
 #include "tests/server/http_client.hpp"
@@ -93,6 +94,29 @@ TEST(ServeCli, SigtermMidScanCancelsTheScanAndStopsCleanly) {
   EXPECT_EQ(scan->status, storage::ScanStatus::kCancelled);
   EXPECT_EQ(scan->status_reason, "cancelled: the workstation stopped");
   EXPECT_TRUE((*archive)->verify().ok());
+}
+
+// A closed terminal or ssh session (SIGHUP), Ctrl-\ (SIGQUIT) and a stray SIGUSR1
+// end a process at once by default; the workstation stops in order instead, as on
+// SIGTERM (the path that cancels a running scan above).
+TEST(ServeCli, HangupQuitAndUsr1StopInOrderLikeSigterm) {
+  for (const auto& [sig, name] : {std::pair{SIGHUP, "SIGHUP"}, {SIGQUIT, "SIGQUIT"}, {SIGUSR1, "SIGUSR1"}}) {
+    const std::string data = temp_dir();
+    Child child = start_serve(data, "a long test password");
+    ASSERT_GT(child.pid, 0);
+    std::string log;
+    ASSERT_GT(read_port(child.out, &log), 0) << log;
+    ASSERT_EQ(kill(child.pid, sig), 0);
+    char line[512];
+    while (std::fgets(line, sizeof line, child.out)) log += line;
+    int status = 0;
+    ASSERT_EQ(waitpid(child.pid, &status, 0), child.pid);
+    fclose(child.out);
+    ASSERT_TRUE(WIFEXITED(status)) << name << ": " << log;
+    EXPECT_EQ(WEXITSTATUS(status), 0) << name << ": " << log;
+    EXPECT_NE(log.find(std::string(name) + ": stopping"), std::string::npos) << log;
+    EXPECT_NE(log.find("stopped cleanly"), std::string::npos) << log;
+  }
 }
 
 }  // namespace
