@@ -10,6 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "recon/core/json_text.hpp"
+
 namespace bodyscan::hw {
 
 using nlohmann::json;
@@ -498,12 +500,10 @@ json vec(const Vec3d& v) { return json::array({v.x(), v.y(), v.z()}); }
 }  // namespace
 
 StatusOr<RigDescription> parse_rig_description(const std::string& json_text, const std::string& source) {
-  json j;
-  try {
-    j = json::parse(json_text);
-  } catch (const json::parse_error& e) {
-    return invalid_argument(source + ": not valid JSON: " + e.what());
-  }
+  const json j = parse_json(json_text);
+  if (j.is_discarded())
+    return invalid_argument(source + ": not valid JSON, or nested more than " + std::to_string(kMaxJsonDepth) +
+                            " levels deep");
   try {
     return read_rig(j, source);
   } catch (const ParseError& e) {

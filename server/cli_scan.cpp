@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "hw/rig_description.hpp"
+#include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/scan_job.hpp"
@@ -347,7 +348,7 @@ int run_reprocess(int argc, char** argv) {
                  in.c_str(), pipeline::kRawRecordFile, pipeline::kRawStripesFile);
     return 1;
   }
-  const nlohmann::json j = nlohmann::json::parse(*record, nullptr, false);
+  const nlohmann::json j = parse_json(*record);
   if (j.is_discarded()) {
     std::fprintf(stderr, "bodyscan reprocess: %s/raw/%s is not JSON\n", in.c_str(), pipeline::kRawRecordFile);
     return 1;

@@ -2,6 +2,7 @@
 
 #include <sodium.h>
 
+#include "recon/core/json_text.hpp"
 #include "server/api/static_files.hpp"
 
 namespace bodyscan::server {
@@ -81,7 +82,7 @@ std::optional<nlohmann::json> json_body(const Call& call, HttpResponse* error) {
     return std::nullopt;
   }
   nlohmann::json j = call.request.body.empty() ? nlohmann::json::object()
-                                               : nlohmann::json::parse(call.request.body, nullptr, false);
+                                               : parse_json(call.request.body);
   if (j.is_discarded() || !j.is_object()) {
     *error = error_response(400, "the request body is not a JSON object");
     return std::nullopt;

@@ -3,6 +3,7 @@
 // browser draws, measurement sheets, deleting and reprocessing.
 #include <cmath>
 
+#include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/api/api.hpp"
 #include "server/api/scan_views.hpp"
@@ -252,7 +253,7 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                          nlohmann::json posture = nullptr;
                          if (auto path = ws.archive().file_path(id, 0, "scan.json"); path.ok())
                            if (auto scan = read_whole_file(*path); scan.ok()) {
-                             const nlohmann::json j = nlohmann::json::parse(*scan, nullptr, false);
+                             const nlohmann::json j = parse_json(*scan);
                              if (j.is_object() && j.contains("posture")) posture = j["posture"];
                            }
                          return nlohmann::json{{"scan_id", id},

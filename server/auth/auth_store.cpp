@@ -15,6 +15,7 @@
 #include <mutex>
 #include <unordered_map>
 
+#include "recon/core/json_text.hpp"
 #include "storage/archive/ids.hpp"
 #include "storage/archive/sqlite.hpp"
 
@@ -411,7 +412,7 @@ struct AuthStore::Impl {
     l.id = st.text(0), l.scan_id = st.text(1), l.created_by = st.text(3), l.created_at = st.text(4);
     l.expires_at = st.integer(5);
     l.revoked = st.integer(6) != 0;
-    const auto j = nlohmann::json::parse(st.text(2), nullptr, /*allow_exceptions=*/false);
+    const auto j = parse_json(st.text(2));
     if (!j.is_array())
       return internal_error("accounts: share " + l.id + " has damaged measurements");
     for (const auto& m : j) {

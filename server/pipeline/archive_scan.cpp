@@ -1,5 +1,6 @@
 #include "server/pipeline/archive_scan.hpp"
 
+#include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/measurements_json.hpp"
 #include "storage/formats/draco_files.hpp"
@@ -54,7 +55,7 @@ StatusOr<int> reprocess_archived_scan(storage::Archive& archive, const std::stri
   ASSIGN_OR_RETURN(std::string stripes_path, archive.file_path(scan_id, -1, kRawStripesFile));
   ASSIGN_OR_RETURN(std::string record_text, read_whole_file(record_path));
   ASSIGN_OR_RETURN(std::string stripes, read_whole_file(stripes_path));
-  const nlohmann::json record = nlohmann::json::parse(record_text, nullptr, false);
+  const nlohmann::json record = parse_json(record_text);
   if (record.is_discarded()) return invalid_argument("scan " + scan_id + ": its raw record is not JSON");
   ASSIGN_OR_RETURN(ScanJobResult result, reprocess_scan(record, stripes, options));
   ASSIGN_OR_RETURN(storage::ScanResults results, to_results(result, options));

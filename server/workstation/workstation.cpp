@@ -18,6 +18,7 @@
 #include <zlib.h>
 
 #include "hw/rig_description.hpp"
+#include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/scan_job.hpp"
@@ -192,7 +193,7 @@ struct Workstation::Impl {
     if (!std::filesystem::exists(path)) return;
     StatusOr<std::string> text = read_whole_file(path);
     if (!text.ok()) return;
-    const nlohmann::json keep = nlohmann::json::parse(*text, nullptr, false);
+    const nlohmann::json keep = parse_json(*text);
     if (keep.is_discarded() || keep.value("rig", "") != rig_json.value("name", "")) return;
     StatusOr<pipeline::RigCalibration> cal = pipeline::calibration_from_record(keep.value("record", nlohmann::json()));
     if (!cal.ok()) return;
@@ -218,7 +219,7 @@ struct Workstation::Impl {
       StatusOr<std::string> text = read_whole_file(*path);
       if (!text.ok()) continue;
       StatusOr<pipeline::RigCalibration> cal =
-          pipeline::calibration_from_record(nlohmann::json::parse(*text, nullptr, false));
+          pipeline::calibration_from_record(parse_json(*text));
       if (!cal.ok()) continue;
       std::tm tm{};
       if (!strptime(r.started_at.c_str(), "%Y-%m-%dT%H:%M:%S", &tm)) continue;

@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "storage/archive/ids.hpp"
 #include "storage/archive/sqlite.hpp"
@@ -215,7 +216,7 @@ struct Archive::Impl {
     r.id = st.text(0), r.customer_id = st.text(1), r.operator_name = st.text(2), r.calibration_id = st.text(3);
     r.status = parse_status(st.text(4));
     r.status_reason = st.text(5), r.started_at = st.text(6), r.finished_at = st.text(7);
-    r.rig = nlohmann::json::parse(st.text(8), nullptr, false);
+    r.rig = parse_json(st.text(8));
     r.current_version = static_cast<int>(st.integer(9));
     ASSIGN_OR_RETURN(Statement vs, db.prepare(
                                        "SELECT version, created_at, algorithms, note FROM scan_versions "
@@ -227,7 +228,7 @@ struct Archive::Impl {
       ScanVersion v;
       v.version = static_cast<int>(vs.integer(0));
       v.created_at = vs.text(1);
-      v.algorithms = nlohmann::json::parse(vs.text(2), nullptr, false);
+      v.algorithms = parse_json(vs.text(2));
       v.note = vs.text(3);
       ASSIGN_OR_RETURN(v.files, files(id, v.version));
       r.versions.push_back(std::move(v));
@@ -521,8 +522,8 @@ StatusOr<nlohmann::json> Archive::calibration(const std::string& id) const {
   ASSIGN_OR_RETURN(std::string rig, slurp(folder / "rig.json"));
   ASSIGN_OR_RETURN(std::string cal, slurp(folder / "calibration.json"));
   return nlohmann::json{{"id", id},
-                        {"rig", nlohmann::json::parse(rig, nullptr, false)},
-                        {"calibration", nlohmann::json::parse(cal, nullptr, false)}};
+                        {"rig", parse_json(rig)},
+                        {"calibration", parse_json(cal)}};
 }
 
 // --- scans -------------------------------------------------------------------
@@ -759,7 +760,7 @@ StatusOr<std::vector<MeasurementRecord>> Archive::measurements(const std::string
     out.push_back(std::move(m));
   }
   }
-  for (size_t i = 0; i < out.size(); ++i) out[i].geometry = nlohmann::json::parse(geometry[i], nullptr, false);
+  for (size_t i = 0; i < out.size(); ++i) out[i].geometry = parse_json(geometry[i]);
   return out;
 }
 

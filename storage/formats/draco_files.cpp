@@ -16,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+#include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 
 namespace bodyscan::storage {
@@ -210,7 +211,7 @@ StatusOr<TriangleMesh> decode_glb(std::string_view bytes) {
   if (u32(8) > bytes.size()) return bad("the file is cut short");
   const uint32_t json_len = u32(12);
   if (u32(16) != 0x4E4F534Au || 20ull + json_len > bytes.size()) return bad("no JSON chunk");
-  const nlohmann::json j = nlohmann::json::parse(bytes.substr(20, json_len), nullptr, false);
+  const nlohmann::json j = parse_json(bytes.substr(20, json_len));
   if (j.is_discarded()) return bad("its JSON chunk does not parse");
   const size_t bin_at = 20 + ((json_len + 3) & ~3u);
   if (bin_at + 8 > bytes.size() || u32(bin_at + 4) != 0x004E4942u) return bad("no BIN chunk");

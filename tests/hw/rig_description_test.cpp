@@ -166,6 +166,13 @@ TEST(RigDescription, ErrorsNameTheField) {
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.status().message().find("broken.json: not valid JSON"), std::string::npos) << r.status().message();
   }
+  {
+    // A description nested past any real one's depth is refused as it is read.
+    auto r = parse_rig_description("{\"frame\": " + std::string(300000, '[') + std::string(300000, ']') + "}", "deep.json");
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.status().message().find("deep.json: not valid JSON, or nested more than 64"), std::string::npos)
+        << r.status().message();
+  }
   auto j = thesis_json();
   j["cameras"][1]["focal_mm"] = -4;
   EXPECT_NE(parse_error(j).find("rig.cameras[1]: 'focal_mm' must be positive"), std::string::npos) << parse_error(j);

@@ -183,6 +183,21 @@ TEST_F(ApiAccess, LoginSetsAStrictHttpOnlyCookieAndLogoutEndsIt) {
   EXPECT_EQ(http(port, "POST", "/api/login", {{"Content-Type", "text/plain"}}, "username=a").status, 415);
 }
 
+// A JSON body nested 400,000 deep (800 KB, under the 1 MiB limit) killed the
+// server where the value was copied (a share's "days", a saved measurement's
+// request): every body is refused at parse time past 64 levels, and the server
+// goes on.
+TEST_F(ApiAccess, DeeplyNestedJsonIsRefusedAndTheServerGoesOn) {
+  Client op = server_->as("op");
+  const std::string nest = std::string(400000, '[') + std::string(400000, ']');
+  const HttpReply r = op.post("/api/customers", R"({"name": )" + nest + "}");
+  EXPECT_EQ(r.status, 400) << r.body;
+  const HttpReply share = op.post("/api/scans/" + server_->scan_id + "/shares", R"({"days": )" + nest + "}");
+  EXPECT_EQ(share.status, 400) << share.body;
+  EXPECT_EQ(op.post("/api/customers", R"({"name": "After"})").status, 201);
+  EXPECT_EQ(http(server_->port, "GET", "/api/health").status, 200);
+}
+
 TEST_F(ApiAccess, StateChangingRequestsNeedTheCsrfTokenAndOurOrigin) {
   Client op = server_->as("op");
   Client no_token = op;
