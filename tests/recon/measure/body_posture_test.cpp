@@ -104,10 +104,11 @@ TEST_P(BodyPostureTest, AskForTheScanningPostureAndFlagWhatDependsOnIt) {
   for (const BodyMeasurement& m : low.measurements)
     EXPECT_EQ(m.outside_posture, !posture_parts(m.name).empty()) << m.name;
   EXPECT_TRUE(low.find("outer_arm_length_left")->outside_posture);
-  EXPECT_FALSE(low.find("waist_girth")->outside_posture);
+  EXPECT_FALSE(low.find("neck_girth")->outside_posture);
   EXPECT_EQ(low.find("outer_arm_length_left")->posture_assumed, "the left arm 35–50° from the vertical");
   EXPECT_EQ(low.find("hip_girth")->posture_assumed, "the ankles 300–450 mm apart");
-  EXPECT_EQ(low.find("waist_girth")->posture_assumed, "");
+  EXPECT_EQ(low.find("neck_girth")->posture_assumed, "");
+  EXPECT_EQ(low.find("waist_girth")->posture_assumed, "the arms 35–50° from the vertical, the ankles 300–450 mm apart");
 
   // In the posture: nothing flagged.
   const BodyMeasurements& within = posed(GetParam(), 42, 380).measured;
