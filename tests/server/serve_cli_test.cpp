@@ -52,6 +52,18 @@ int read_port(FILE* out, std::string* log) {
   return 0;
 }
 
+// Sends `sig` to the child, reads the rest of its output into *log and waits for
+// it to end: its wait status.
+int signal_and_wait(Child& child, int sig, std::string* log) {
+  if (kill(child.pid, sig) != 0) return -1;
+  char line[512];
+  while (std::fgets(line, sizeof line, child.out)) *log += line;
+  int status = 0;
+  if (waitpid(child.pid, &status, 0) != child.pid) return -1;
+  fclose(child.out);
+  return status;
+}
+
 TEST(ServeCli, SigtermMidScanCancelsTheScanAndStopsCleanly) {
   const std::string data = temp_dir();
   const std::string password = "a long test password";
@@ -75,12 +87,8 @@ TEST(ServeCli, SigtermMidScanCancelsTheScanAndStopsCleanly) {
     std::this_thread::sleep_for(100ms);
   }
   const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_EQ(kill(child.pid, SIGTERM), 0);
-  char line[512];
-  while (std::fgets(line, sizeof line, child.out)) log += line;
-  int status = 0;
-  ASSERT_EQ(waitpid(child.pid, &status, 0), child.pid);
-  fclose(child.out);
+  const int status = signal_and_wait(child, SIGTERM, &log);
+  ASSERT_NE(status, -1);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_TRUE(WIFEXITED(status)) << log;
   EXPECT_EQ(WEXITSTATUS(status), 0) << log;
@@ -106,12 +114,8 @@ TEST(ServeCli, HangupQuitAndUsr1StopInOrderLikeSigterm) {
     ASSERT_GT(child.pid, 0);
     std::string log;
     ASSERT_GT(read_port(child.out, &log), 0) << log;
-    ASSERT_EQ(kill(child.pid, sig), 0);
-    char line[512];
-    while (std::fgets(line, sizeof line, child.out)) log += line;
-    int status = 0;
-    ASSERT_EQ(waitpid(child.pid, &status, 0), child.pid);
-    fclose(child.out);
+    const int status = signal_and_wait(child, sig, &log);
+    ASSERT_NE(status, -1) << name;
     ASSERT_TRUE(WIFEXITED(status)) << name << ": " << log;
     EXPECT_EQ(WEXITSTATUS(status), 0) << name << ": " << log;
     EXPECT_NE(log.find(std::string(name) + ": stopping"), std::string::npos) << log;

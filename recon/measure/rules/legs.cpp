@@ -34,32 +34,41 @@ const Ring* leg_loop(const BodyCuts& cuts, const std::vector<Ring>& cut, Side si
   return l && parts_near(cut, *l, 0.06 * cuts.stature()) == 0 ? l : nullptr;
 }
 
-// The tape round the part of `ring` on `side` of the midline X = mid_x, in the
-// ring's plane: a tape round one of two thighs pressed together runs between them.
-std::optional<Girth> side_part(const Ring& ring, double mid_x, Side side) {
+// The tape round the points of `ring` on `side` of the midline X = mid_x (with
+// `measured_only`, those of mesh confidence 0.5 or more), in the ring's plane: a
+// tape round one of two thighs pressed together, or bridged by hole filling, runs
+// between them. Its min_confidence is the lowest on that side; loop_length_mm
+// counts the edges between kept points. Nothing with fewer than three.
+std::optional<Girth> side_tape(const Ring& ring, double mid_x, Side side, bool measured_only) {
+  const size_t n = ring.points.size();
+  if (n < 3) return std::nullopt;
   const double s = sign(side);
-  const double y = ring.points.empty() ? 0 : ring.points.front().y();
+  const double y = ring.points.front().y();
+  const auto on_side = [&](size_t i) { return s * (ring.points[i].x() - mid_x) > 0; };
+  const auto confidence = [&](size_t i) { return i < ring.confidence.size() ? ring.confidence[i] : 1.0f; };
+  const auto kept = [&](size_t i) { return on_side(i) && (!measured_only || confidence(i) >= kMeasuredConfidence); };
   Girth g;
   g.plane = Plane{Eigen::Vector3d(0, y, 0), Eigen::Vector3d::UnitY()};
   g.loops_cut = 1;
   std::vector<Eigen::Vector2d> flat;
-  for (size_t i = 0; i < ring.points.size(); ++i) {
-    if (s * (ring.points[i].x() - mid_x) <= 0) continue;
-    if (i < ring.confidence.size()) g.min_confidence = std::min(g.min_confidence, ring.confidence[i]);
+  for (size_t i = 0; i < n; ++i) {
+    if (!on_side(i)) continue;
+    g.min_confidence = std::min(g.min_confidence, confidence(i));
+    if (!kept(i)) continue;
+    if (kept((i + 1) % n)) g.loop_length_mm += (ring.points[(i + 1) % n] - ring.points[i]).norm();
     g.loop.push_back(ring.points[i]);
     flat.emplace_back(ring.points[i].x(), ring.points[i].z());
   }
   const std::vector<Eigen::Vector2d> hull = convex_hull(std::move(flat));
   if (hull.size() < 3) return std::nullopt;
   g.value_mm = closed_length(hull);
-  g.loop_length_mm = closed_length(g.loop);
   for (const Eigen::Vector2d& q : hull) g.tape.emplace_back(q.x(), y, q.y());
   return g;
 }
 
 // The thigh's tape at a level below the crotch where a loop spans the midline:
 // hole filling bridges the gap between the thighs (bridged_part, round the leg's
-// measured skin), or the thighs press together (side_part). Of the loops spanning
+// measured skin), or the thighs press together (side_tape). Of the loops spanning
 // the midline, this side's own where each leg's loop crosses it (skinned legs
 // pass through each other), else the longest (one loop round both). Nothing
 // unless the tape is a leg's (6 % of the stature round).
@@ -76,7 +85,7 @@ std::optional<Girth> bridged_leg(const BodyCuts& cuts, double crotch_y, double y
   }
   if (!m) return std::nullopt;
   std::optional<Girth> g = bridged_part(*m, mid_x, side);
-  if (!g) g = side_part(*m, mid_x, side);
+  if (!g) g = side_tape(*m, mid_x, side, false);
   if (!g || g->value_mm < 0.06 * cuts.stature()) return std::nullopt;
   g->loops_cut = cut.size();
   return g;
@@ -221,29 +230,9 @@ double knee_reading_level(double own_y, std::optional<double> other_y) {
 }
 
 std::optional<Girth> bridged_part(const Ring& ring, double mid_x, Side side) {
-  const size_t n = ring.points.size();
-  if (n < 3 || ring.confidence.size() != n || ring.crossing_confidence(mid_x) >= kMeasuredConfidence)
+  if (ring.confidence.size() != ring.points.size() || ring.crossing_confidence(mid_x) >= kMeasuredConfidence)
     return std::nullopt;
-  const double s = sign(side);
-  const double y = ring.points.front().y();
-  Girth g;
-  g.plane = Plane{Eigen::Vector3d(0, y, 0), Eigen::Vector3d::UnitY()};
-  g.loops_cut = 1;
-  std::vector<Eigen::Vector2d> flat;
-  auto kept = [&](size_t i) { return s * (ring.points[i].x() - mid_x) > 0 && ring.confidence[i] >= kMeasuredConfidence; };
-  for (size_t i = 0; i < n; ++i) {
-    if (s * (ring.points[i].x() - mid_x) <= 0) continue;
-    g.min_confidence = std::min(g.min_confidence, ring.confidence[i]);
-    if (!kept(i)) continue;
-    if (kept((i + 1) % n)) g.loop_length_mm += (ring.points[(i + 1) % n] - ring.points[i]).norm();
-    g.loop.push_back(ring.points[i]);
-    flat.emplace_back(ring.points[i].x(), ring.points[i].z());
-  }
-  const std::vector<Eigen::Vector2d> hull = convex_hull(std::move(flat));
-  if (hull.size() < 3) return std::nullopt;
-  g.value_mm = closed_length(hull);
-  for (const Eigen::Vector2d& q : hull) g.tape.emplace_back(q.x(), y, q.y());
-  return g;
+  return side_tape(ring, mid_x, side, true);
 }
 
 }  // namespace bodyscan::rules
