@@ -319,6 +319,12 @@ ControllerDescription read_controller(const Reader& r, const std::vector<LaserDe
   }
   c.lasers.assign(lasers.size(), {});
   if (c.backend == "sim") return c;
+  // Real lasers point at people: when the process dies in a way no handler sees
+  // (SIGKILL, a hung machine, the USB cable pulled), the board's watchdog is what
+  // switches them off (docs/hardware.md).
+  if (c.watchdog_ms == 0 && !lasers.empty())
+    r.fail("watchdog_ms 0 (none) is refused for a board that switches lasers: its watchdog switches them off "
+           "when the workstation dies unseen");
   std::set<int> outputs, axes;
   auto output = [&](const Reader& at, int o, const std::string& what) {
     if (o < 0) return;

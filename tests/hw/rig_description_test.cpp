@@ -255,6 +255,10 @@ TEST(RigDescription, ControllerWiringMistakesAreNamed) {
   j["controller"]["lasers"]["back-right"]["axis"] = 0;
   EXPECT_NE(parse_error(j).find("axis 0 turns two lasers"), std::string::npos) << parse_error(j);
   j["controller"]["lasers"]["back-right"]["axis"] = 3;
+  j["controller"]["watchdog_ms"] = 0;
+  EXPECT_NE(parse_error(j).find("watchdog_ms 0 (none) is refused for a board that switches lasers"), std::string::npos)
+      << parse_error(j);
+  j["controller"]["watchdog_ms"] = 500;
   j["controller"]["usb"] = {{"vendor", "xyz"}};
   EXPECT_NE(parse_error(j).find("4 hex digits"), std::string::npos) << parse_error(j);
   j["controller"].erase("usb");
