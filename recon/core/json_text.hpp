@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
+#include <string>
 #include <string_view>
 
 namespace bodyscan {
@@ -30,6 +32,17 @@ inline nlohmann::json parse_json(std::string_view text, int max_depth = kMaxJson
   } catch (const TooDeep&) {
     return nlohmann::json(nlohmann::json::value_t::discarded);
   }
+}
+
+// A string member of `object`: its value, `fallback` when absent or null, nullopt
+// when present with another type (a client's mistake to answer with 400, where
+// nlohmann's value() would throw).
+inline std::optional<std::string> string_field(const nlohmann::json& object, const char* key,
+                                               std::string fallback = {}) {
+  const auto it = object.find(key);
+  if (it == object.end() || it->is_null()) return fallback;
+  if (!it->is_string()) return std::nullopt;
+  return it->get<std::string>();
 }
 
 }  // namespace bodyscan

@@ -1,4 +1,5 @@
 // Logging in and out, the session, and the staff accounts (admins).
+#include "recon/core/json_text.hpp"
 #include "server/api/api.hpp"
 
 namespace bodyscan::server {
@@ -71,7 +72,8 @@ void add_account_routes(std::vector<Api::Route>* routes, const ApiOptions& optio
                        HttpResponse error;
                        auto body = json_body(call, &error);
                        if (!body) return error;
-                       const auto role = role_from_string(body->value("role", ""));
+                       const auto role_name = string_field(*body, "role");
+                       const auto role = role_name ? role_from_string(*role_name) : std::nullopt;
                        if (!(*body)["username"].is_string() || !(*body)["password"].is_string() || !role)
                          return error_response(400, "give 'username', 'password' and 'role' (operator, tailor, admin)");
                        auto a = ws.auth().add_account((*body)["username"], (*body)["password"], *role);
@@ -85,7 +87,8 @@ void add_account_routes(std::vector<Api::Route>* routes, const ApiOptions& optio
                        if (!body) return error;
                        const std::string& name = call.params.at("username");
                        if (body->contains("role")) {
-                         const auto role = role_from_string(body->value("role", ""));
+                         const auto role_name = string_field(*body, "role");
+                         const auto role = role_name ? role_from_string(*role_name) : std::nullopt;
                          if (!role) return error_response(400, "'role' is operator, tailor or admin");
                          const Status s = ws.auth().set_role(name, *role);
                          if (!s.ok()) return error_response(s);

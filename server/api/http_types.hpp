@@ -63,7 +63,8 @@ HttpResponse error_response(int status, const std::string& message);
 int http_status(const Status& s);
 HttpResponse error_response(const Status& s);
 
-// "%41b+c" -> "Ab c" (with plus_is_space); nullopt for a malformed escape or a NUL.
+// "%41b+c" -> "Ab c" (with plus_is_space); nullopt for a malformed escape, a NUL,
+// or a result that is not well-formed UTF-8.
 std::optional<std::string> percent_decode(std::string_view text, bool plus_is_space);
 // Splits a target into its decoded path and query; false when malformed.
 bool parse_target(const std::string& target, std::string* path, std::map<std::string, std::string>* query);

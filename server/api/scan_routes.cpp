@@ -280,9 +280,12 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                        auto body = json_body(call, &error);
                        if (!body) return error;
                        const std::string& id = call.params.at("id");
-                       const std::string name = body->value("name", "");
-                       if (name.empty() || name.size() > 100)
+                       const std::optional<std::string> name = string_field(*body, "name");
+                       if (!name || name->empty() || name->size() > 100)
                          return error_response(400, "give the measurement a 'name' (up to 100 characters)");
+                       const std::optional<std::string> label = string_field(*body, "label", *name);
+                       if (!label || label->size() > 200)
+                         return error_response(400, "'label' is the name shown on the sheet (up to 200 characters)");
                        if (!(*body)["request"].is_object())
                          return error_response(400, "'request' is the measurement to take (as for /measure)");
                        auto r = ws.archive().scan(id);
@@ -296,8 +299,8 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                        rec.scan_id = id;
                        rec.version = r->current_version;
                        rec.source = "user";
-                       rec.name = name;
-                       rec.label = body->value("label", name);
+                       rec.name = *name;
+                       rec.label = *label;
                        rec.kind = (*m)["kind"];
                        rec.value_mm = (*m)["value_mm"];
                        rec.geometry = *m;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "recon/core/json_text.hpp"
 #include "recon/measure/girth.hpp"
 #include "recon/measure/surface_path.hpp"
 #include "server/pipeline/measurements_json.hpp"
@@ -57,7 +58,9 @@ StatusOr<Plane> request_plane(const nlohmann::json& request) {
 
 StatusOr<nlohmann::json> evaluate_measurement(const TriangleMesh& mesh, const nlohmann::json& request) {
   if (!request.is_object()) return invalid_argument("the measurement request must be a JSON object");
-  const std::string kind = request.value("kind", "");
+  const std::optional<std::string> kind_field = string_field(request, "kind");
+  if (!kind_field) return invalid_argument("'kind' is the kind of measurement, a string");
+  const std::string& kind = *kind_field;
   if (kind == "distance") {
     ASSIGN_OR_RETURN(Eigen::Vector3d a, vec3(request, "from"));
     ASSIGN_OR_RETURN(Eigen::Vector3d b, vec3(request, "to"));

@@ -46,6 +46,30 @@ TEST_F(HttpLimits, MalformedRequestsGetClearErrors) {
   EXPECT_FALSE(e["error"]["message"].get<std::string>().empty());
 }
 
+TEST_F(HttpLimits, WrongTypesBadEncodingsAndConflictingLengthsAre400) {
+  const int port = server_->port;
+  // A percent-encoding that decodes to bytes which are not UTF-8.
+  EXPECT_EQ(status_of(raw(port, "GET /api/jobs/%ff HTTP/1.1\r\nHost: x\r\n\r\n")), 400);
+  EXPECT_EQ(status_of(raw(port, "GET /api/health?x=%c3%28 HTTP/1.1\r\nHost: x\r\n\r\n")), 400);
+  EXPECT_EQ(server_->as("op").request("GET", "/api/jobs/%ff", "").status, 400);
+  // Two Content-Length headers that disagree: answered, not dropped.
+  EXPECT_EQ(status_of(raw(port, "POST /api/login HTTP/1.1\r\nHost: x\r\nContent-Length: 2\r\n"
+                                "Content-Length: 3\r\n\r\n{}")),
+            400);
+  // Fields of the wrong JSON type.
+  Client admin = server_->as("admin");
+  EXPECT_EQ(admin.request("POST", "/api/accounts", R"({"username": "zed", "password": "long enough pw", "role": 5})").status,
+            400);
+  EXPECT_EQ(admin.request("PUT", "/api/accounts/op", R"({"role": ["admin"]})").status, 400);
+  Client tailor = server_->as("tailor");
+  const std::string scan = "/api/scans/" + server_->scan_id;
+  EXPECT_EQ(tailor.request("POST", scan + "/measure", R"({"kind": 7})").status, 400);
+  EXPECT_EQ(tailor.request("POST", scan + "/measurements", R"({"name": 3, "request": {}})").status, 400);
+  EXPECT_EQ(tailor.request("POST", scan + "/measurements", R"({"name": "a", "label": {}, "request": {}})").status, 400);
+  EXPECT_EQ(tailor.request("POST", "/api/login", R"({"username": 1, "password": 2})").status, 400);
+  EXPECT_EQ(http(port, "GET", "/api/health").status, 200);
+}
+
 TEST_F(HttpLimits, OversizedRequestsAreRefused) {
   const int port = server_->port;
   Client t = server_->as("tailor");
