@@ -62,7 +62,10 @@ void usage(FILE* out) {
       "                     password comes from BODYSCAN_ADMIN_PASSWORD, or one is made\n"
       "                     up, printed once and kept in DATA/first-admin-password\n"
       "                     (mode 0600) until changed\n"
-      "  --workers N        threads for requests' work (default 3)\n",
+      "  --workers N        threads for requests' work (default 3)\n"
+      "  --max-connections N\n"
+      "                     open HTTP and WebSocket connections at most; more are\n"
+      "                     answered 503 (default: the descriptor limit less 128)\n",
       kSubjectOptionsHelp);
 }
 
@@ -138,6 +141,10 @@ int run_serve(int argc, char** argv) {
       auto n = number(1, 64);
       if (!n) return 2;
       no.workers = *n;
+    } else if (a == "--max-connections") {
+      auto n = number(1, 1000000);
+      if (!n) return 2;
+      no.max_connections = static_cast<size_t>(*n);
     } else {
       std::fprintf(stderr, "bodyscan serve: unknown option '%s'\n", a.c_str());
       usage(stderr);

@@ -7,6 +7,7 @@
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/ssl.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/asio/thread_pool.hpp>
@@ -15,12 +16,16 @@
 #include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <deque>
 #include <mutex>
 #include <set>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace bodyscan::server {
@@ -60,8 +65,25 @@ struct Shared {
   std::mutex mutex;
   std::set<std::weak_ptr<EventSessionBase>, std::owner_less<std::weak_ptr<EventSessionBase>>> event_sessions;
   bool stopping = false;
+  std::atomic<size_t> connections{0};
+  size_t max_connections = 0;
 
   Shared(Api& a, Workstation& w, const NetOptions& o) : api(a), ws(w), options(o), workers(std::max(1, o.workers)) {}
+};
+
+// One open connection counted against NetOptions::max_connections, for as long
+// as its HTTP session, then its WebSocket session, lives.
+class ConnectionSlot {
+ public:
+  explicit ConnectionSlot(Shared& shared) : shared_(&shared) { shared_->connections.fetch_add(1); }
+  ConnectionSlot(ConnectionSlot&& o) noexcept : shared_(std::exchange(o.shared_, nullptr)) {}
+  ConnectionSlot& operator=(ConnectionSlot&&) = delete;
+  ~ConnectionSlot() {
+    if (shared_) shared_->connections.fetch_sub(1);
+  }
+
+ private:
+  Shared* shared_;
 };
 
 namespace {
@@ -116,7 +138,8 @@ bool is_preview(const std::string& event) { return event.find("\"type\":\"previe
 template <class Stream>
 class EventSession : public EventSessionBase, public std::enable_shared_from_this<EventSession<Stream>> {
  public:
-  EventSession(Stream&& stream, Shared& shared) : ws_(std::move(stream)), shared_(shared) {}
+  EventSession(Stream&& stream, Shared& shared, ConnectionSlot slot)
+      : ws_(std::move(stream)), shared_(shared), slot_(std::move(slot)) {}
   ~EventSession() override {
     if (sink_) shared_.ws.unsubscribe(sink_);
   }
@@ -200,6 +223,7 @@ class EventSession : public EventSessionBase, public std::enable_shared_from_thi
 
   websocket::stream<Stream> ws_;
   Shared& shared_;
+  ConnectionSlot slot_;
   beast::flat_buffer buffer_;
   std::deque<std::shared_ptr<const std::string>> queue_;
   std::string hello_;
@@ -213,8 +237,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
 
  public:
   template <class... Args>
-  HttpSession(Shared& shared, std::string remote, Args&&... args)
-      : stream_(std::forward<Args>(args)...), shared_(shared), remote_(std::move(remote)) {}
+  HttpSession(Shared& shared, ConnectionSlot slot, std::string remote, Args&&... args)
+      : stream_(std::forward<Args>(args)...), shared_(shared), slot_(std::move(slot)), remote_(std::move(remote)) {}
 
   void run() { asio::dispatch(stream_.get_executor(), beast::bind_front_handler(&HttpSession::on_run, this->shared_from_this())); }
 
@@ -268,7 +292,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
                                                   hello = std::move(hello)]() mutable {
           if (refused) return self->send(make_message(std::move(*refused), req.version(), false, false), false);
           self->tcp().expires_never();
-          auto session = std::make_shared<EventSession<Stream>>(std::move(self->stream_), self->shared_);
+          auto session = std::make_shared<EventSession<Stream>>(std::move(self->stream_), self->shared_,
+                                                                std::move(self->slot_));
           session->run(std::move(req), std::move(hello));
         });
       });
@@ -340,6 +365,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
 
   Stream stream_;
   Shared& shared_;
+  ConnectionSlot slot_;
   std::string remote_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
@@ -348,10 +374,22 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   size_t drained_ = 0;
 };
 
+// What a connection past the cap is told before it is closed; written without
+// waiting (a client that does not read it just gets the close).
+constexpr std::string_view kBusyReply =
+    "HTTP/1.1 503 Service Unavailable\r\nServer: bodyscan\r\nContent-Type: application/json\r\n"
+    "Retry-After: 5\r\nConnection: close\r\nContent-Length: 82\r\n\r\n"
+    "{\"error\":{\"status\":503,\"message\":\"the workstation has too many open connections\"}}";
+static_assert(kBusyReply.size() - kBusyReply.find("\r\n\r\n") - 4 == 82);
+
 struct HttpServer::Impl {
   asio::io_context ioc;
   std::optional<ssl::context> tls;
   tcp::acceptor acceptor{ioc};
+  asio::steady_timer accept_retry{ioc};
+  std::chrono::milliseconds accept_delay{0};
+  std::chrono::steady_clock::time_point accept_error_logged{};
+  size_t accept_errors_unlogged = 0;
   std::unique_ptr<Shared> shared;
   std::vector<std::thread> threads;
   uint16_t port = 0;
@@ -360,26 +398,67 @@ struct HttpServer::Impl {
   void do_accept() {
     acceptor.async_accept(asio::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
       if (ec) {
-        if (ec != asio::error::operation_aborted) fail(ec, "accept");
-        if (!acceptor.is_open()) return;
-      } else {
-        beast::error_code e2;
-        // Responses go out in several writes (headers, file chunks): without
-        // this, Nagle holds the last one for the client's delayed ACK (40 ms).
-        socket.set_option(tcp::no_delay(true), e2);
-        const auto ep = socket.remote_endpoint(e2);
-        std::string remote = e2 ? "?" : ep.address().to_string();
-        if (tls)
-          std::make_shared<HttpSession<beast::ssl_stream<beast::tcp_stream>>>(*shared, std::move(remote),
-                                                                               std::move(socket), *tls)
-              ->run();
-        else
-          std::make_shared<HttpSession<beast::tcp_stream>>(*shared, std::move(remote), std::move(socket))->run();
+        if (!acceptor.is_open() || ec == asio::error::operation_aborted) return;
+        return on_accept_error(ec);
       }
+      accept_delay = std::chrono::milliseconds(0);
+      if (shared->connections.load() >= shared->max_connections) {
+        beast::error_code e2;
+        socket.non_blocking(true, e2);
+        socket.write_some(asio::buffer(kBusyReply.data(), kBusyReply.size()), e2);
+        socket.shutdown(tcp::socket::shutdown_both, e2);
+        socket.close(e2);
+        return do_accept();
+      }
+      beast::error_code e2;
+      // Responses go out in several writes (headers, file chunks): without
+      // this, Nagle holds the last one for the client's delayed ACK (40 ms).
+      socket.set_option(tcp::no_delay(true), e2);
+      const auto ep = socket.remote_endpoint(e2);
+      std::string remote = e2 ? "?" : ep.address().to_string();
+      ConnectionSlot slot(*shared);
+      if (tls)
+        std::make_shared<HttpSession<beast::ssl_stream<beast::tcp_stream>>>(*shared, std::move(slot), std::move(remote),
+                                                                             std::move(socket), *tls)
+            ->run();
+      else
+        std::make_shared<HttpSession<beast::tcp_stream>>(*shared, std::move(slot), std::move(remote), std::move(socket))
+            ->run();
       do_accept();
     });
   }
+
+  // Out of descriptors (or memory) the same accept fails at once, again and
+  // again: wait before the next, and keep the log to a line per 10 s.
+  void on_accept_error(beast::error_code ec) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - accept_error_logged >= std::chrono::seconds(10)) {
+      std::fprintf(stderr, "bodyscan serve: accept: %s (%zu more since the last report); %zu connections open\n",
+                   ec.message().c_str(), accept_errors_unlogged, shared->connections.load());
+      accept_error_logged = now;
+      accept_errors_unlogged = 0;
+    } else {
+      ++accept_errors_unlogged;
+    }
+    accept_delay = std::clamp(accept_delay * 2, std::chrono::milliseconds(10), std::chrono::milliseconds(1000));
+    accept_retry.expires_after(accept_delay);
+    accept_retry.async_wait([this](beast::error_code wait_ec) {
+      if (!wait_ec && acceptor.is_open()) do_accept();
+    });
+  }
 };
+
+namespace {
+
+size_t connection_cap(size_t configured) {
+  if (configured > 0) return configured;
+  rlimit limit{};
+  if (getrlimit(RLIMIT_NOFILE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return 4096;
+  const size_t descriptors = static_cast<size_t>(limit.rlim_cur);
+  return descriptors > 2 * kReservedDescriptors ? descriptors - kReservedDescriptors : descriptors / 2;
+}
+
+}  // namespace
 
 HttpServer::HttpServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 HttpServer::~HttpServer() { stop(); }
@@ -411,6 +490,7 @@ StatusOr<std::unique_ptr<HttpServer>> HttpServer::start(Api& api, Workstation& w
     return unavailable("cannot listen on " + options.address + ":" + std::to_string(options.port) + ": " + ec.message());
   impl->port = impl->acceptor.local_endpoint().port();
   impl->shared = std::make_unique<Shared>(api, ws, options);
+  impl->shared->max_connections = connection_cap(options.max_connections);
   impl->do_accept();
   for (int i = 0; i < std::max(1, options.io_threads); ++i) impl->threads.emplace_back([io = &impl->ioc]() { io->run(); });
   return std::unique_ptr<HttpServer>(new HttpServer(std::move(impl)));
@@ -426,6 +506,7 @@ void HttpServer::stop() {
   asio::post(s.ioc, [&s]() {
     beast::error_code ec;
     s.acceptor.close(ec);
+    s.accept_retry.cancel();
   });
   std::vector<std::shared_ptr<EventSessionBase>> live;
   {

@@ -4,6 +4,9 @@
 // WebSocket session has its own write queue, bounded: a slow client loses camera
 // previews first and is dropped if it falls further behind, never slowing others.
 //
+// Running out of descriptors does not spin: an accept that fails waits (10 ms,
+// doubling to 1 s) before the next, and says so in the log at most every 10 s.
+//
 // Only this module's .cpp includes Beast (the heavy headers stay in one place).
 #pragma once
 
@@ -29,7 +32,13 @@ struct NetOptions {
   std::chrono::seconds timeout{30};  // to read a request, or write a response, or a TLS handshake
   size_t ws_queue_limit = 256;       // queued events before a WebSocket client is dropped
   size_t ws_preview_limit = 8;       // queued events past which camera previews are skipped
+  // Open connections (HTTP and WebSocket) at most; one more is answered 503 and
+  // closed. 0: the process's descriptor limit (RLIMIT_NOFILE) less
+  // kReservedDescriptors for the archive, the rig and the logs.
+  size_t max_connections = 0;
 };
+
+inline constexpr size_t kReservedDescriptors = 128;
 
 class HttpServer {
  public:

@@ -214,5 +214,33 @@ TEST(HttpsServer, ServesTlsWithSecureCookies) {
   EXPECT_NE(refused.status().message().find("certificate"), std::string::npos) << refused.status().message();
 }
 
+// Past NetOptions::max_connections a new connection is told 503 and closed; a
+// slot frees when its connection closes.
+TEST(HttpConnectionCap, ConnectionsPastTheCapAre503UntilOneCloses) {
+  server::NetOptions net;
+  net.max_connections = 3;
+  ServerUnderTest s(12, net);
+  std::vector<std::unique_ptr<Connection>> held;
+  for (int i = 0; i < 3; ++i) {
+    held.push_back(Connection::open(s.port));
+    ASSERT_TRUE(held.back());
+    held.back()->send_all("GET /api/health HTTP/1.1\r\nHost: x\r\n\r\n");
+    ASSERT_EQ(held.back()->read_reply(5s).status, 200);  // accepted, and kept alive
+  }
+  const HttpReply busy = http(s.port, "GET", "/api/health");
+  EXPECT_EQ(busy.status, 503);
+  EXPECT_EQ(busy.header("retry-after"), "5");
+  EXPECT_EQ(parse(busy)["error"]["status"], 503);
+  held.front()->send_all("GET /api/health HTTP/1.1\r\nHost: x\r\n\r\n");
+  EXPECT_EQ(held.front()->read_reply(5s).status, 200) << "the connections already open are served";
+  held.pop_back();
+  int status = 0;
+  for (int attempt = 0; attempt < 50 && status != 200; ++attempt) {
+    status = http(s.port, "GET", "/api/health").status;
+    if (status != 200) std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(status, 200);
+}
+
 }  // namespace
 }  // namespace bodyscan::testing

@@ -3,12 +3,14 @@
 // cancelled with the reason, and the next start must find the archive whole.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "storage/archive/archive.hpp"
 #include "tests/server/http_client.hpp"
@@ -24,16 +26,33 @@ struct Child {
   FILE* out = nullptr;
 };
 
-Child start_serve(const std::string& data, const std::string& password) {
+// How the child starts besides its data folder and admin password.
+struct ServeStart {
+  std::vector<std::string> extra_args;
+  rlim_t descriptor_limit = 0;  // RLIMIT_NOFILE for the child; 0: inherited
+  bool stderr_to_log = false;   // its stderr into the same pipe as its stdout
+};
+
+Child start_serve(const std::string& data, const std::string& password, const ServeStart& how = {}) {
   int fds[2];
   if (pipe(fds) != 0) return {};
+  std::vector<std::string> args = {BODYSCAN_BIN, "serve", "--data", data, "--port", "0", "--address", "127.0.0.1",
+                                   "--every", "4"};
+  args.insert(args.end(), how.extra_args.begin(), how.extra_args.end());
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
     dup2(fds[1], STDOUT_FILENO);
+    if (how.stderr_to_log) dup2(fds[1], STDERR_FILENO);
     close(fds[0]);
+    if (how.descriptor_limit > 0) {
+      const rlimit limit{how.descriptor_limit, how.descriptor_limit};
+      if (setrlimit(RLIMIT_NOFILE, &limit) != 0) _exit(126);
+    }
     setenv("BODYSCAN_ADMIN_PASSWORD", password.c_str(), 1);
-    execl(BODYSCAN_BIN, BODYSCAN_BIN, "serve", "--data", data.c_str(), "--port", "0", "--address", "127.0.0.1",
-          "--every", "4", static_cast<char*>(nullptr));
+    execv(BODYSCAN_BIN, argv.data());
     _exit(127);
   }
   close(fds[1]);
@@ -121,6 +140,43 @@ TEST(ServeCli, HangupQuitAndUsr1StopInOrderLikeSigterm) {
     EXPECT_NE(log.find(std::string(name) + ": stopping"), std::string::npos) << log;
     EXPECT_NE(log.find("stopped cleanly"), std::string::npos) << log;
   }
+}
+
+// A server out of descriptors (clients hold every one the process may open)
+// waits before accepting again rather than spinning, keeps its log short, and
+// serves again once the clients go.
+TEST(ServeCli, RunningOutOfDescriptorsBacksOffAndRecovers) {
+  const std::string data = temp_dir();
+  ServeStart how;
+  how.extra_args = {"--max-connections", "100000"};  // past the limit: the accept itself fails
+  how.descriptor_limit = 96;
+  how.stderr_to_log = true;
+  Child child = start_serve(data, "a long test password", how);
+  ASSERT_GT(child.pid, 0);
+  std::string log;
+  const int port = read_port(child.out, &log);
+  ASSERT_GT(port, 0) << log;
+  std::vector<std::unique_ptr<Connection>> flood;
+  for (int i = 0; i < 200; ++i) {
+    auto c = Connection::open(port);
+    if (c) flood.push_back(std::move(c));
+  }
+  ASSERT_GT(flood.size(), 96u) << "the kernel queues connections the server cannot take";
+  std::this_thread::sleep_for(3s);
+  flood.clear();
+  // Served again: the backoff is at most a second.
+  int status = 0;
+  for (int attempt = 0; attempt < 50 && status != 200; ++attempt) {
+    status = http(port, "GET", "/api/health").status;
+    if (status != 200) std::this_thread::sleep_for(200ms);
+  }
+  EXPECT_EQ(status, 200);
+  const int exit_status = signal_and_wait(child, SIGTERM, &log);
+  ASSERT_TRUE(WIFEXITED(exit_status)) << log;
+  size_t accept_lines = 0;
+  for (size_t at = log.find("accept:"); at != std::string::npos; at = log.find("accept:", at + 1)) ++accept_lines;
+  EXPECT_GE(accept_lines, 1u) << log;
+  EXPECT_LE(accept_lines, 2u) << "at most a line per 10 s: " << log.substr(0, 4000);
 }
 
 }  // namespace
