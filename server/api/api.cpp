@@ -115,10 +115,11 @@ Api::Api(Workstation& ws, ApiOptions options) : ws_(ws), options_(std::move(opti
   add_share_routes(&routes_, options_);
 }
 
-std::optional<HttpResponse> Api::refuse_events(const HttpRequest& request) {
-  const std::optional<Session> s = ws_.auth().session(session_cookie(request));
+std::optional<HttpResponse> Api::refuse_events(const HttpRequest& request, Session* session) {
+  std::optional<Session> s = ws_.auth().session(session_cookie(request));
   if (!s) return error_response(401, "log in to follow the rig's events");
   if (foreign_origin(request)) return error_response(403, "the events are for this workstation's own pages");
+  *session = std::move(*s);
   return std::nullopt;
 }
 

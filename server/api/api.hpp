@@ -58,8 +58,9 @@ class Api {
   Api(Workstation& ws, ApiOptions options);
 
   HttpResponse handle(const HttpRequest& request);
-  // The WebSocket upgrade at /api/events: staff only. Ok, or the error response.
-  std::optional<HttpResponse> refuse_events(const HttpRequest& request);
+  // The WebSocket upgrade at /api/events: staff only. Nullopt with *session set
+  // (the caller's, not refreshed beyond this request), or the error response.
+  std::optional<HttpResponse> refuse_events(const HttpRequest& request, Session* session);
 
   const std::vector<Route>& routes() const { return routes_; }
   const ApiOptions& options() const { return options_; }

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <ctime>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <unordered_map>
 
@@ -250,6 +251,9 @@ struct AuthStore::Impl {
   AuthOptions options;
   std::string dummy_hash;  // what unknown users are verified against
   Limiter limiter;
+  std::mutex watch_mu;
+  std::map<int, std::function<void(const SessionChange&)>> watchers;
+  int next_watcher = 1;
 
   Impl(Database d, AuthOptions o)
       : db(std::move(d)),
@@ -376,7 +380,16 @@ struct AuthStore::Impl {
     return std::optional<LoginResult>(std::move(r));
   }
 
-  StatusOr<std::optional<Session>> find_session(const std::string& hash, int64_t now) {
+  void notify(const SessionChange& change) {
+    std::vector<std::function<void(const SessionChange&)>> fns;
+    {
+      std::lock_guard lock(watch_mu);
+      for (const auto& [id, fn] : watchers) fns.push_back(fn);
+    }
+    for (const auto& fn : fns) fn(change);
+  }
+
+  StatusOr<std::optional<Session>> find_session(const std::string& hash, int64_t now, bool refresh) {
     ASSIGN_OR_RETURN(Statement st,
                      db.prepare("SELECT s.token_hash, s.csrf_token, s.last_used, s.expires_at, "
                                 "a.username, a.role FROM sessions s JOIN accounts a "
@@ -396,7 +409,7 @@ struct AuthStore::Impl {
     s.role = *role;
     s.csrf_token = st.text(1);
     int64_t used = last_used;
-    if (now - last_used >= kTouchEvery) {
+    if (refresh && now - last_used >= kTouchEvery) {
       ASSIGN_OR_RETURN(Statement touch,
                        db.prepare("UPDATE sessions SET last_used = ? WHERE token_hash = ?"));
       // The session is valid either way; a failed refresh only shortens it.
@@ -479,58 +492,76 @@ StatusOr<Account> AuthStore::add_account(const std::string& username, const std:
 
 Status AuthStore::set_password(const std::string& username, const std::string& password) {
   RETURN_IF_ERROR(check_password(password));
+  std::string stored_name;
   {
     std::lock_guard lock(impl_->mu);
     ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
     if (!existing) return not_found("no account named '" + username + "'");
+    stored_name = existing->username;
   }
   ASSIGN_OR_RETURN(std::string hash, impl_->hash_password(password));
-  std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
-  ASSIGN_OR_RETURN(Statement st,
-                   impl_->db.prepare("UPDATE accounts SET password_hash = ? WHERE username = ?"));
-  RETURN_IF_ERROR(st.bind(1, hash).bind(2, username).run());
-  if (sqlite3_changes(impl_->db.handle()) == 0)
-    return not_found("no account named '" + username + "'");
-  RETURN_IF_ERROR(impl_->delete_sessions_of(username));
-  return tx.commit();
+  {
+    std::lock_guard lock(impl_->mu);
+    ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+    ASSIGN_OR_RETURN(Statement st,
+                     impl_->db.prepare("UPDATE accounts SET password_hash = ? WHERE username = ?"));
+    RETURN_IF_ERROR(st.bind(1, hash).bind(2, username).run());
+    if (sqlite3_changes(impl_->db.handle()) == 0)
+      return not_found("no account named '" + username + "'");
+    RETURN_IF_ERROR(impl_->delete_sessions_of(username));
+    RETURN_IF_ERROR(tx.commit());
+  }
+  impl_->notify({stored_name, ""});
+  return Status::Ok();
 }
 
 Status AuthStore::set_role(const std::string& username, Role role) {
-  std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
-  ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
-  if (!existing) return not_found("no account named '" + username + "'");
-  if (existing->role == role) return Status::Ok();
-  if (existing->role == Role::kAdmin) {
-    ASSIGN_OR_RETURN(int64_t admins, impl_->admin_count());
-    if (admins <= 1)
-      return failed_precondition("'" + existing->username +
-                                 "' is the last admin; make another admin first");
+  std::string stored_name;
+  {
+    std::lock_guard lock(impl_->mu);
+    ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+    ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
+    if (!existing) return not_found("no account named '" + username + "'");
+    if (existing->role == role) return Status::Ok();
+    if (existing->role == Role::kAdmin) {
+      ASSIGN_OR_RETURN(int64_t admins, impl_->admin_count());
+      if (admins <= 1)
+        return failed_precondition("'" + existing->username +
+                                   "' is the last admin; make another admin first");
+    }
+    ASSIGN_OR_RETURN(Statement st,
+                     impl_->db.prepare("UPDATE accounts SET role = ? WHERE username = ?"));
+    RETURN_IF_ERROR(st.bind(1, to_string(role)).bind(2, username).run());
+    RETURN_IF_ERROR(tx.commit());
+    stored_name = existing->username;
   }
-  ASSIGN_OR_RETURN(Statement st,
-                   impl_->db.prepare("UPDATE accounts SET role = ? WHERE username = ?"));
-  RETURN_IF_ERROR(st.bind(1, to_string(role)).bind(2, username).run());
-  return tx.commit();
+  impl_->notify({stored_name, ""});
+  return Status::Ok();
 }
 
 Status AuthStore::delete_account(const std::string& username) {
-  std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
-  ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
-  if (!existing) return not_found("no account named '" + username + "'");
-  if (existing->role == Role::kAdmin) {
-    ASSIGN_OR_RETURN(int64_t admins, impl_->admin_count());
-    if (admins <= 1)
-      return failed_precondition("'" + existing->username +
-                                 "' is the last admin; make another admin first");
+  std::string stored_name;
+  {
+    std::lock_guard lock(impl_->mu);
+    ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+    ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
+    if (!existing) return not_found("no account named '" + username + "'");
+    if (existing->role == Role::kAdmin) {
+      ASSIGN_OR_RETURN(int64_t admins, impl_->admin_count());
+      if (admins <= 1)
+        return failed_precondition("'" + existing->username +
+                                   "' is the last admin; make another admin first");
+    }
+    // Sessions go with it (ON DELETE CASCADE); said explicitly so it does not
+    // hang on a pragma.
+    RETURN_IF_ERROR(impl_->delete_sessions_of(username));
+    ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("DELETE FROM accounts WHERE username = ?"));
+    RETURN_IF_ERROR(st.bind(1, username).run());
+    RETURN_IF_ERROR(tx.commit());
+    stored_name = existing->username;
   }
-  // Sessions go with it (ON DELETE CASCADE); said explicitly so it does not
-  // hang on a pragma.
-  RETURN_IF_ERROR(impl_->delete_sessions_of(username));
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("DELETE FROM accounts WHERE username = ?"));
-  RETURN_IF_ERROR(st.bind(1, username).run());
-  return tx.commit();
+  impl_->notify({stored_name, ""});
+  return Status::Ok();
 }
 
 StatusOr<Account> AuthStore::account(const std::string& username) const {
@@ -628,12 +659,12 @@ LoginResult AuthStore::login(const std::string& username, const std::string& pas
   return std::move(*ok);
 }
 
-std::optional<Session> AuthStore::session(const std::string& token) {
+std::optional<Session> AuthStore::session(const std::string& token, bool refresh) {
   if (!well_formed_token(token, kSessionTokenBytes)) return std::nullopt;
   const std::string hash = token_hash(token);
   const int64_t now = impl_->now();
   std::lock_guard lock(impl_->mu);
-  auto s = impl_->find_session(hash, now);
+  auto s = impl_->find_session(hash, now, refresh);
   // A store that cannot answer lets no one in.
   if (!s.ok()) return std::nullopt;
   return std::move(*s);
@@ -642,14 +673,33 @@ std::optional<Session> AuthStore::session(const std::string& token) {
 void AuthStore::logout(const std::string& token) {
   if (!well_formed_token(token, kSessionTokenBytes)) return;
   const std::string hash = token_hash(token);
-  std::lock_guard lock(impl_->mu);
-  auto st = impl_->db.prepare("DELETE FROM sessions WHERE token_hash = ?");
-  if (st.ok()) (void)st->bind(1, hash).run();
+  {
+    std::lock_guard lock(impl_->mu);
+    auto st = impl_->db.prepare("DELETE FROM sessions WHERE token_hash = ?");
+    if (st.ok()) (void)st->bind(1, hash).run();
+  }
+  impl_->notify({"", token});
 }
 
 Status AuthStore::end_sessions(const std::string& username) {
-  std::lock_guard lock(impl_->mu);
-  return impl_->delete_sessions_of(username);
+  {
+    std::lock_guard lock(impl_->mu);
+    RETURN_IF_ERROR(impl_->delete_sessions_of(username));
+  }
+  impl_->notify({username, ""});
+  return Status::Ok();
+}
+
+int AuthStore::watch_sessions(std::function<void(const SessionChange&)> fn) {
+  std::lock_guard lock(impl_->watch_mu);
+  const int id = impl_->next_watcher++;
+  impl_->watchers.emplace(id, std::move(fn));
+  return id;
+}
+
+void AuthStore::unwatch_sessions(int id) {
+  std::lock_guard lock(impl_->watch_mu);
+  impl_->watchers.erase(id);
 }
 
 // --- share links ---------------------------------------------------------------

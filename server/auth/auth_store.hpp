@@ -67,6 +67,14 @@ struct NewShare {
   std::string token;
 };
 
+// Sessions that ended or changed: every session of `username` (password, role
+// or account deleted, end_sessions), or the one session `token` (logout). One of
+// the two is set.
+struct SessionChange {
+  std::string username;  // as stored
+  std::string token;     // the cookie value
+};
+
 struct AuthOptions {
   // Argon2id cost. 0: libsodium's INTERACTIVE limits. Tests use
   // crypto_pwhash_OPSLIMIT_MIN / crypto_pwhash_MEMLIMIT_MIN.
@@ -121,9 +129,17 @@ class AuthStore {
                     const std::string& remote_address);
   // The session for a cookie token: unexpired (absolute and idle) and its account
   // still there. Refreshes its last use. Anything malformed is just nullopt.
-  std::optional<Session> session(const std::string& token);
+  // With `refresh` false the last use stays as it was: for a check that is not
+  // the user doing something (an open WebSocket re-checking its session).
+  std::optional<Session> session(const std::string& token, bool refresh = true);
   void logout(const std::string& token);
   Status end_sessions(const std::string& username);  // every session of that user
+
+  // Calls `fn` after every change that ends or alters sessions (logout,
+  // end_sessions, set_password, set_role, delete_account), outside the store's
+  // lock, on the caller's thread. Returns an id for unwatch_sessions.
+  int watch_sessions(std::function<void(const SessionChange&)> fn);
+  void unwatch_sessions(int id);
 
   // Share links. valid_for_s in (0, 365 days].
   StatusOr<NewShare> create_share(const std::string& scan_id,

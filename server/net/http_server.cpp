@@ -53,8 +53,22 @@ void fail(beast::error_code ec, const char* what) {
 class EventSessionBase {
  public:
   virtual ~EventSessionBase() = default;
+  // The server stops.
   virtual void close() = 0;
+  // The staff session it was opened with ended or changed (see SessionChange):
+  // close with 1008 when it is this socket's.
+  virtual void session_changed(const SessionChange& change) = 0;
 };
+
+namespace {
+
+bool same_username(const std::string& a, const std::string& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](unsigned char x, unsigned char y) {
+    return std::tolower(x) == std::tolower(y);
+  });
+}
+
+}  // namespace
 
 // What every session shares: the API, the pool, the limits, the live WebSockets.
 struct Shared {
@@ -67,6 +81,7 @@ struct Shared {
   bool stopping = false;
   std::atomic<size_t> connections{0};
   size_t max_connections = 0;
+  int session_watch = 0;  // AuthStore::watch_sessions id
 
   Shared(Api& a, Workstation& w, const NetOptions& o) : api(a), ws(w), options(o), workers(std::max(1, o.workers)) {}
 };
@@ -138,10 +153,17 @@ bool is_preview(const std::string& event) { return event.find("\"type\":\"previe
 template <class Stream>
 class EventSession : public EventSessionBase, public std::enable_shared_from_this<EventSession<Stream>> {
  public:
-  EventSession(Stream&& stream, Shared& shared, ConnectionSlot slot)
-      : ws_(std::move(stream)), shared_(shared), slot_(std::move(slot)) {}
+  EventSession(Stream&& stream, Shared& shared, ConnectionSlot slot, std::string token, Session session)
+      : ws_(std::move(stream)),
+        shared_(shared),
+        slot_(std::move(slot)),
+        expiry_(ws_.get_executor()),
+        token_(std::move(token)),
+        session_(std::move(session)) {}
   ~EventSession() override {
     if (sink_) shared_.ws.unsubscribe(sink_);
+    std::lock_guard lock(shared_.mutex);
+    shared_.event_sessions.erase(this->weak_from_this());
   }
 
   void run(http::request<http::string_body> req, std::string hello) {
@@ -158,12 +180,12 @@ class EventSession : public EventSessionBase, public std::enable_shared_from_thi
     asio::post(ws_.get_executor(), [self = this->shared_from_this(), event]() { self->on_send(event); });
   }
 
-  void close() override {
-    asio::post(ws_.get_executor(), [self = this->shared_from_this()]() {
-      if (self->closed_) return;
-      self->closed_ = true;
-      self->ws_.async_close(websocket::close_code::going_away, [self](beast::error_code) {});
-    });
+  void close() override { close_with({websocket::close_code::going_away, "the workstation is stopping"}); }
+
+  void session_changed(const SessionChange& change) override {
+    if ((!change.token.empty() && change.token == token_) ||
+        (!change.username.empty() && same_username(change.username, session_.username)))
+      close_with({websocket::close_code::policy_error, "the session ended or changed; log in again"});
   }
 
  private:
@@ -180,6 +202,39 @@ class EventSession : public EventSessionBase, public std::enable_shared_from_thi
     });
     on_send(std::make_shared<const std::string>(std::move(hello_)));
     do_read();
+    watch_expiry(session_.expires_at);
+  }
+
+  void close_with(websocket::close_reason reason) {
+    asio::post(ws_.get_executor(), [self = this->shared_from_this(), reason]() {
+      self->expiry_.cancel();
+      if (self->closed_) return;
+      self->closed_ = true;
+      self->ws_.async_close(reason, [self](beast::error_code) {});
+    });
+  }
+
+  // At the session's expiry (idle or absolute), or every five minutes at the
+  // latest, ask the store whether the session still holds; a socket open in a
+  // forgotten tab does not count as use.
+  void watch_expiry(int64_t expires_at) {
+    const int64_t now = std::chrono::duration_cast<std::chrono::seconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
+    expiry_.expires_after(std::chrono::seconds(std::clamp<int64_t>(expires_at - now, 1, 300)));
+    std::weak_ptr<EventSession> weak = this->shared_from_this();
+    expiry_.async_wait([weak](beast::error_code ec) {
+      auto self = weak.lock();
+      if (ec || !self || self->closed_) return;
+      asio::post(self->shared_.workers, [self]() {
+        const std::optional<Session> now_valid = self->shared_.ws.auth().session(self->token_, false);
+        asio::post(self->ws_.get_executor(), [self, now_valid]() {
+          if (self->closed_) return;
+          if (!now_valid) return self->close_with({websocket::close_code::policy_error, "the session expired"});
+          self->watch_expiry(now_valid->expires_at);
+        });
+      });
+    });
   }
 
   void do_read() {
@@ -188,6 +243,7 @@ class EventSession : public EventSessionBase, public std::enable_shared_from_thi
   void on_read(beast::error_code ec, size_t) {
     if (ec) {
       closed_ = true;
+      expiry_.cancel();
       return fail(ec, "websocket read");
     }
     buffer_.consume(buffer_.size());  // nothing clients say changes anything
@@ -224,6 +280,9 @@ class EventSession : public EventSessionBase, public std::enable_shared_from_thi
   websocket::stream<Stream> ws_;
   Shared& shared_;
   ConnectionSlot slot_;
+  asio::steady_timer expiry_;
+  const std::string token_;
+  const Session session_;
   beast::flat_buffer buffer_;
   std::deque<std::shared_ptr<const std::string>> queue_;
   std::string hello_;
@@ -285,16 +344,18 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
       if (request.path != "/api/events") return reply_and_close(404, "WebSockets live at /api/events");
       // The session check reads the accounts database: on the pool, like all work.
       asio::post(shared_.workers, [self = this->shared_from_this(), req = std::move(req), request]() mutable {
-        std::optional<HttpResponse> refused = self->shared_.api.refuse_events(request);
+        Session session;
+        std::optional<HttpResponse> refused = self->shared_.api.refuse_events(request, &session);
         std::string hello;
         if (!refused) hello = nlohmann::json{{"type", "hello"}, {"rig", self->shared_.ws.rig_status()}}.dump();
         asio::post(self->stream_.get_executor(), [self, req = std::move(req), refused = std::move(refused),
-                                                  hello = std::move(hello)]() mutable {
+                                                  hello = std::move(hello), token = session_cookie(request),
+                                                  session = std::move(session)]() mutable {
           if (refused) return self->send(make_message(std::move(*refused), req.version(), false, false), false);
           self->tcp().expires_never();
-          auto session = std::make_shared<EventSession<Stream>>(std::move(self->stream_), self->shared_,
-                                                                std::move(self->slot_));
-          session->run(std::move(req), std::move(hello));
+          auto session_socket = std::make_shared<EventSession<Stream>>(
+              std::move(self->stream_), self->shared_, std::move(self->slot_), std::move(token), std::move(session));
+          session_socket->run(std::move(req), std::move(hello));
         });
       });
       return;
@@ -491,6 +552,15 @@ StatusOr<std::unique_ptr<HttpServer>> HttpServer::start(Api& api, Workstation& w
   impl->port = impl->acceptor.local_endpoint().port();
   impl->shared = std::make_unique<Shared>(api, ws, options);
   impl->shared->max_connections = connection_cap(options.max_connections);
+  impl->shared->session_watch = ws.auth().watch_sessions([shared = impl->shared.get()](const SessionChange& change) {
+    std::vector<std::shared_ptr<EventSessionBase>> live;
+    {
+      std::lock_guard lock(shared->mutex);
+      for (const auto& w : shared->event_sessions)
+        if (auto p = w.lock()) live.push_back(std::move(p));
+    }
+    for (auto& p : live) p->session_changed(change);
+  });
   impl->do_accept();
   for (int i = 0; i < std::max(1, options.io_threads); ++i) impl->threads.emplace_back([io = &impl->ioc]() { io->run(); });
   return std::unique_ptr<HttpServer>(new HttpServer(std::move(impl)));
@@ -503,6 +573,7 @@ void HttpServer::stop() {
   Impl& s = *impl_;
   if (s.stopped) return;
   s.stopped = true;
+  s.shared->ws.auth().unwatch_sessions(s.shared->session_watch);
   asio::post(s.ioc, [&s]() {
     beast::error_code ec;
     s.acceptor.close(ec);

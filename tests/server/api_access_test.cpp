@@ -253,6 +253,70 @@ TEST_F(ApiAccess, EventsNeedAStaffSession) {
   EXPECT_EQ(t.get("/api/events").status, 426);
 }
 
+using namespace std::chrono_literals;
+
+// True once the server has closed the socket (within `wait`); false while it is
+// open. Messages that arrive meanwhile (events, previews) are skipped.
+bool closed_within(EventStream& events, std::chrono::milliseconds wait) {
+  const auto until = std::chrono::steady_clock::now() + wait;
+  while (std::chrono::steady_clock::now() < until) {
+    events.next(std::chrono::milliseconds(200));
+    if (events.closed()) return true;
+  }
+  return events.closed();
+}
+
+std::unique_ptr<EventStream> open_events(int port, const Client& c) {
+  auto events = EventStream::open(port, c.cookie);
+  if (events && !events->next(std::chrono::seconds(10))) return nullptr;  // the hello
+  return events;
+}
+
+// A socket carries job events and camera pictures of the person in the rig: it
+// lives no longer than the session it was opened with, whatever ends that.
+TEST(EventSockets, CloseWhenTheirSessionEndsOrChanges) {
+  ServerUnderTest s;
+  Client admin = s.as("admin");
+  for (const char* name : {"anna", "ben", "carl"})
+    ASSERT_EQ(admin.post("/api/accounts", std::string(R"({"username": ")") + name +
+                                              R"(", "password": "a long password", "role": "operator"})")
+                  .status,
+              201);
+  const Client anna1 = login(s.port, "anna", "a long password"), anna2 = login(s.port, "anna", "a long password");
+  const Client ben = login(s.port, "ben", "a long password"), carl = login(s.port, "carl", "a long password");
+  auto e_anna1 = open_events(s.port, anna1), e_anna2 = open_events(s.port, anna2);
+  auto e_ben = open_events(s.port, ben), e_carl = open_events(s.port, carl);
+  auto e_admin = open_events(s.port, admin);
+  ASSERT_TRUE(e_anna1 && e_anna2 && e_ben && e_carl && e_admin);
+
+  // Logout ends that session's socket only.
+  EXPECT_EQ(anna1.post("/api/logout").status, 204);
+  EXPECT_TRUE(closed_within(*e_anna1, 5s));
+  EXPECT_FALSE(closed_within(*e_anna2, 500ms));
+  // A new password ends every session of the account.
+  EXPECT_EQ(admin.put("/api/accounts/ANNA", R"({"password": "another long password"})").status, 200);
+  EXPECT_TRUE(closed_within(*e_anna2, 5s));
+  // So does a new role, and deleting the account.
+  EXPECT_EQ(admin.put("/api/accounts/ben", R"({"role": "tailor"})").status, 200);
+  EXPECT_TRUE(closed_within(*e_ben, 5s));
+  EXPECT_EQ(admin.del("/api/accounts/carl").status, 204);
+  EXPECT_TRUE(closed_within(*e_carl, 5s));
+  // Nobody else's socket is touched.
+  EXPECT_FALSE(closed_within(*e_admin, 500ms));
+  // A closed socket cannot be reopened with the ended session.
+  HttpReply refusal;
+  EXPECT_EQ(EventStream::open(s.port, anna1.cookie, &refusal), nullptr);
+  EXPECT_EQ(refusal.status, 401);
+}
+
+TEST(EventSockets, CloseWhenTheirSessionExpires) {
+  ServerUnderTest s(12, {}, [](server::WorkstationOptions& wo) { wo.auth.session_idle_s = 2; });
+  const Client op = s.as("op");
+  auto events = open_events(s.port, op);
+  ASSERT_TRUE(events);
+  EXPECT_TRUE(closed_within(*events, 6s)) << "idle for longer than the idle limit";
+}
+
 }  // namespace
 }  // namespace bodyscan::testing
 
