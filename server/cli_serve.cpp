@@ -57,6 +57,8 @@ void usage(FILE* out) {
       "  --tls-cert PEM --tls-key PEM\n"
       "                     serve HTTPS (session cookies become Secure)\n"
       "  --behind-tls-proxy a TLS proxy in front forwards to us: cookies Secure\n"
+      "  --trusted-proxy A  believe X-Forwarded-For/-Proto/-Host from this address\n"
+      "                     (the reverse proxy's; repeatable)\n"
       "  --public-url URL   the address customers' share links start with\n"
       "  --admin NAME       the first admin account, made when there is none; its\n"
       "                     password comes from BODYSCAN_ADMIN_PASSWORD, or one is made\n"
@@ -133,6 +135,7 @@ int run_serve(int argc, char** argv) {
       if (!n) return 2;
       wo.default_every = *n;
     } else if (a == "--web") ao.web_root = v;
+    else if (a == "--trusted-proxy") no.trusted_proxies.push_back(v);
     else if (a == "--tls-cert") no.tls_cert = v;
     else if (a == "--tls-key") no.tls_key = v;
     else if (a == "--public-url") ao.public_url = v;

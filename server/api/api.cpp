@@ -50,13 +50,15 @@ bool constant_time_equal(const std::string& a, const std::string& b) {
 }
 
 // A browser sends Origin on cross-site requests; when it names another host
-// than the one addressed, the request did not come from our pages.
+// than the one addressed, the request did not come from our pages. The host a
+// proxy says the browser addressed counts only from a trusted proxy: anyone
+// else could send it to match their own Origin.
 bool foreign_origin(const HttpRequest& r) {
   const std::string origin = r.header("origin");
   if (origin.empty() || origin == "null") return !origin.empty();
   const size_t scheme = origin.find("://");
   const std::string host = scheme == std::string::npos ? origin : origin.substr(scheme + 3);
-  const std::string forwarded = r.header("x-forwarded-host");
+  const std::string forwarded = r.via_trusted_proxy ? r.header("x-forwarded-host") : std::string();
   return host != r.header("host") && (forwarded.empty() || host != forwarded);
 }
 

@@ -21,8 +21,11 @@ struct HttpRequest {
   std::map<std::string, std::string> query;    // decoded
   std::map<std::string, std::string> headers;  // names in lower case
   std::string body;
+  // The client's address: the peer's, or behind a trusted proxy (NetOptions::
+  // trusted_proxies) the one it forwarded for in X-Forwarded-For.
   std::string remote_address;
-  bool secure = false;  // arrived over TLS
+  bool via_trusted_proxy = false;  // its X-Forwarded-* headers may be believed
+  bool secure = false;             // arrived over TLS (here, or at the trusted proxy)
 
   std::string header(const std::string& lower_name) const {
     auto it = headers.find(lower_name);

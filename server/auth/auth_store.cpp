@@ -12,6 +12,7 @@
 #include <cstring>
 #include <ctime>
 #include <deque>
+#include <initializer_list>
 #include <map>
 #include <mutex>
 #include <unordered_map>
@@ -173,60 +174,84 @@ std::string lower(std::string s) {
   return s;
 }
 
-// Remembers recent login failures per key. A failure is recorded before the
-// password is checked and forgiven on success, so parallel guesses cannot all
-// slip past the check before any of them is counted.
+// Remembers recent login failures, in a sliding window, under four keys: the
+// account at one address, the address, the account from anywhere, and all.
+// - An account guessed at from one address: that pair is refused.
+// - Many accounts guessed at from one address: that address is refused.
+// - One account guessed at from many addresses, or guessing all over (more than
+//   an overall limit): the brake. Every address then gets one failure for that
+//   account (or for any, under the overall limit) before it is refused.
+// Failures at one address never refuse the right password from an address that
+// has made none: a shop's staff cannot be locked out from elsewhere.
+//
+// A failure is recorded before the password is checked and forgiven on success,
+// so parallel guesses cannot all slip past the check before any is counted.
 class Limiter {
  public:
-  Limiter(int max_failures, int max_address_failures, int64_t window_s)
-      : max_(max_failures), max_addr_(max_address_failures), window_(window_s) {}
+  struct Keys {
+    std::string pair, address, account;
+  };
 
-  // 0 having reserved a failure under both keys, else seconds to wait.
-  int reserve(const std::string& user_key, const std::string& addr_key, int64_t now) {
+  explicit Limiter(const AuthOptions& o)
+      : pair_max_(o.max_failures),
+        address_max_(o.max_address_failures > 0 ? o.max_address_failures : 4 * o.max_failures),
+        account_max_(o.max_account_failures > 0 ? o.max_account_failures : 4 * o.max_failures),
+        total_max_(o.max_total_failures > 0 ? o.max_total_failures : 20 * o.max_failures),
+        window_(o.failure_window_s) {}
+
+  // 0 having reserved a failure under every key, else seconds to wait.
+  int reserve(const Keys& k, int64_t now) {
     std::lock_guard lock(mu_);
-    if (max_ <= 0) return 0;
+    if (pair_max_ <= 0) return 0;
     if (failures_.size() > kLimiterSweepAbove) sweep(now);
-    auto& user = failures_[user_key];
-    auto& addr = failures_[addr_key];
+    auto& pair = failures_[k.pair];
+    auto& address = failures_[k.address];
+    auto& account = failures_[k.account];
+    for (auto* d : {&pair, &address, &account, &total_}) expire(*d, now);
+    const bool brake_all = static_cast<int>(total_.size()) >= total_max_;
+    const bool brake_account = brake_all || static_cast<int>(account.size()) >= account_max_;
     int64_t wait = 0;
-    for (auto [d, max] : {std::pair{&user, max_}, std::pair{&addr, max_addr_}}) {
-      expire(*d, now);
-      if (static_cast<int>(d->size()) >= max) wait = std::max(wait, d->front() + window_ - now);
+    for (auto [d, max] : {std::pair{&pair, brake_account ? 1 : pair_max_},
+                          std::pair{&address, brake_all ? 1 : address_max_}}) {
+      const auto n = static_cast<int>(d->size());
+      // Until enough of this key's failures age out to go under its limit.
+      if (n >= max) wait = std::max<int64_t>(wait, (*d)[n - max] + window_ - now);
+      if (n >= max && wait <= 0) wait = 1;
     }
     // Clamped: a clock stepped backwards must not lock anyone out for longer.
-    if (wait > 0 || static_cast<int>(user.size()) >= max_ || static_cast<int>(addr.size()) >= max_addr_)
-      return static_cast<int>(std::clamp<int64_t>(wait, 1, window_));
-    user.push_back(now);
-    addr.push_back(now);
+    if (wait > 0) return static_cast<int>(std::clamp<int64_t>(wait, 1, window_));
+    for (auto* d : {&pair, &address, &account, &total_}) d->push_back(now);
     return 0;
   }
 
-  // The reserved failure was no failure: the username starts afresh, the
-  // address keeps the failures it made before.
-  void forgive(const std::string& user_key, const std::string& addr_key, int64_t reserved_at) {
+  // The reserved failure was no failure: the pair starts afresh; the other keys
+  // keep the failures made before.
+  void forgive(const Keys& k, int64_t reserved_at) {
     std::lock_guard lock(mu_);
-    failures_.erase(user_key);
-    auto it = failures_.find(addr_key);
-    if (it == failures_.end()) return;
-    auto& d = it->second;
-    auto pos = std::find(d.rbegin(), d.rend(), reserved_at);
-    if (pos != d.rend()) d.erase(std::next(pos).base());
-    if (d.empty()) failures_.erase(it);
+    failures_.erase(k.pair);
+    unreserve({&k.address, &k.account}, reserved_at);
   }
 
   // Not the user's fault (the store failed): the attempt does not count.
-  void release(const std::string& user_key, const std::string& addr_key, int64_t reserved_at) {
+  void release(const Keys& k, int64_t reserved_at) {
     std::lock_guard lock(mu_);
-    for (const std::string* k : {&user_key, &addr_key}) {
-      auto it = failures_.find(*k);
-      if (it == failures_.end()) continue;
-      auto pos = std::find(it->second.rbegin(), it->second.rend(), reserved_at);
-      if (pos != it->second.rend()) it->second.erase(std::next(pos).base());
-      if (it->second.empty()) failures_.erase(it);
-    }
+    unreserve({&k.pair, &k.address, &k.account}, reserved_at);
   }
 
  private:
+  static void drop_one(std::deque<int64_t>& d, int64_t at) {
+    auto pos = std::find(d.rbegin(), d.rend(), at);
+    if (pos != d.rend()) d.erase(std::next(pos).base());
+  }
+  void unreserve(std::initializer_list<const std::string*> keys, int64_t at) {
+    for (const std::string* key : keys) {
+      auto it = failures_.find(*key);
+      if (it == failures_.end()) continue;
+      drop_one(it->second, at);
+      if (it->second.empty()) failures_.erase(it);
+    }
+    drop_one(total_, at);
+  }
   void expire(std::deque<int64_t>& d, int64_t now) const {
     while (!d.empty() && d.front() <= now - window_) d.pop_front();
   }
@@ -237,10 +262,11 @@ class Limiter {
     }
   }
 
-  const int max_, max_addr_;
+  const int pair_max_, address_max_, account_max_, total_max_;
   const int64_t window_;
   std::mutex mu_;
   std::unordered_map<std::string, std::deque<int64_t>> failures_;
+  std::deque<int64_t> total_;
 };
 
 }  // namespace
@@ -258,9 +284,7 @@ struct AuthStore::Impl {
   Impl(Database d, AuthOptions o)
       : db(std::move(d)),
         options(std::move(o)),
-        limiter(options.max_failures,
-                options.max_address_failures > 0 ? options.max_address_failures : options.max_failures,
-                options.failure_window_s) {}
+        limiter(options) {}
 
   int64_t now() const { return options.now ? options.now() : system_now(); }
 
@@ -606,15 +630,17 @@ LoginResult AuthStore::login(const std::string& username, const std::string& pas
   LoginResult r;
   const int64_t now = impl_->now();
   // Bounded keys: an absurd username or address is still one key, not a megabyte.
-  const std::string user_key = "u:" + lower(username.substr(0, kMaxUsername + 1));
-  const std::string addr_key = "a:" + remote_address.substr(0, kMaxRemoteKey);
-  if (const int wait = impl_->limiter.reserve(user_key, addr_key, now)) {
+  const std::string user = lower(username.substr(0, kMaxUsername + 1));
+  const std::string address = remote_address.substr(0, kMaxRemoteKey);
+  // NUL cannot occur in a username that reaches here bounded, nor in an address.
+  const Limiter::Keys keys{"p:" + user + std::string(1, '\0') + address, "a:" + address, "u:" + user};
+  if (const int wait = impl_->limiter.reserve(keys, now)) {
     r.outcome = LoginResult::kRateLimited;
     r.retry_after_s = wait;
     return r;
   }
   auto fail = [&](Status s) {
-    impl_->limiter.release(user_key, addr_key, now);
+    impl_->limiter.release(keys, now);
     r.outcome = LoginResult::kError;
     r.error = std::move(s);
     return r;
@@ -642,7 +668,7 @@ LoginResult AuthStore::login(const std::string& username, const std::string& pas
     ok = std::move(*created);
   }
   if (!ok) return r;  // the password changed (or the account went) while verifying
-  impl_->limiter.forgive(user_key, addr_key, now);
+  impl_->limiter.forgive(keys, now);
 
   // Accounts made under weaker settings get the current cost now that the
   // password is at hand; failing to is no reason to refuse the login.

@@ -81,13 +81,16 @@ struct AuthOptions {
   unsigned long long opslimit = 0, memlimit = 0;
   int64_t session_lifetime_s = 12 * 3600;  // absolute lifetime
   int64_t session_idle_s = 2 * 3600;       // expires when unused this long
-  // Login failures per key (the username, and the remote address separately)
-  // within failure_window_s before refusing. <= 0 turns the limit off.
+  // Login failures within failure_window_s before refusing (see the limiter in
+  // auth_store.cpp): per account at one address; per address over all accounts
+  // (higher: a shop's tablets may share a NAT address); per account from all
+  // addresses, and over everything, past which each address gets one failure.
+  // max_failures <= 0 turns the limits off; the others <= 0 take their default
+  // multiple of max_failures (4, 4, 20).
   int max_failures = 5;
-  // From one address: higher, since a shop's tablets may all reach the server
-  // through one proxy or NAT address; guessing at one account stays at
-  // max_failures. <= 0: the same as max_failures.
   int max_address_failures = 20;
+  int max_account_failures = 20;
+  int max_total_failures = 100;
   int64_t failure_window_s = 300;
   std::function<int64_t()> now;  // unix seconds; default: the system clock
 };
@@ -121,10 +124,12 @@ class AuthStore {
   bool has_admin() const;
 
   // The same work whether or not the user exists (an unknown user is verified
-  // against a dummy hash). After max_failures failures within failure_window_s
-  // for the username or for the remote address, attempts (even with the right
-  // password) are kRateLimited without hashing. Success clears the username's
-  // failures. Expired sessions are purged here.
+  // against a dummy hash). Past the failure limits (AuthOptions) attempts, even
+  // with the right password, are kRateLimited without hashing; an address that
+  // has failed at nothing is never refused. Success clears the failures of that
+  // username at that address. Expired sessions are purged here.
+  // `remote_address` is the client's (behind a trusted proxy, the address it
+  // forwarded for).
   LoginResult login(const std::string& username, const std::string& password,
                     const std::string& remote_address);
   // The session for a cookie token: unexpired (absolute and idle) and its account

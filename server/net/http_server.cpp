@@ -82,6 +82,7 @@ struct Shared {
   std::atomic<size_t> connections{0};
   size_t max_connections = 0;
   int session_watch = 0;  // AuthStore::watch_sessions id
+  std::vector<asio::ip::address> trusted_proxies;
 
   Shared(Api& a, Workstation& w, const NetOptions& o) : api(a), ws(w), options(o), workers(std::max(1, o.workers)) {}
 };
@@ -103,8 +104,45 @@ class ConnectionSlot {
 
 namespace {
 
-HttpRequest to_request(const http::request<http::string_body>& req, const std::string& remote, bool secure,
-                       bool* ok) {
+// IPv4 peers of an IPv6 socket come as ::ffff:a.b.c.d; compared as a.b.c.d.
+asio::ip::address plain(const asio::ip::address& a) {
+  if (a.is_v6() && a.to_v6().is_v4_mapped()) return asio::ip::make_address_v4(asio::ip::v4_mapped, a.to_v6());
+  return a;
+}
+
+bool is_trusted(const std::vector<asio::ip::address>& trusted, const asio::ip::address& a) {
+  return std::find(trusted.begin(), trusted.end(), a) != trusted.end();
+}
+
+// The client behind a trusted proxy: the right-most X-Forwarded-For entry that
+// is not itself a trusted proxy (entries further left were written by the
+// client and prove nothing). Nullopt when there is no usable entry.
+std::optional<asio::ip::address> forwarded_client(const http::request<http::string_body>& req,
+                                                  const std::vector<asio::ip::address>& trusted) {
+  std::vector<std::string> entries;
+  const auto [first, last] = req.equal_range("X-Forwarded-For");
+  for (auto f = first; f != last; ++f) {
+    std::string_view v = f->value();
+    while (!v.empty()) {
+      const size_t comma = std::min(v.find(','), v.size());
+      std::string_view e = v.substr(0, comma);
+      while (!e.empty() && (e.front() == ' ' || e.front() == '\t')) e.remove_prefix(1);
+      while (!e.empty() && (e.back() == ' ' || e.back() == '\t')) e.remove_suffix(1);
+      entries.emplace_back(e);
+      v.remove_prefix(std::min(comma + 1, v.size()));
+    }
+  }
+  for (auto it = entries.rbegin(); it != entries.rend(); ++it) {
+    beast::error_code ec;
+    const auto a = asio::ip::make_address(*it, ec);
+    if (ec) return std::nullopt;
+    if (!is_trusted(trusted, plain(a))) return plain(a);
+  }
+  return std::nullopt;
+}
+
+HttpRequest to_request(const http::request<http::string_body>& req, const asio::ip::address* peer, bool tls,
+                       const std::vector<asio::ip::address>& trusted, bool* ok) {
   HttpRequest r;
   r.method = std::string(req.method_string());
   r.target = std::string(req.target());
@@ -114,8 +152,13 @@ HttpRequest to_request(const http::request<http::string_body>& req, const std::s
     r.headers[name] = std::string(f.value());
   }
   r.body = req.body();
-  r.remote_address = remote;
-  r.secure = secure;
+  r.remote_address = peer ? peer->to_string() : "?";
+  r.secure = tls;
+  if (peer && is_trusted(trusted, *peer)) {
+    r.via_trusted_proxy = true;
+    if (const auto client = forwarded_client(req, trusted)) r.remote_address = client->to_string();
+    if (r.header("x-forwarded-proto") == "https") r.secure = true;
+  }
   *ok = parse_target(r.target, &r.path, &r.query);
   return r;
 }
@@ -296,8 +339,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
 
  public:
   template <class... Args>
-  HttpSession(Shared& shared, ConnectionSlot slot, std::string remote, Args&&... args)
-      : stream_(std::forward<Args>(args)...), shared_(shared), slot_(std::move(slot)), remote_(std::move(remote)) {}
+  HttpSession(Shared& shared, ConnectionSlot slot, std::optional<asio::ip::address> peer, Args&&... args)
+      : stream_(std::forward<Args>(args)...), shared_(shared), slot_(std::move(slot)), peer_(std::move(peer)) {}
 
   void run() { asio::dispatch(stream_.get_executor(), beast::bind_front_handler(&HttpSession::on_run, this->shared_from_this())); }
 
@@ -338,7 +381,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     if (ec) return fail(ec, "read");
     http::request<http::string_body> req = parser_->release();
     bool ok = false;
-    HttpRequest request = to_request(req, remote_, kTls, &ok);
+    HttpRequest request = to_request(req, peer_ ? &*peer_ : nullptr, kTls, shared_.trusted_proxies, &ok);
     if (!ok) return reply_and_close(400, "malformed request target");
     if (websocket::is_upgrade(req)) {
       if (request.path != "/api/events") return reply_and_close(404, "WebSockets live at /api/events");
@@ -427,7 +470,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   Stream stream_;
   Shared& shared_;
   ConnectionSlot slot_;
-  std::string remote_;
+  std::optional<asio::ip::address> peer_;
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
   bool lingering_ = false;
@@ -476,15 +519,15 @@ struct HttpServer::Impl {
       // this, Nagle holds the last one for the client's delayed ACK (40 ms).
       socket.set_option(tcp::no_delay(true), e2);
       const auto ep = socket.remote_endpoint(e2);
-      std::string remote = e2 ? "?" : ep.address().to_string();
+      std::optional<asio::ip::address> peer;
+      if (!e2) peer = plain(ep.address());
       ConnectionSlot slot(*shared);
       if (tls)
-        std::make_shared<HttpSession<beast::ssl_stream<beast::tcp_stream>>>(*shared, std::move(slot), std::move(remote),
+        std::make_shared<HttpSession<beast::ssl_stream<beast::tcp_stream>>>(*shared, std::move(slot), peer,
                                                                              std::move(socket), *tls)
             ->run();
       else
-        std::make_shared<HttpSession<beast::tcp_stream>>(*shared, std::move(slot), std::move(remote), std::move(socket))
-            ->run();
+        std::make_shared<HttpSession<beast::tcp_stream>>(*shared, std::move(slot), peer, std::move(socket))->run();
       do_accept();
     });
   }
@@ -552,6 +595,11 @@ StatusOr<std::unique_ptr<HttpServer>> HttpServer::start(Api& api, Workstation& w
   impl->port = impl->acceptor.local_endpoint().port();
   impl->shared = std::make_unique<Shared>(api, ws, options);
   impl->shared->max_connections = connection_cap(options.max_connections);
+  for (const std::string& proxy : options.trusted_proxies) {
+    const auto a = asio::ip::make_address(proxy, ec);
+    if (ec) return invalid_argument("trusted proxy '" + proxy + "' is not an IP address");
+    impl->shared->trusted_proxies.push_back(plain(a));
+  }
   impl->shared->session_watch = ws.auth().watch_sessions([shared = impl->shared.get()](const SessionChange& change) {
     std::vector<std::shared_ptr<EventSessionBase>> live;
     {

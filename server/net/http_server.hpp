@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "recon/core/status.hpp"
 #include "server/api/api.hpp"
@@ -36,6 +37,10 @@ struct NetOptions {
   // closed. 0: the process's descriptor limit (RLIMIT_NOFILE) less
   // kReservedDescriptors for the archive, the rig and the logs.
   size_t max_connections = 0;
+  // Peers whose X-Forwarded-For, -Proto and -Host are believed (the reverse
+  // proxy in front, e.g. "127.0.0.1"). From anyone else they are ignored: the
+  // login limits key on the client's address, and a client must not choose it.
+  std::vector<std::string> trusted_proxies;
 };
 
 inline constexpr size_t kReservedDescriptors = 128;

@@ -255,6 +255,55 @@ TEST_F(ApiAccess, EventsNeedAStaffSession) {
 
 using namespace std::chrono_literals;
 
+HttpReply login_from(int port, const std::string& password, std::map<std::string, std::string> headers) {
+  headers.emplace("Content-Type", "application/json");
+  return http(port, "POST", "/api/login", headers, R"({"username": "op", "password": ")" + password + R"("})");
+}
+
+// Behind the documented proxy every client reaches the server from 127.0.0.1;
+// the client's own address comes from X-Forwarded-For, believed only from the
+// configured proxy, and the login limits key on it.
+TEST(ProxiedClients, LoginLimitsKeyOnTheAddressTheTrustedProxyForwarded) {
+  server::NetOptions net;
+  net.trusted_proxies = {"127.0.0.1"};
+  ServerUnderTest s(12, net);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(login_from(s.port, "wrong guess " + std::to_string(i), {{"X-Forwarded-For", "10.0.0.1"}}).status, 401);
+  EXPECT_EQ(login_from(s.port, kPassword, {{"X-Forwarded-For", "10.0.0.1"}}).status, 429);
+  // What the guesser writes to the left of the proxy's entry changes nothing.
+  EXPECT_EQ(login_from(s.port, kPassword, {{"X-Forwarded-For", "10.0.0.2, 10.0.0.1"}}).status, 429);
+  // The right password from another client gets in.
+  const HttpReply ok = login_from(s.port, kPassword, {{"X-Forwarded-For", "10.0.0.2"}, {"X-Forwarded-Proto", "https"}});
+  EXPECT_EQ(ok.status, 200);
+  EXPECT_NE(ok.header("set-cookie").find("; Secure"), std::string::npos) << "TLS ended at the proxy";
+  // The host the proxy says the browser addressed satisfies the Origin check.
+  Client op = s.as("op");
+  EXPECT_EQ(op.request("POST", "/api/customers", R"({"name": "P"})",
+                       {{"Origin", "https://scanner.shop.example"}, {"X-Forwarded-Host", "scanner.shop.example"}})
+                .status,
+            201);
+}
+
+// Without a trusted proxy the X-Forwarded-* headers are the client's own words.
+TEST(ProxiedClients, ForwardedHeadersFromAnyoneElseAreIgnored) {
+  ServerUnderTest s;
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(login_from(s.port, "wrong guess " + std::to_string(i), {{"X-Forwarded-For", "10.0.1." + std::to_string(i)}})
+                  .status,
+              401);
+  EXPECT_EQ(login_from(s.port, kPassword, {{"X-Forwarded-For", "10.0.1.99"}}).status, 429);
+  Client admin = s.as("admin");
+  EXPECT_EQ(admin.request("POST", "/api/customers", R"({"name": "Q"})",
+                          {{"Origin", "https://evil.example"}, {"X-Forwarded-Host", "evil.example"}})
+                .status,
+            403);
+  const HttpReply plain = http(s.port, "POST", "/api/login",
+                               {{"Content-Type", "application/json"}, {"X-Forwarded-Proto", "https"}},
+                               std::string(R"({"username": "tailor", "password": ")") + kPassword + R"("})");
+  ASSERT_EQ(plain.status, 200);
+  EXPECT_EQ(plain.header("set-cookie").find("; Secure"), std::string::npos) << "plain HTTP all the way";
+}
+
 // True once the server has closed the socket (within `wait`); false while it is
 // open. Messages that arrive meanwhile (events, previews) are skipped.
 bool closed_within(EventStream& events, std::chrono::milliseconds wait) {
