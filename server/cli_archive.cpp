@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/ply.hpp"
 #include "server/pipeline/archive_scan.hpp"
+#include "server/workstation/erasure.hpp"
 #include "storage/archive/archive.hpp"
 #include "storage/formats/draco_files.hpp"
 #include "storage/formats/measurement_sheet.hpp"
@@ -31,7 +34,8 @@ void usage(FILE* out) {
       "  verify                   repairs what a crash left (on open), then checks the\n"
       "                           database and every file against its checksum\n"
       "  export CUSTOMER DEST     everything held about a customer, into DEST\n"
-      "  erase CUSTOMER --yes     deletes a customer and everything derived from them\n"
+      "  erase CUSTOMER --yes     deletes a customer, everything derived from them and\n"
+      "                           their scans' share links\n"
       "  delete-scan SCAN --yes   deletes one scan\n"
       "  reprocess SCAN           the scan again from its raw record, as a new version\n"
       "  mesh SCAN -o OUT         the scan's surface as .ply, .obj, .stl (mm) or .glb\n"
@@ -166,7 +170,16 @@ int run_archive(int argc, char** argv) {
       std::fprintf(stderr, "bodyscan archive %s: this cannot be undone; add --yes\n", cmd.c_str());
       return 2;
     }
-    const Status s = cmd == "erase" ? ar.delete_customer(args[2], actor) : ar.delete_scan(args[2], actor);
+    // The workstation keeps its share links beside the archive; they go too.
+    std::unique_ptr<server::AuthStore> accounts;
+    const std::string accounts_path = args[0] + "/accounts.db";
+    if (std::filesystem::exists(accounts_path)) {
+      auto opened_accounts = server::AuthStore::open(accounts_path);
+      if (!opened_accounts.ok()) return fail(opened_accounts.status());
+      accounts = std::move(*opened_accounts);
+    }
+    const Status s = cmd == "erase" ? server::erase_customer(ar, accounts.get(), args[2], actor)
+                                    : server::erase_scan(ar, accounts.get(), args[2], actor);
     if (!s.ok()) return fail(s);
     std::printf("%s %s\n", cmd == "erase" ? "erased customer" : "deleted scan", args[2].c_str());
     return 0;

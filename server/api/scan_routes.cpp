@@ -9,6 +9,7 @@
 #include "server/api/scan_views.hpp"
 #include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/evaluate_measurement.hpp"
+#include "server/workstation/erasure.hpp"
 #include "storage/formats/measurement_sheet.hpp"
 
 namespace bodyscan::server {
@@ -182,17 +183,10 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                      }});
   routes->push_back({"DELETE", "/api/customers/{id}", kAdmin, [](Workstation& ws, const Call& call) {
                        const std::string& id = call.params.at("id");
-                       storage::ScanQuery q;
-                       q.customer_id = id;
-                       q.limit = 1000000;
-                       auto scans = ws.archive().scans(q);
-                       if (!scans.ok()) return error_response(scans.status());
-                       // The links go first: a link must never outlive what it shows.
-                       for (const auto& s : *scans) {
-                         const Status st = ws.auth().delete_shares_of_scan(s.id);
-                         if (!st.ok()) return error_response(st);
-                       }
-                       const Status st = ws.archive().delete_customer(id, call.actor());
+                       if (auto j = ws.current_job(); j && j->customer_id == id)
+                         return error_response(409, "a job for customer " + id + " is running (scan " + j->scan_id +
+                                                        "); cancel it first");
+                       const Status st = erase_customer(ws.archive(), &ws.auth(), id, call.actor());
                        if (!st.ok()) return error_response(st);
                        return no_content();
                      }});
@@ -222,10 +216,7 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                        const std::string& id = call.params.at("id");
                        if (auto j = ws.current_job(); j && j->scan_id == id)
                          return error_response(409, "scan " + id + " is being processed; cancel the job first");
-                       auto r = ws.archive().scan(id);
-                       if (!r.ok()) return error_response(r.status());
-                       Status st = ws.auth().delete_shares_of_scan(id);
-                       if (st.ok()) st = ws.archive().delete_scan(id, call.actor());
+                       const Status st = erase_scan(ws.archive(), &ws.auth(), id, call.actor());
                        if (!st.ok()) return error_response(st);
                        return no_content();
                      }});

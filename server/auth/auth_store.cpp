@@ -817,7 +817,10 @@ Status AuthStore::revoke_share(const std::string& share_id) {
 Status AuthStore::delete_shares_of_scan(const std::string& scan_id) {
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("DELETE FROM shares WHERE scan_id = ?"));
-  return st.bind(1, scan_id).run();
+  RETURN_IF_ERROR(st.bind(1, scan_id).run());
+  // An erased scan's id must not linger in the write-ahead log (secure_delete
+  // already overwrites the freed pages of the database itself).
+  return impl_->db.exec("PRAGMA wal_checkpoint(TRUNCATE)");
 }
 
 }  // namespace bodyscan::server

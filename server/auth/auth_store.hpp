@@ -153,7 +153,9 @@ class AuthStore {
   std::optional<ShareLink> share_by_token(const std::string& token);  // unexpired and not revoked
   StatusOr<std::vector<ShareLink>> shares(const std::string& scan_id) const;  // all, oldest first
   Status revoke_share(const std::string& share_id);          // not_found if unknown
-  Status delete_shares_of_scan(const std::string& scan_id);  // when a scan or customer is erased
+  // When a scan or customer is erased (server/workstation/erasure.hpp); the
+  // write-ahead log is checkpointed and truncated after.
+  Status delete_shares_of_scan(const std::string& scan_id);
 
  private:
   struct Impl;

@@ -683,7 +683,8 @@ Status Archive::delete_scan(const std::string& id, const std::string& actor) {
     RETURN_IF_ERROR(tx.commit());
   }
   impl_->discard(impl_->scan_dir(id));
-  return Status::Ok();
+  // Nothing of it may linger in the write-ahead log either.
+  return impl_->db.exec("PRAGMA wal_checkpoint(TRUNCATE)");
 }
 
 StatusOr<ScanRecord> Archive::scan(const std::string& id) const {

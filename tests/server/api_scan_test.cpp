@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <thread>
 
@@ -428,6 +431,35 @@ TEST(ApiScan, AdminErasesACustomer) {
   EXPECT_EQ(admin.get("/api/scans/" + s.scan_id).status, 404);
   EXPECT_EQ(http(s.port, "GET", "/api/share/" + token).status, 404);
   EXPECT_EQ(admin.del("/api/customers/" + s.customer_id).status, 404);
+}
+
+// Erasure while the customer is in the rig is refused (the scan would go on
+// writing their data); once the job ends, nothing of theirs is left in any file
+// of the data folder, write-ahead logs included.
+TEST(ApiScan, ErasureWaitsForTheRunningScanAndLeavesNothingBehind) {
+  ServerUnderTest s(12);
+  Client admin = s.as("admin");
+  const std::string token = parse(admin.post("/api/scans/" + s.scan_id + "/shares", "{}"))["token"];
+  ASSERT_FALSE(token.empty());
+  const HttpReply started = admin.post("/api/scans", "{\"customer_id\": \"" + s.customer_id + "\"}");
+  ASSERT_EQ(started.status, 202) << started.body;
+  const std::string job = parse(started)["job"]["id"], running_scan = parse(started)["job"]["scan_id"];
+  const HttpReply refused = admin.del("/api/customers/" + s.customer_id);
+  EXPECT_EQ(refused.status, 409) << refused.body;
+  EXPECT_NE(parse(refused)["error"]["message"].get<std::string>().find("cancel"), std::string::npos);
+  EXPECT_EQ(admin.del("/api/scans/" + running_scan).status, 409);
+  EXPECT_EQ(admin.post("/api/jobs/" + job + "/cancel").status, 202);
+  wait_job(admin, job, 60);
+  ASSERT_EQ(admin.del("/api/customers/" + s.customer_id).status, 204);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + token).status, 404);
+  std::string everything;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(s.data))
+    if (e.is_regular_file()) {
+      std::ifstream in(e.path(), std::ios::binary);
+      everything.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+  for (const std::string& gone : {s.scan_id, running_scan, s.customer_id, std::string("Demo Customer")})
+    EXPECT_EQ(everything.find(gone), std::string::npos) << gone << " is still in the data folder";
 }
 
 }  // namespace
