@@ -244,7 +244,7 @@ if [[ -d "$DATA_DIR" ]]; then
   say "$DATA_DIR exists"
 else
   say "creating $DATA_DIR"
-  run install -d -m 0750 -o "$SERVICE_USER" -g "$SERVICE_USER" "$DATA_DIR"
+  run install -d -m 0700 -o "$SERVICE_USER" -g "$SERVICE_USER" "$DATA_DIR"
 fi
 
 # ---- reload ----------------------------------------------------------------------

@@ -4,6 +4,7 @@
 // lasers off and closes cleanly.
 #include <signal.h>
 #include <sodium.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include <cstdio>
@@ -166,6 +167,9 @@ int run_serve(int argc, char** argv) {
   for (int stop : kStopSignals) sigaddset(&stop_signals, stop);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
+  // Everything the workstation writes (the archive, accounts, logs of people's
+  // scans) is for its own user only, however it was started.
+  umask(0077);
 
   auto ws = server::Workstation::open(wo);
   if (!ws.ok()) {
@@ -186,14 +190,23 @@ int run_serve(int argc, char** argv) {
     }
     if (!(env && *env)) {
       const std::string file = wo.data_dir + "/first-admin-password";
-      const Status w = write_file_atomically(file, password + "\n");
-      if (w.ok()) chmod(file.c_str(), 0600);
+      const Status w = write_file_atomically(file, password + "\n", FileAccess::kPrivate);
+      if (!w.ok()) std::fprintf(stderr, "bodyscan serve: %s\n", w.message().c_str());
       std::printf("first admin account: %s, password %s (also in %s; change it after logging in)\n", admin.c_str(),
                   password.c_str(), file.c_str());
     } else {
       std::printf("first admin account: %s (password from BODYSCAN_ADMIN_PASSWORD)\n", admin.c_str());
     }
   }
+  // The made-up first password is kept on disk only until it stops working.
+  const std::string first_password_file = wo.data_dir + "/first-admin-password";
+  (*ws)->auth().watch_sessions([first_password_file, admin](const server::SessionChange& change) {
+    if (change.reason != server::SessionChange::kPassword && change.reason != server::SessionChange::kDeleted) return;
+    if (strcasecmp(change.username.c_str(), admin.c_str()) != 0) return;
+    if (std::remove(first_password_file.c_str()) == 0)
+      std::fprintf(stderr, "bodyscan serve: %s removed: the password in it no longer works\n",
+                   first_password_file.c_str());
+  });
   server::Api api(**ws, ao);
   auto http = server::HttpServer::start(api, **ws, no);
   if (!http.ok()) {

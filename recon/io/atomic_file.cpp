@@ -1,6 +1,7 @@
 #include "recon/io/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -30,14 +31,24 @@ StatusOr<std::string> read_whole_file(const std::string& path) {
   return bytes;
 }
 
-Status write_file_atomically(const std::string& path, std::string_view bytes) {
+Status write_file_atomically(const std::string& path, std::string_view bytes, FileAccess access) {
   // A reader (or a crash) must never see half a file: write beside the target,
   // make it durable, then rename over the target in one step.
   const std::string temp = path + ".tmp-" + std::to_string(::getpid());
-  std::FILE* f = std::fopen(temp.c_str(), "wb");
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC,
+                        access == FileAccess::kPrivate ? 0600 : 0666);
+  std::FILE* f = fd < 0 ? nullptr : ::fdopen(fd, "wb");
   if (f == nullptr) {
     const int error = errno;
+    if (fd >= 0) ::close(fd);
     return io_error(path + ": cannot create " + temp + ": " + errno_text(error));
+  }
+  // A temporary file left by a crash keeps its old mode; O_CREAT does not reset it.
+  if (access == FileAccess::kPrivate && ::fchmod(fd, 0600) != 0) {
+    const int error = errno;
+    std::fclose(f);
+    std::remove(temp.c_str());
+    return io_error(path + ": cannot make " + temp + " private: " + errno_text(error));
   }
   auto fail = [&](const std::string& what, int error) {
     if (f != nullptr) std::fclose(f);

@@ -535,7 +535,7 @@ Status AuthStore::set_password(const std::string& username, const std::string& p
     RETURN_IF_ERROR(impl_->delete_sessions_of(username));
     RETURN_IF_ERROR(tx.commit());
   }
-  impl_->notify({stored_name, ""});
+  impl_->notify({SessionChange::kPassword, stored_name, ""});
   return Status::Ok();
 }
 
@@ -559,7 +559,7 @@ Status AuthStore::set_role(const std::string& username, Role role) {
     RETURN_IF_ERROR(tx.commit());
     stored_name = existing->username;
   }
-  impl_->notify({stored_name, ""});
+  impl_->notify({SessionChange::kRole, stored_name, ""});
   return Status::Ok();
 }
 
@@ -584,7 +584,7 @@ Status AuthStore::delete_account(const std::string& username) {
     RETURN_IF_ERROR(tx.commit());
     stored_name = existing->username;
   }
-  impl_->notify({stored_name, ""});
+  impl_->notify({SessionChange::kDeleted, stored_name, ""});
   return Status::Ok();
 }
 
@@ -704,7 +704,7 @@ void AuthStore::logout(const std::string& token) {
     auto st = impl_->db.prepare("DELETE FROM sessions WHERE token_hash = ?");
     if (st.ok()) (void)st->bind(1, hash).run();
   }
-  impl_->notify({"", token});
+  impl_->notify({SessionChange::kLogout, "", token});
 }
 
 Status AuthStore::end_sessions(const std::string& username) {
@@ -712,7 +712,7 @@ Status AuthStore::end_sessions(const std::string& username) {
     std::lock_guard lock(impl_->mu);
     RETURN_IF_ERROR(impl_->delete_sessions_of(username));
   }
-  impl_->notify({username, ""});
+  impl_->notify({SessionChange::kEnded, username, ""});
   return Status::Ok();
 }
 

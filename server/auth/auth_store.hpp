@@ -71,8 +71,9 @@ struct NewShare {
 // or account deleted, end_sessions), or the one session `token` (logout). One of
 // the two is set.
 struct SessionChange {
-  std::string username;  // as stored
-  std::string token;     // the cookie value
+  enum Reason { kLogout, kEnded, kPassword, kRole, kDeleted } reason = kEnded;
+  std::string username;  // as stored (kLogout: empty)
+  std::string token;     // the cookie value (kLogout only)
 };
 
 struct AuthOptions {

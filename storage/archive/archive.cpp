@@ -404,16 +404,26 @@ std::string Archive::dir() const { return impl_->dir.string(); }
 StatusOr<std::unique_ptr<Archive>> Archive::open(const std::string& dir_in) {
   if (sodium_init() < 0) return internal_error("archive: libsodium failed to start");
   const fs::path dir = fs::absolute(dir_in);
+  RETURN_IF_ERROR(make_dirs(dir));
+  // People's names and bodies: the folder is its owner's alone, whatever the
+  // umask made of it (a copy made with rsync -a or cp -a keeps that too).
+  std::error_code perm_ec;
+  fs::permissions(dir, fs::perms::owner_all, fs::perm_options::replace, perm_ec);
+  if (perm_ec) return io_error("archive: cannot make " + dir.string() + " private: " + perm_ec.message());
   RETURN_IF_ERROR(make_dirs(dir / "scans"));
   RETURN_IF_ERROR(make_dirs(dir / "calibrations"));
+  // Created private before SQLite opens it (SQLite gives its -wal and -shm the
+  // database's mode).
+  const std::string db_path = (dir / "archive.db").string();
+  if (const int db_fd = ::open(db_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600); db_fd >= 0) ::close(db_fd);
   const std::string lock_path = (dir / "archive.lock").string();
-  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
   if (fd < 0) return io_error("archive: cannot open " + lock_path + ": " + std::strerror(errno));
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     ::close(fd);
     return unavailable("archive: " + dir.string() + " is in use by another bodyscan process");
   }
-  auto db = Database::open((dir / "archive.db").string());
+  auto db = Database::open(db_path);
   if (!db.ok()) {
     ::close(fd);
     return db.status();

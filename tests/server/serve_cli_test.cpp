@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -140,6 +142,39 @@ TEST(ServeCli, HangupQuitAndUsr1StopInOrderLikeSigterm) {
     EXPECT_NE(log.find(std::string(name) + ": stopping"), std::string::npos) << log;
     EXPECT_NE(log.find("stopped cleanly"), std::string::npos) << log;
   }
+}
+
+// A made-up first password is written where only the service's user can read
+// it, and removed as soon as it stops working.
+TEST(ServeCli, TheFirstAdminPasswordFileIsPrivateAndGoesWhenThePasswordChanges) {
+  const std::string data = temp_dir();
+  Child child = start_serve(data, "");  // no BODYSCAN_ADMIN_PASSWORD: one is made up
+  ASSERT_GT(child.pid, 0);
+  std::string log;
+  const int port = read_port(child.out, &log);
+  ASSERT_GT(port, 0) << log;
+  const std::string file = data + "/first-admin-password";
+  struct stat st {};
+  ASSERT_EQ(stat(file.c_str(), &st), 0) << log;
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  ASSERT_EQ(stat(data.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0077, 0u) << "the data folder is the service's alone";
+  std::string password;
+  {
+    std::ifstream in(file);
+    std::getline(in, password);
+  }
+  Client admin = login(port, "admin", password);
+  ASSERT_FALSE(admin.cookie.empty()) << "the file holds the working password";
+  // Another account changing its password leaves the file alone.
+  ASSERT_EQ(admin.post("/api/accounts", R"({"username": "zoe", "password": "zoes long password", "role": "tailor"})")
+                .status,
+            201);
+  ASSERT_EQ(admin.put("/api/accounts/zoe", R"({"password": "zoes new long password"})").status, 200);
+  EXPECT_EQ(stat(file.c_str(), &st), 0);
+  ASSERT_EQ(admin.put("/api/accounts/admin", R"({"password": "the admin's own password"})").status, 200);
+  EXPECT_NE(stat(file.c_str(), &st), 0) << "the old password no longer works; its file is gone";
+  signal_and_wait(child, SIGTERM, &log);
 }
 
 // A server out of descriptors (clients hold every one the process may open)

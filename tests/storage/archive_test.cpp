@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -57,6 +58,27 @@ std::string everything(const fs::path& dir) {
   for (const auto& e : fs::recursive_directory_iterator(dir))
     if (e.is_regular_file()) all += slurp(e.path());
   return all;
+}
+
+// People's names and bodies: whatever the umask, the archive's folder is its
+// owner's alone and its database is created private (SQLite gives the -wal and
+// -shm files the database's mode).
+TEST(Archive, ItsFolderAndDatabaseArePrivate) {
+  const mode_t old_mask = umask(0022);
+  const std::string dir = testing::temp_dir() + "/archive";
+  fs::create_directories(dir);
+  fs::permissions(dir, fs::perms::all);  // left open by someone
+  {
+    auto a = Archive::open(dir);
+    ASSERT_TRUE(a.ok()) << a.status().message();
+    ASSERT_TRUE((*a)->add_customer(std::string("Private Person"), std::nullopt, "test").ok());
+    EXPECT_EQ(fs::status(dir).permissions(), fs::perms::owner_all);
+    for (const char* name : {"archive.db", "archive.db-wal", "archive.lock"})
+      EXPECT_EQ(fs::status(dir + "/" + name).permissions() & (fs::perms::group_all | fs::perms::others_all),
+                fs::perms::none)
+          << name;
+  }
+  umask(old_mask);
 }
 
 TEST(Archive, AScanIsStoredWithItsRecordsFilesAndChecksums) {
