@@ -24,6 +24,8 @@
 #include <limits>
 #include <system_error>
 #include <type_traits>
+#include <unordered_map>
+#include <unordered_set>
 
 namespace bodyscan {
 
@@ -208,6 +210,13 @@ void split_tokens(std::string_view line, std::vector<std::string_view>* tokens) 
   }
 }
 
+// Lines a header may have, comments included. Real files declare a few elements
+// with at most some dozens of properties; the cap turns a runaway or hostile header
+// into a clear error instead of a long parse.
+constexpr int kMaxHeaderLines = 10000;
+
+// Linear in the header's length: duplicate element and property names are found
+// through hash sets of views into `bytes`.
 StatusOr<PlyHeader> parse_header(std::string_view bytes) {
   if (bytes.empty()) return invalid_argument("empty file; a PLY file starts with the line 'ply'");
   size_t pos;
@@ -224,6 +233,8 @@ StatusOr<PlyHeader> parse_header(std::string_view bytes) {
   bool have_format = false;
   int line_no = 1;
   std::vector<std::string_view> tokens;
+  std::unordered_map<std::string_view, int> element_lines;  // name -> header line
+  std::unordered_set<std::string_view> property_names;      // of the last element
   auto at_line = [&](const std::string& what) {
     return invalid_argument("header line " + std::to_string(line_no) + ": " + what);
   };
@@ -238,6 +249,10 @@ StatusOr<PlyHeader> parse_header(std::string_view bytes) {
     std::string_view line = bytes.substr(pos, end - pos);
     pos = last_line ? end : end + 1;
     ++line_no;
+    if (line_no > kMaxHeaderLines) {
+      return at_line("no end_header within " + std::to_string(kMaxHeaderLines) +
+                     " lines: the header is longer than any real PLY file's");
+    }
     split_tokens(line, &tokens);
     if (tokens.empty()) continue;
     const std::string_view keyword = tokens[0];
@@ -279,13 +294,13 @@ StatusOr<PlyHeader> parse_header(std::string_view bytes) {
         return at_line("element " + quoted(tokens[1]) + " count " + quoted(count) +
                        " is not a non-negative integer");
       }
-      for (const PlyElement& e : header.elements) {
-        if (e.name == element.name) {
-          return at_line("element " + quoted(element.name) + " is declared twice (also on line " +
-                         std::to_string(e.line) + ")");
-        }
+      const auto [first, added] = element_lines.emplace(tokens[1], line_no);
+      if (!added) {
+        return at_line("element " + quoted(element.name) + " is declared twice (also on line " +
+                       std::to_string(first->second) + ")");
       }
       header.elements.push_back(std::move(element));
+      property_names.clear();
     } else if (keyword == "property") {
       if (header.elements.empty()) return at_line("a property before any element");
       PlyProperty property;
@@ -312,7 +327,7 @@ StatusOr<PlyHeader> parse_header(std::string_view bytes) {
         property.name = std::string(tokens[2]);
       }
       PlyElement& element = header.elements.back();
-      if (element.find(property.name) != nullptr) {
+      if (!property_names.insert(tokens.back()).second) {
         return at_line("element " + quoted(element.name) + " has two properties named " +
                        quoted(property.name));
       }

@@ -398,6 +398,44 @@ TEST(PlyBadInputTest, RandomByteFlips) {
   EXPECT_LT(parsed, 2000);
 }
 
+// A header of `lines` element, property and comment lines after a vertex element,
+// then end_header; every count is 0, so the file is valid whatever its length.
+std::string long_header(int lines) {
+  std::string s = kBinaryStart + "element vertex 0\n" + kXyz;
+  for (int i = 0; i < lines; ++i) {
+    if (i % 3 == 0) s += "element e" + std::to_string(i) + " 0\n";
+    else if (i % 3 == 1) s += "property float p" + std::to_string(i) + "\n";
+    else s += "comment line " + std::to_string(i) + "\n";
+  }
+  return s + "end_header\n";
+}
+
+TEST(PlyBadInputTest, OverlongHeaderIsRefused) {
+  EXPECT_ERROR_CONTAINS(long_header(100000),
+                        "header line 10001: no end_header within 10000 lines: the header is longer than any "
+                        "real PLY file's");
+}
+
+TEST(PlyBadInputTest, LongHeaderUnderTheCapIsReadWithItsDuplicatesFound) {
+  // 9,990 lines, under the cap: valid, and the duplicate checks still see names
+  // declared thousands of lines apart.
+  auto data = parse_ply(long_header(9980), "long.ply");
+  ASSERT_TRUE(data.ok()) << data.status().message();
+  EXPECT_EQ(data->cloud.size(), 0u);
+
+  std::string many = kBinaryStart + "element vertex 0\n" + kXyz + "element wide 0\n";
+  for (int i = 0; i < 9000; ++i) many += "property uchar p" + std::to_string(i) + "\n";
+  EXPECT_TRUE(parse_ply(many + "end_header\n").ok());
+  // Line 9008 follows ply, format, vertex and its three properties, 'wide' (line 7)
+  // and its 9,000 properties.
+  EXPECT_ERROR_CONTAINS(many + "property int p17\nend_header\n",
+                        "header line 9008: element 'wide' has two properties named 'p17'");
+  // A property of the same name in another element is no duplicate.
+  EXPECT_TRUE(parse_ply(many + "element other 0\nproperty int p17\nend_header\n").ok());
+  EXPECT_ERROR_CONTAINS(many + "element wide 0\nend_header\n",
+                        "header line 9008: element 'wide' is declared twice (also on line 7)");
+}
+
 TEST(PlyBadInputTest, WriteIntoMissingDirectory) {
   const std::string dir = testing::temp_dir();
   const std::string path = dir + "/missing/sub/points.ply";
