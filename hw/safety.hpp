@@ -9,6 +9,14 @@
 // server stopping) go through Controller::all_lasers_off and LasersOff instead.
 // SIGKILL and power loss cannot be caught: the board-side watchdog covers them
 // (hw/usb/tmcl_controller.hpp).
+//
+// A handler needs stack to run on, and a thread whose stack overflowed has none
+// left: the kernel then ends the process without running any handler. So the
+// handlers run on an alternate signal stack (sigaltstack), which is per thread:
+// the thread that installs the handlers gets one for the life of the process, and
+// every other thread that may crash with the lasers on must get its own with
+// ensure_alternate_signal_stack. TmclController does that on each thread that
+// switches a laser on, so the thread driving the rig always has one.
 #pragma once
 
 namespace bodyscan::hw {
@@ -27,5 +35,10 @@ void run_emergency_stops() noexcept;
 // false in a process that handles them itself (`bodyscan serve` takes them with
 // sigwait and stops in order).
 void install_laser_safety_handlers(bool termination_signals);
+
+// Gives the calling thread an alternate signal stack, unless it has one, kept until
+// the thread ends. Cheap after the first call on a thread. False when the thread
+// has none (out of memory).
+bool ensure_alternate_signal_stack();
 
 }  // namespace bodyscan::hw

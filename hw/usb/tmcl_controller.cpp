@@ -118,6 +118,7 @@ TmclController::~TmclController() {
 }
 
 void TmclController::feed_loop() {
+  ensure_alternate_signal_stack();
   const auto period = std::chrono::milliseconds(std::max(20, wiring_.watchdog_ms / 4));
   std::unique_lock lock(feed_mutex_);
   while (!stop_feeding_) {
@@ -161,6 +162,9 @@ Status TmclController::set_frame_light_circuits(bool front_poles, bool back_pole
 
 Status TmclController::set_laser(int laser, bool on) {
   RETURN_IF_ERROR(check_laser(laser));
+  // A crash on this thread while the laser is on must still reach the handlers,
+  // stack overflow included (hw/safety.hpp).
+  if (on) ensure_alternate_signal_stack();
   Status st;
   {
     std::lock_guard lock(mutex_);

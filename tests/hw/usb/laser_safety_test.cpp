@@ -2,12 +2,13 @@
 // process that opens the rig's TMCL controller over a pseudo-terminal, switches a
 // laser on and then dies a different way. The board (here, in the parent) must
 // see the laser off:
-// - by the process's own emergency stop (crash signals, std::terminate, SIGTERM,
-//   SIGINT) - with the board's watchdog set to a minute, so only that path can
-//   have done it, and fast;
+// - by the process's own emergency stop (crash signals, a stack overflow on the
+//   main thread or another, std::terminate, SIGTERM, SIGINT, SIGHUP) - with the
+//   board's watchdog set to a minute, so only that path can have done it, and fast;
 // - by the board's watchdog when nothing in the process can run (SIGKILL).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -25,7 +26,23 @@ namespace {
 
 using namespace std::chrono_literals;
 
-enum class Death { kSegfault, kAbort, kTerminate, kSigterm, kSigint, kSigkill };
+enum class Death {
+  kSegfault, kAbort, kTerminate, kSigterm, kSigint, kSigkill, kSighup,
+  kStackOverflow,               // on the main thread, which installed the handlers
+  kStackOverflowOnRigThread,    // on a thread that switched the laser on
+  kStackOverflowOnOtherThread,  // on a thread that asked for an alternate stack
+};
+
+// Recursion the optimiser can neither drop nor turn into a loop: whether to go
+// deeper is a volatile read, and each frame's volatile buffer is read after the
+// call returns.
+volatile bool g_deeper = true;
+[[gnu::noinline]] int overflow_stack(int depth) {
+  volatile char frame[1024];
+  frame[0] = static_cast<char>(depth);
+  const int below = g_deeper ? overflow_stack(depth + 1) : depth;
+  return below + frame[0];
+}
 
 // Runs the child; returns its wait status. `laser_output` is the board output of
 // laser 0.
@@ -37,17 +54,48 @@ int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoar
   if (pid == 0) {
     close(ready[0]);
     close(go[1]);
+    // No core files; and a main-thread stack that overflows at 8 MiB even where
+    // the limit is larger or unlimited.
+    const rlimit no_core{0, 0};
+    setrlimit(RLIMIT_CORE, &no_core);
+    rlimit stack{};
+    if (getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur > (8u << 20)) {
+      stack.rlim_cur = 8u << 20;
+      setrlimit(RLIMIT_STACK, &stack);
+    }
     install_laser_safety_handlers(true);
     auto c = TmclController::open(testing::tmcl_rig(port, watchdog_ms));
-    if (!c.ok() || !(*c)->set_laser(0, true).ok()) _exit(3);
-    const char one = 1;
-    (void)!write(ready[1], &one, 1);
-    char wait_for_parent = 0;
-    (void)!read(go[0], &wait_for_parent, 1);  // until the parent has seen the laser on
+    if (!c.ok()) _exit(3);
+    auto switch_on_and_wait = [&] {
+      if (!(*c)->set_laser(0, true).ok()) _exit(3);
+      const char one = 1;
+      (void)!write(ready[1], &one, 1);
+      char wait_for_parent = 0;
+      (void)!read(go[0], &wait_for_parent, 1);  // until the parent has seen the laser on
+    };
+    switch (death) {
+      case Death::kStackOverflowOnRigThread:
+        std::thread([&] {
+          switch_on_and_wait();
+          overflow_stack(0);
+        }).join();
+        break;
+      case Death::kStackOverflowOnOtherThread:
+        switch_on_and_wait();
+        std::thread([] {
+          ensure_alternate_signal_stack();
+          overflow_stack(0);
+        }).join();
+        break;
+      default:
+        switch_on_and_wait();
+        break;
+    }
     switch (death) {
       case Death::kSegfault: raise(SIGSEGV); break;
       case Death::kAbort: std::abort();
       case Death::kTerminate: std::terminate();
+      case Death::kStackOverflow: overflow_stack(0); break;
       default: break;
     }
     for (;;) pause();  // the parent signals it
@@ -63,6 +111,7 @@ int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoar
   if (death == Death::kSigterm) kill(pid, SIGTERM);
   if (death == Death::kSigint) kill(pid, SIGINT);
   if (death == Death::kSigkill) kill(pid, SIGKILL);
+  if (death == Death::kSighup) kill(pid, SIGHUP);
   int status = 0;
   waitpid(pid, &status, 0);
   return status;
@@ -79,7 +128,10 @@ double off_within(SimTmclBoard& board, int output, std::chrono::milliseconds lim
 }
 
 std::string death_name(const ::testing::TestParamInfo<std::pair<Death, int>>& p) {
-  static const char* const names[] = {"Segfault", "Abort", "Terminate", "Sigterm", "Sigint", "Sigkill"};
+  static const char* const names[] = {"Segfault", "Abort",         "Terminate",
+                                      "Sigterm",  "Sigint",        "Sigkill",
+                                      "Sighup",   "StackOverflow", "StackOverflowOnTheRigThread",
+                                      "StackOverflowOnAnotherThread"};
   return names[static_cast<int>(p.param.first)];
 }
 
@@ -112,7 +164,10 @@ TEST_P(LaserSafety, LaserGoesOffWhenTheProcessDies) {
 INSTANTIATE_TEST_SUITE_P(EveryDeath, LaserSafety,
                          ::testing::Values(std::pair{Death::kSegfault, SIGSEGV}, std::pair{Death::kAbort, SIGABRT},
                                            std::pair{Death::kTerminate, SIGABRT}, std::pair{Death::kSigterm, SIGTERM},
-                                           std::pair{Death::kSigint, SIGINT}, std::pair{Death::kSigkill, SIGKILL}),
+                                           std::pair{Death::kSigint, SIGINT}, std::pair{Death::kSigkill, SIGKILL},
+                                           std::pair{Death::kSighup, SIGHUP}, std::pair{Death::kStackOverflow, SIGSEGV},
+                                           std::pair{Death::kStackOverflowOnRigThread, SIGSEGV},
+                                           std::pair{Death::kStackOverflowOnOtherThread, SIGSEGV}),
                          death_name);
 
 TEST(LaserSafetyInProcess, ExceptionUnwindingThroughLasersOff) {
