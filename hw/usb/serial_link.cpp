@@ -75,12 +75,20 @@ Status SerialLink::write(const uint8_t* data, size_t size, std::chrono::millisec
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   size_t done = 0;
   while (done < size) {
-    const ssize_t n = ::write(fd_, data + done, size - done);
+    ssize_t n = 0;
+    int err = 0;
+    {
+      WireLedger::Send send(ledger_);
+      if (!send.open()) return unavailable("the controller on " + path_ + " is taken by the emergency stop");
+      n = ::write(fd_, data + done, size - done);
+      err = errno;
+      if (n > 0) send.sent(data + done, static_cast<size_t>(n));
+    }
     if (n > 0) {
       done += static_cast<size_t>(n);
       continue;
     }
-    if (n < 0 && errno != EAGAIN && errno != EINTR) return gone("write", errno);
+    if (n < 0 && err != EAGAIN && err != EINTR) return gone("write", err);
     pollfd p{fd_, POLLOUT, 0};
     const int r = ::poll(&p, 1, remaining_ms(deadline));
     if (r == 0) return deadline_exceeded("the controller on " + path_ + " does not take commands");
@@ -125,8 +133,12 @@ bool SerialLink::emergency_write(const uint8_t* data, size_t size) noexcept {
   size_t done = 0;
   for (int tries = 0; done < size && tries < 50; ++tries) {
     const ssize_t n = ::write(fd_, data + done, size - done);
-    if (n > 0) done += static_cast<size_t>(n);
-    else if (n < 0 && errno != EAGAIN && errno != EINTR) return false;
+    if (n > 0) {
+      ledger_.record(data + done, static_cast<size_t>(n));
+      done += static_cast<size_t>(n);
+    } else if (n < 0 && errno != EAGAIN && errno != EINTR) {
+      return false;
+    }
   }
   if (done == size) tcdrain(fd_);
   return done == size;

@@ -5,6 +5,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -214,6 +215,7 @@ std::optional<Frame> SimTmclBoard::handle(const Frame& request) {
   if (request[0] != address_) return std::nullopt;  // another module on the bus
   Frame out;
   if (!checksum_ok(request)) {
+    ++checksum_errors_;
     out = encode(Reply{2, address_, kWrongChecksum, request[1], 0});
   } else if (request[1] == kGetFirmwareVersion && request[2] == 0) {
     out = Frame{2, '6', '1', '1', '0', 'V', '1', '3', '0'};
@@ -221,7 +223,11 @@ std::optional<Frame> SimTmclBoard::handle(const Frame& request) {
     out = encode(Reply{2, address_, refuse, request[1], 0});
   } else {
     std::lock_guard lock(mutex_);
-    out = encode(execute(decode_request(request)));
+    const Request r = decode_request(request);
+    executed_.push_back(r);
+    if (executed_.size() > kExecutedKept) executed_.pop_front();
+    ++executed_count_;
+    out = encode(execute(r));
   }
   if (garble_ > 0) {
     --garble_;
@@ -243,6 +249,15 @@ bool SimTmclBoard::application_running() const {
   std::lock_guard lock(mutex_);
   return running_program_;
 }
+uint64_t SimTmclBoard::executed_count() const {
+  std::lock_guard lock(mutex_);
+  return executed_count_;
+}
+std::vector<Request> SimTmclBoard::last_executed(size_t n) const {
+  std::lock_guard lock(mutex_);
+  n = std::min(n, executed_.size());
+  return std::vector<Request>(executed_.end() - static_cast<std::ptrdiff_t>(n), executed_.end());
+}
 int32_t SimTmclBoard::user_variable(int i) const {
   std::lock_guard lock(mutex_);
   return user_vars_.at(static_cast<size_t>(i));
@@ -252,6 +267,14 @@ int32_t SimTmclBoard::user_variable(int i) const {
 
 Status SimBoardLink::write(const uint8_t* data, size_t size, std::chrono::milliseconds) {
   if (unplugged_) return unavailable("the simulated board is unplugged");
+  WireLedger::Send send(ledger_);
+  if (!send.open()) return unavailable("the simulated board is taken by the emergency stop");
+  send.sent(data, size);
+  deliver(data, size);
+  return Status::Ok();
+}
+
+void SimBoardLink::deliver(const uint8_t* data, size_t size) {
   std::lock_guard lock(mutex_);
   pending_.insert(pending_.end(), data, data + size);
   while (pending_.size() >= 9) {
@@ -260,7 +283,6 @@ Status SimBoardLink::write(const uint8_t* data, size_t size, std::chrono::millis
     pending_.erase(pending_.begin(), pending_.begin() + 9);
     if (auto rep = board_.handle(f)) replies_.insert(replies_.end(), rep->begin(), rep->end());
   }
-  return Status::Ok();
 }
 
 Status SimBoardLink::read(uint8_t* data, size_t size, std::chrono::milliseconds timeout) {
@@ -287,10 +309,12 @@ bool SimBoardLink::emergency_write(const uint8_t* data, size_t size) noexcept {
   // Tests only: a real link's emergency path is a plain system call.
   if (unplugged_) return false;
   try {
-    return write(data, size, std::chrono::milliseconds(0)).ok();
+    deliver(data, size);
   } catch (...) {
     return false;
   }
+  ledger_.record(data, size);
+  return true;
 }
 
 // ---- behind a pseudo-terminal ----

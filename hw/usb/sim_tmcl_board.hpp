@@ -49,6 +49,14 @@ class SimTmclBoard {
   // Times any of the outputs in `mask` was switched on, and how many of those the
   // board's own program switched off.
   int watchdog_trips() const { return watchdog_trips_; }
+  // Frames refused for their checksum: answered "wrong checksum" and not run, as the
+  // TMCL reference says a module does.
+  uint64_t checksum_errors() const { return checksum_errors_; }
+  // Requests from the host the board has acted on (run, or stored in download
+  // mode), in order: how many, and the last `n` of them (at most kExecutedKept).
+  static constexpr size_t kExecutedKept = 256;
+  uint64_t executed_count() const;
+  std::vector<tmcl::Request> last_executed(size_t n) const;
 
   // Faults.
   void set_silent(bool silent) { silent_ = silent; }
@@ -84,6 +92,9 @@ class SimTmclBoard {
   bool compare_equal_ = true;
   double wait_left_s_ = 0;
   int watchdog_trips_ = 0;
+  std::deque<tmcl::Request> executed_;  // the last kExecutedKept
+  uint64_t executed_count_ = 0;
+  std::atomic<uint64_t> checksum_errors_{0};
   double speed_ = 20000;
   std::atomic<bool> silent_{false};
   std::atomic<int> garble_{0};
@@ -105,6 +116,7 @@ class SimBoardLink : public ByteLink {
   void unplug() { unplugged_ = true; }
 
  private:
+  void deliver(const uint8_t* data, size_t size);  // to the board, frame by frame
   SimTmclBoard& board_;
   std::string name_ = "the simulated board";
   std::mutex mutex_;

@@ -1,6 +1,7 @@
 #include "hw/usb/tmcl_controller.hpp"
 
 #include <cmath>
+#include <tuple>
 
 #include "hw/safety.hpp"
 #include "hw/usb/serial_link.hpp"
@@ -44,10 +45,11 @@ TmclController::TmclController(const RigDescription& rig, std::unique_ptr<ByteLi
               std::chrono::milliseconds(rig.controller.reply_timeout_ms)),
       laser_on_(rig.lasers.size()),
       homed_(rig.lasers.size(), false) {
+  emergency_bytes_.assign(std::tuple_size_v<Frame>, 0);
   for (const auto& w : wiring_.lasers) {
     const Frame f = encode(Request{static_cast<uint8_t>(wiring_.module_address), kSIO, static_cast<uint8_t>(w.output),
                                    kBankOutputs, 0});
-    off_frames_.insert(off_frames_.end(), f.begin(), f.end());
+    emergency_bytes_.insert(emergency_bytes_.end(), f.begin(), f.end());
   }
 }
 
@@ -133,8 +135,28 @@ void TmclController::feed_loop() {
 }
 
 void TmclController::emergency_stop(void* self) noexcept {
+  // The board cuts the byte stream into 9-byte frames. A frame the normal path left
+  // half sent (a signal between two write(2)s, a write that timed out) would take
+  // the first bytes of the off frames as its tail, and every off frame after it
+  // would be read out of step. So that frame is completed first, with a checksum
+  // that cannot match: the board answers "wrong checksum" and runs nothing, and the
+  // off frames start on a frame boundary.
   auto* c = static_cast<TmclController*>(self);
-  c->link_->emergency_write(c->off_frames_.data(), c->off_frames_.size());
+  constexpr size_t kFrameSize = std::tuple_size_v<Frame>;
+  const WireLedger::Snapshot wire = c->link_->emergency_claim();
+  const auto have = static_cast<size_t>(wire.sent % kFrameSize);
+  uint8_t* out = c->emergency_bytes_.data() + kFrameSize;
+  size_t size = c->emergency_bytes_.size() - kFrameSize;
+  if (have > 0) {
+    const size_t missing = kFrameSize - have;
+    out -= missing;
+    size += missing;
+    unsigned sum = 0;  // of the frame's first eight bytes: those sent, then zeros
+    for (size_t i = WireLedger::kTail - have; i < WireLedger::kTail; ++i) sum += wire.tail[i];
+    for (size_t i = 0; i + 1 < missing; ++i) out[i] = 0;
+    out[missing - 1] = static_cast<uint8_t>(sum + 1);
+  }
+  c->link_->emergency_write(out, size);
 }
 
 Status TmclController::check_laser(int i) const {

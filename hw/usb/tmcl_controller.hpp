@@ -7,7 +7,8 @@
 // - every laser output is switched off when the controller opens and closes, and
 //   on any error the board reports;
 // - an emergency stop (hw/safety.hpp) is registered for the crash and signal
-//   paths: the prepared SIO frames written straight to the link;
+//   paths: the prepared SIO frames written straight to the link, after completing
+//   (with a checksum the board refuses) any frame the normal path left half sent;
 // - a board-side watchdog: a short TMCL program stored in the module and run by it
 //   switches every laser output off when the host has not fed it for
 //   `watchdog_ms` (killed process, hung machine, cable pulled while the board keeps
@@ -75,7 +76,9 @@ class TmclController : public Controller {
   std::unique_ptr<ByteLink> link_;
   mutable std::mutex mutex_;  // one request at a time on the link
   mutable tmcl::Client client_;
-  std::vector<uint8_t> off_frames_;  // SIO off for every laser output, prepared for the signal path
+  // For the signal path: room for the tail of a half-sent frame, then the SIO off
+  // frames of every laser output.
+  std::vector<uint8_t> emergency_bytes_;
   std::vector<std::atomic<bool>> laser_on_;
   std::vector<bool> homed_;
   std::string firmware_;

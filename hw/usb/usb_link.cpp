@@ -175,8 +175,16 @@ UsbLink::~UsbLink() {
 
 Status UsbLink::write(const uint8_t* data, size_t size, std::chrono::milliseconds timeout) {
   int sent = 0;
-  const int rc = libusb_bulk_transfer(handle_, out_ep_, const_cast<uint8_t*>(data), static_cast<int>(size), &sent,
-                                      static_cast<unsigned>(timeout.count()));
+  int rc = 0;
+  {
+    // A frame of up to a packet's size crosses USB whole or not at all; the ledger
+    // still counts what went, for a write of several packets cut short.
+    WireLedger::Send send(ledger_);
+    if (!send.open()) return unavailable("the controller " + name_ + " is taken by the emergency stop");
+    rc = libusb_bulk_transfer(handle_, out_ep_, const_cast<uint8_t*>(data), static_cast<int>(size), &sent,
+                              static_cast<unsigned>(timeout.count()));
+    if (sent > 0) send.sent(data, static_cast<size_t>(sent));
+  }
   if (rc != 0) return error("write", rc);
   if (static_cast<size_t>(sent) != size) return deadline_exceeded("the controller " + name_ + " took only part of a command");
   return Status::Ok();
@@ -216,7 +224,9 @@ bool UsbLink::emergency_write(const uint8_t* data, size_t size) noexcept {
   bulk.len = static_cast<unsigned>(size);
   bulk.timeout = 200;
   bulk.data = const_cast<uint8_t*>(data);
-  return ioctl(fd_, USBDEVFS_BULK, &bulk) == static_cast<int>(size);
+  const int sent = ioctl(fd_, USBDEVFS_BULK, &bulk);
+  if (sent > 0) ledger_.record(data, static_cast<size_t>(sent));
+  return sent == static_cast<int>(size);
 }
 
 }  // namespace bodyscan::hw::usb

@@ -187,5 +187,81 @@ TEST(LaserSafetyInProcess, ExceptionUnwindingThroughLasersOff) {
   EXPECT_FALSE(board.output(rig.controller.lasers[1].output));
 }
 
+// The emergency stop after the normal path has put only the first `cut` bytes of
+// a frame on the wire (here a frame switching laser 1 on): the board must refuse
+// the completed frame for its checksum, then run exactly the off frames.
+void expect_resynchronised(SimTmclBoard& board, const RigDescription& rig, size_t cut, uint64_t ran_before,
+                           uint64_t refused_before) {
+  const auto& wiring = rig.controller.lasers;
+  EXPECT_EQ(board.checksum_errors(), refused_before + (cut > 0 ? 1 : 0))
+      << "the half-sent frame was not completed as a frame the board refuses";
+  ASSERT_EQ(board.executed_count(), ran_before + wiring.size())
+      << "the board ran something besides the off frames (a frame assembled from the cut one and the stop's bytes)";
+  const std::vector<tmcl::Request> last = board.last_executed(wiring.size());
+  for (size_t i = 0; i < wiring.size(); ++i) {
+    EXPECT_EQ(last[i].command, tmcl::kSIO);
+    EXPECT_EQ(last[i].type, wiring[i].output);
+    EXPECT_EQ(last[i].bank, tmcl::kBankOutputs);
+    EXPECT_EQ(last[i].value, 0);
+    EXPECT_FALSE(board.output(wiring[i].output)) << "laser " << i;
+  }
+}
+
+tmcl::Frame laser_on_frame(const RigDescription& rig, int laser) {
+  return tmcl::encode(tmcl::Request{static_cast<uint8_t>(rig.controller.module_address), tmcl::kSIO,
+                                    static_cast<uint8_t>(rig.controller.lasers[static_cast<size_t>(laser)].output),
+                                    tmcl::kBankOutputs, 1});
+}
+
+TEST(EmergencyStopResync, CompletesAHalfSentFrameAtEveryCut) {
+  for (size_t cut = 0; cut < 9; ++cut) {
+    SCOPED_TRACE("frame cut after " + std::to_string(cut) + " bytes");
+    SimTmclBoard board;
+    auto owned = std::make_unique<SimBoardLink>(board);
+    SimBoardLink* link = owned.get();
+    const RigDescription rig = testing::tmcl_rig("in process", 0);
+    auto c = TmclController::open(rig, std::move(owned));
+    ASSERT_TRUE(c.ok()) << c.status().message();
+    ASSERT_TRUE((*c)->set_laser(0, true).ok());
+    const tmcl::Frame on = laser_on_frame(rig, 1);
+    ASSERT_TRUE(link->write(on.data(), cut, std::chrono::milliseconds(0)).ok());
+    const uint64_t ran = board.executed_count(), refused = board.checksum_errors();
+
+    run_emergency_stops();
+    expect_resynchronised(board, rig, cut, ran, refused);
+
+    // The stop keeps the link: nothing switches a laser on behind it.
+    const Status again = (*c)->set_laser(1, true);
+    EXPECT_EQ(again.code(), StatusCode::kUnavailable) << again.message();
+    EXPECT_FALSE(board.output(rig.controller.lasers[1].output));
+  }
+}
+
+TEST(EmergencyStopResync, CompletesAHalfSentFrameOnASerialPort) {
+  SimTmclBoard board;
+  auto pty = PtyBoard::start(board);
+  ASSERT_TRUE(pty.ok());
+  const RigDescription rig = testing::tmcl_rig((*pty)->path(), 0);
+  auto owned = SerialLink::open((*pty)->path());
+  ASSERT_TRUE(owned.ok()) << owned.status().message();
+  SerialLink* link = owned->get();
+  auto c = TmclController::open(rig, std::move(*owned));
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  ASSERT_TRUE((*c)->set_laser(0, true).ok());
+  const tmcl::Frame on = laser_on_frame(rig, 1);
+  const size_t cut = 5;
+  ASSERT_TRUE(link->write(on.data(), cut, std::chrono::milliseconds(200)).ok());
+  const uint64_t ran = board.executed_count(), refused = board.checksum_errors();
+
+  run_emergency_stops();
+  // The board takes the bytes from the pseudo-terminal on its own thread.
+  const size_t expected = rig.controller.lasers.size();
+  const auto t0 = std::chrono::steady_clock::now();
+  while (board.executed_count() < ran + expected && std::chrono::steady_clock::now() - t0 < 2s) {
+    std::this_thread::sleep_for(1ms);
+  }
+  expect_resynchronised(board, rig, cut, ran, refused);
+}
+
 }  // namespace
 }  // namespace bodyscan::hw::usb
