@@ -47,6 +47,9 @@ RTCGeometry attach_mesh(RTCDevice device, RTCScene scene, const std::vector<Vec3
     for (int k = 0; k < 3; ++k) ib[3 * i + k] = triangles[i][k];
   rtcCommitGeometry(g);
   rtcAttachGeometry(scene, g);
+  // The scene holds its own reference: the handle stays valid as long as the
+  // scene, and the geometry goes with it.
+  rtcReleaseGeometry(g);
   return g;
 }
 
