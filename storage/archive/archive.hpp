@@ -141,7 +141,9 @@ class Archive {
   // The calibration a running scan uses, when it was made for it (after begin_scan).
   Status set_scan_calibration(const std::string& scan_id, const std::string& calibration_id);
   Status complete_scan(const std::string& scan_id, const ScanResults& results);
-  // kFailed or kCancelled, with the reason; partial results are removed, raw data kept.
+  // kFailed or kCancelled, with the reason. The record and the reason stay; its
+  // files go, raw data included: a scan that did not complete keeps nothing of
+  // the person (and a cancelled one may be a customer who changed their mind).
   Status end_scan(const std::string& scan_id, ScanStatus status, const std::string& reason);
   // Reprocessing: a new version beside the old ones, which stay.
   StatusOr<int> add_version(const std::string& scan_id, const ScanResults& results, const std::string& actor);
