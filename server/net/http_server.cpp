@@ -10,7 +10,8 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/ssl.hpp>
 #include <boost/asio/strand.hpp>
-#include <boost/asio/thread_pool.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
@@ -27,6 +28,8 @@
 #include <thread>
 #include <utility>
 #include <vector>
+
+#include "hw/safety.hpp"
 
 namespace bodyscan::server {
 
@@ -70,12 +73,39 @@ bool same_username(const std::string& a, const std::string& b) {
 
 }  // namespace
 
+// The threads that run requests' work. Like asio::thread_pool, but each thread
+// first takes an alternate signal stack, so that a stack overflow in a request
+// still runs the lasers-off stops (hw/safety.hpp).
+class WorkerPool {
+ public:
+  explicit WorkerPool(int n) : guard_(asio::make_work_guard(ctx_)) {
+    for (int i = 0; i < n; ++i)
+      threads_.emplace_back([this]() {
+        hw::ensure_alternate_signal_stack();
+        ctx_.run();
+      });
+  }
+  ~WorkerPool() { join(); }
+  asio::io_context::executor_type get_executor() { return ctx_.get_executor(); }
+  // Runs what was queued, then ends the threads. Idempotent.
+  void join() {
+    guard_.reset();
+    for (std::thread& t : threads_)
+      if (t.joinable()) t.join();
+  }
+
+ private:
+  asio::io_context ctx_;
+  asio::executor_work_guard<asio::io_context::executor_type> guard_;
+  std::vector<std::thread> threads_;
+};
+
 // What every session shares: the API, the pool, the limits, the live WebSockets.
 struct Shared {
   Api& api;
   Workstation& ws;
   NetOptions options;
-  asio::thread_pool workers;
+  WorkerPool workers;
   std::mutex mutex;
   std::set<std::weak_ptr<EventSessionBase>, std::owner_less<std::weak_ptr<EventSessionBase>>> event_sessions;
   bool stopping = false;
@@ -161,6 +191,20 @@ HttpRequest to_request(const http::request<http::string_body>& req, const asio::
   }
   *ok = parse_target(r.target, &r.path, &r.query);
   return r;
+}
+
+// What a request that could not be read is answered: 413, 431, 400, or nullopt
+// for a connection error (nothing to answer).
+std::optional<std::pair<int, std::string>> refusal(beast::error_code ec) {
+  if (ec == http::error::body_limit) return std::pair{413, std::string("the request body is too large")};
+  if (ec == http::error::header_limit) return std::pair{431, std::string("the request headers are too large")};
+  if (ec == http::error::bad_method || ec == http::error::bad_target || ec == http::error::bad_version ||
+      ec == http::error::bad_field || ec == http::error::bad_value || ec == http::error::bad_chunk ||
+      ec == http::error::bad_chunk_extension || ec == http::error::bad_content_length ||
+      ec == http::error::bad_line_ending || ec == http::error::bad_obs_fold ||
+      ec == http::error::bad_transfer_encoding)
+    return std::pair{400, "malformed request: " + ec.message()};
+  return std::nullopt;
 }
 
 template <class Body>
@@ -269,7 +313,7 @@ class EventSession : public EventSessionBase, public std::enable_shared_from_thi
     expiry_.async_wait([weak](beast::error_code ec) {
       auto self = weak.lock();
       if (ec || !self || self->closed_) return;
-      asio::post(self->shared_.workers, [self]() {
+      asio::post(self->shared_.workers.get_executor(), [self]() {
         const std::optional<Session> now_valid = self->shared_.ws.auth().session(self->token_, false);
         asio::post(self->ws_.get_executor(), [self, now_valid]() {
           if (self->closed_) return;
@@ -371,13 +415,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
 
   void on_read(beast::error_code ec, size_t) {
     if (ec == http::error::end_of_stream) return do_close();
-    if (ec == http::error::body_limit) return reply_and_close(413, "the request body is too large");
-    if (ec == http::error::header_limit) return reply_and_close(431, "the request headers are too large");
-    if (ec == http::error::bad_method || ec == http::error::bad_target || ec == http::error::bad_version ||
-        ec == http::error::bad_field || ec == http::error::bad_value || ec == http::error::bad_chunk ||
-        ec == http::error::bad_content_length || ec == http::error::bad_line_ending ||
-        ec == http::error::bad_obs_fold || ec == http::error::bad_transfer_encoding)
-      return reply_and_close(400, "malformed request: " + ec.message());
+    if (const auto refused = refusal(ec)) return reply_and_close(refused->first, refused->second);
     if (ec) return fail(ec, "read");
     http::request<http::string_body> req = parser_->release();
     bool ok = false;
@@ -386,7 +424,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     if (websocket::is_upgrade(req)) {
       if (request.path != "/api/events") return reply_and_close(404, "WebSockets live at /api/events");
       // The session check reads the accounts database: on the pool, like all work.
-      asio::post(shared_.workers, [self = this->shared_from_this(), req = std::move(req), request]() mutable {
+      asio::post(shared_.workers.get_executor(), [self = this->shared_from_this(), req = std::move(req), request]() mutable {
         Session session;
         std::optional<HttpResponse> refused = self->shared_.api.refuse_events(request, &session);
         std::string hello;
@@ -408,7 +446,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     const bool head = req.method() == http::verb::head;
     // The work happens off the network thread; the answer comes back to this
     // session's strand.
-    asio::post(shared_.workers, [self = this->shared_from_this(), request = std::move(request), version, keep_alive, head]() {
+    asio::post(shared_.workers.get_executor(), [self = this->shared_from_this(), request = std::move(request), version, keep_alive, head]() {
       HttpResponse response;
       try {
         response = self->shared_.api.handle(request);
@@ -564,6 +602,52 @@ size_t connection_cap(size_t configured) {
 
 }  // namespace
 
+RequestBytes parse_request_bytes(std::string_view bytes, const NetOptions& options, const std::string& peer) {
+  RequestBytes out;
+  http::request_parser<http::string_body> parser;
+  parser.header_limit(static_cast<std::uint32_t>(options.header_limit));
+  parser.body_limit(options.body_limit);
+  parser.eager(true);
+  beast::error_code ec;
+  size_t used = 0;
+  while (used < bytes.size() && !parser.is_done()) {
+    const size_t n = parser.put(asio::buffer(bytes.data() + used, bytes.size() - used), ec);
+    if (ec == http::error::need_more) {
+      ec = {};
+      break;
+    }
+    if (ec) break;
+    used += n;
+    if (n == 0) break;
+  }
+  if (!ec && !parser.is_done()) {
+    parser.put_eof(ec);
+    if (!ec && !parser.is_done()) ec = http::error::partial_message;
+  }
+  if (ec) {
+    const auto refused = refusal(ec);
+    out.status = refused ? refused->first : 0;
+    return out;
+  }
+  std::vector<asio::ip::address> trusted;
+  for (const std::string& proxy : options.trusted_proxies) {
+    beast::error_code e;
+    const auto a = asio::ip::make_address(proxy, e);
+    if (!e) trusted.push_back(plain(a));
+  }
+  beast::error_code peer_ec;
+  const auto peer_address = asio::ip::make_address(peer, peer_ec);
+  const std::optional<asio::ip::address> peer_plain =
+      peer_ec ? std::nullopt : std::optional<asio::ip::address>(plain(peer_address));
+  bool ok = false;
+  out.request = to_request(parser.get(), peer_plain ? &*peer_plain : nullptr, false, trusted, &ok);
+  if (!ok) {
+    out.request.reset();
+    out.status = 400;
+  }
+  return out;
+}
+
 HttpServer::HttpServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 HttpServer::~HttpServer() { stop(); }
 
@@ -610,7 +694,11 @@ StatusOr<std::unique_ptr<HttpServer>> HttpServer::start(Api& api, Workstation& w
     for (auto& p : live) p->session_changed(change);
   });
   impl->do_accept();
-  for (int i = 0; i < std::max(1, options.io_threads); ++i) impl->threads.emplace_back([io = &impl->ioc]() { io->run(); });
+  for (int i = 0; i < std::max(1, options.io_threads); ++i)
+    impl->threads.emplace_back([io = &impl->ioc]() {
+      hw::ensure_alternate_signal_stack();
+      io->run();
+    });
   return std::unique_ptr<HttpServer>(new HttpServer(std::move(impl)));
 }
 

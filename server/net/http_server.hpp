@@ -13,7 +13,9 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "recon/core/status.hpp"
@@ -44,6 +46,15 @@ struct NetOptions {
 };
 
 inline constexpr size_t kReservedDescriptors = 128;
+
+// One request's bytes read as a connection reads them (the limits, the target's
+// decoding, forwarded headers believed from a trusted `peer`). For tests and
+// fuzzing: the server itself reads from sockets.
+struct RequestBytes {
+  std::optional<HttpRequest> request;  // read whole
+  int status = 0;                      // otherwise the answer (400, 413, 431); 0: incomplete or cut short
+};
+RequestBytes parse_request_bytes(std::string_view bytes, const NetOptions& options, const std::string& peer);
 
 class HttpServer {
  public:
