@@ -5,6 +5,7 @@
 #   deploy/install-deps.sh            build + test dependencies, Node.js for the UI
 #   deploy/install-deps.sh --browser  also Chromium, for the browser UI's tests
 #   deploy/install-deps.sh --bench    also the peers the benchmarks compare with (Open3D)
+#   deploy/install-deps.sh --sanitize also clang and its sanitizer and libFuzzer runtimes
 #
 # It never removes a package: before installing it asks apt what the install
 # would do, says how many packages and how many megabytes that is, and stops
@@ -44,6 +45,7 @@ for arg in "$@"; do
   case "$arg" in
     --browser) packages+=(chromium) ;;  # driven headless by playwright-core (web/tests/e2e)
     --bench) packages+=(python3-open3d python3-numpy time wrk curl chromium) ;;
+    --sanitize) packages+=(clang libclang-rt-dev) ;;  # deploy/sanitize.sh
     *) echo "install-deps: unknown option '$arg'" >&2; exit 2 ;;
   esac
 done
