@@ -621,6 +621,7 @@ RequestBytes parse_request_bytes(std::string_view bytes, const NetOptions& optio
     if (n == 0) break;
   }
   if (!ec && !parser.is_done()) {
+    if (!parser.got_some()) return out;  // nothing but the end: a closed connection
     parser.put_eof(ec);
     if (!ec && !parser.is_done()) ec = http::error::partial_message;
   }

@@ -449,7 +449,7 @@ TEST(ApiScan, ErasureWaitsForTheRunningScanAndLeavesNothingBehind) {
   EXPECT_NE(parse(refused)["error"]["message"].get<std::string>().find("cancel"), std::string::npos);
   EXPECT_EQ(admin.del("/api/scans/" + running_scan).status, 409);
   EXPECT_EQ(admin.post("/api/jobs/" + job + "/cancel").status, 202);
-  wait_job(admin, job, 60);
+  ASSERT_EQ(wait_job(admin, job)["state"], "cancelled");
   ASSERT_EQ(admin.del("/api/customers/" + s.customer_id).status, 204);
   EXPECT_EQ(http(s.port, "GET", "/api/share/" + token).status, 404);
   std::string everything;

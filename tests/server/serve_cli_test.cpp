@@ -3,6 +3,7 @@
 // cancelled with the reason, and the next start must find the archive whole.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -46,6 +47,7 @@ Child start_serve(const std::string& data, const std::string& password, const Se
   argv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGKILL);  // a test killed on its timeout takes its server with it
     dup2(fds[1], STDOUT_FILENO);
     if (how.stderr_to_log) dup2(fds[1], STDERR_FILENO);
     close(fds[0]);
