@@ -20,6 +20,7 @@
 #include "hw/usb/sim_tmcl_board.hpp"
 #include "server/pipeline/acquire.hpp"
 #include "server/pipeline/rig_backend.hpp"
+#include "tests/deaths.hpp"
 #include "tests/half_resolution.hpp"
 #include "tests/hw/usb/tmcl_rig.hpp"
 
@@ -30,15 +31,7 @@ using namespace std::chrono_literals;
 
 enum class Death { kStackOverflow, kSegfault, kAbort, kSighup };
 
-volatile bool g_deeper = true;
-// Recursion the optimiser can neither drop nor turn into a loop (see
-// tests/hw/usb/laser_safety_test.cpp).
-[[gnu::noinline]] int overflow_stack(int depth) {
-  volatile char frame[1024];
-  frame[0] = static_cast<char>(depth);
-  const int below = g_deeper ? overflow_stack(depth + 1) : depth;
-  return below + frame[0];
-}
+using bodyscan::testing::overflow_stack;
 
 // A store through a pointer the compiler cannot see is null: a real fault, not a
 // trap instruction put in its place.

@@ -19,6 +19,7 @@
 #include "hw/usb/serial_link.hpp"
 #include "hw/usb/sim_tmcl_board.hpp"
 #include "hw/usb/tmcl_controller.hpp"
+#include "tests/deaths.hpp"
 #include "tests/hw/usb/tmcl_rig.hpp"
 
 namespace bodyscan::hw::usb {
@@ -33,16 +34,7 @@ enum class Death {
   kStackOverflowOnOtherThread,  // on a thread that asked for an alternate stack
 };
 
-// Recursion the optimiser can neither drop nor turn into a loop: whether to go
-// deeper is a volatile read, and each frame's volatile buffer is read after the
-// call returns.
-volatile bool g_deeper = true;
-[[gnu::noinline]] int overflow_stack(int depth) {
-  volatile char frame[1024];
-  frame[0] = static_cast<char>(depth);
-  const int below = g_deeper ? overflow_stack(depth + 1) : depth;
-  return below + frame[0];
-}
+using bodyscan::testing::overflow_stack;
 
 // Runs the child; returns its wait status. `laser_output` is the board output of
 // laser 0.
