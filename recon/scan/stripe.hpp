@@ -65,9 +65,8 @@ void smooth_stripe(std::vector<StripeSample>& samples, int half_window = 5, doub
 // smooth_stripe also reaches across missing rows and this does not) and returns
 // how many. A sample with no neighbour on its stripe is where a stripe is
 // glimpsed for one row, between a limb and the skin it hides or at a silhouette,
-// and nothing along the stripe confirms it: on the simulated tiered rig such samples
-// are 1.3 % of a body's samples and hold 4 of the 5 that land over 4 mm off the skin
-// (bench/stripe_fidelity --noisy, docs/benchmarks.md §7, session 30).
+// and nothing along the stripe confirms it. Few samples are such, but they hold
+// most of those that land far off the skin (bench/stripe_fidelity --noisy).
 size_t drop_short_runs(std::vector<StripeSample>& samples, int min_rows = 2, double max_step = 1.5);
 
 }  // namespace bodyscan

@@ -52,10 +52,8 @@ struct SwayRegularization {
   // pairing only (made at no sway), where it competes with the moving holds on the
   // skin they were not fitted to. A still body's sweeps disagree a little
   // (grazing views, calibration), and a moving hold, however firm, turns that into
-  // a path: on the tiered rig a still scan's path peaked at 0.4-0.6 mm and made
-  // the neck and waist 0.05-0.1 mm thin. Held still, male_muscular's and
-  // male_heavy's still scans are off the truth by a median 0.44 and 0.71 mm
-  // (0.63 and 0.77 on that path; docs/benchmarks.md §7, session 35).
+  // a path that thins the neck and waist slightly; held still, a still scan
+  // stays nearer the truth (docs/benchmarks.md §7, "A still body held still").
   bool still = false;
 };
 
@@ -96,7 +94,7 @@ struct SwayOptions {
   // over to other skin, while a sway does.
   std::vector<SwayRegularization> regularizations = {
       {0, false, 0, true},  // no sway
-      {1, false, 0},   // every pair's weight, as firm as before
+      {1, false, 0},   // every pair's weight
       {1, true, 30},   // per axis, the slow part held
       {0.3, true, 30}, // and the size's weight a third
   };

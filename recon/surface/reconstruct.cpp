@@ -201,13 +201,11 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   // cameras saw those lie a few millimetres back from the point, and a kernel
   // extrapolating across the unseen strip from that tilted plane stands proud of
   // the skin. Each normal is carried to its own point along the shape operator
-  // (correct_normal_tilt), where the skin is convex. On the tiered rig's scans of
-  // six bodies the crown stood 2.75-3.94 mm high before and 1.54-2.40 after, and
-  // the wrist girths, whose sparse stripes leave one-sided neighbourhoods too, came
-  // out 1.36 mm large on average before and 0.54 after (docs/benchmarks.md §7,
-  // session 27). Passes that refit the shape operator to the carried normals and
-  // carry them again overshoot: those normals turn faster than the surface where
-  // the sampling is uneven (wrists 1.4 mm small after three).
+  // (correct_normal_tilt), where the skin is convex: the crown and the wrists,
+  // whose sparse stripes leave one-sided neighbourhoods, otherwise stand high
+  // (docs/reconstruction.md). One pass only: refitting the shape operator to the
+  // carried normals and carrying them again overshoots, since those normals turn
+  // faster than the surface where the sampling is uneven.
   if (options.correct_normal_tilt && !shape.empty() && source != NormalSource::kInput) {
     frames = correct_normal_tilt(frames, shape);
     // At the edge itself the operator was fitted to PCA normals that all lean the

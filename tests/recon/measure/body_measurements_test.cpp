@@ -469,7 +469,7 @@ TEST(BodyMeasurements, TheWristAndShoulderPointsStayPutUnderTheScansNoise) {
 TEST(BodyMeasurements, TheCentreOfADipMovesWithTheProfile) {
   // A V sampled every 2 mm, its vertex moved in steps of 0.25 mm: the centre follows
   // within 0.1 mm. The lowest sample, and the middle of the samples within 2 mm of
-  // it (the waist's rule until session 24), stand still and then jump 2 mm.
+  // it, stand still and then jump 2 mm: neither can mark a level.
   std::vector<double> x;
   for (double t = 0; t <= 60; t += 2) x.push_back(t);
   for (double c = 29; c <= 31; c += 0.25) {
@@ -578,9 +578,9 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
         EXPECT_LT(moved(elbow), male ? 1.5 : 2.5) << body << " " << elbow << ", seed " << seed;
       }
       EXPECT_LT(diff("waist_height"), male ? 1.0 : 2.0) << body << ", seed " << seed;
-      // female_average's under-bust is a crease, its level the deepest of the
-      // profile's 2 mm samples until session 24, and the tape, steep across the
-      // crease, jumped up to 3.3 mm; now the centroid of the crease's bottom.
+      // An under-bust that is a crease: its level is the centroid of the crease's
+      // bottom, not its deepest 2 mm sample, which the tape, steep across the
+      // crease, would follow in jumps.
       if (!male) {
         EXPECT_LT(diff("underbust_girth"), 2.5) << body << ", seed " << seed;
       }
