@@ -159,7 +159,8 @@ TEST(Workstation, CancellingAWaitingCalibrationEndsIt) {
   EXPECT_NE(done->error.find("olivia"), std::string::npos) << done->error;
   EXPECT_FALSE(done->prompt);
   EXPECT_EQ((*ws)->answer_prompt(job->id, p->id).code(), StatusCode::kFailedPrecondition);
-  for (const auto& l : (*ws)->rig_status()["lasers"]) EXPECT_FALSE(l["on"].get<bool>());
+  const nlohmann::json rig = (*ws)->rig_status();  // held: a range-for does not keep a temporary's member alive
+  for (const auto& l : rig["lasers"]) EXPECT_FALSE(l["on"].get<bool>());
   EXPECT_TRUE((*ws)->rig_status()["calibration"].is_null());
 }
 
@@ -177,7 +178,8 @@ TEST(Workstation, AnUnansweredPromptTimesOut) {
   EXPECT_EQ(done->state, server::JobState::kFailed);
   EXPECT_NE(done->error.find("nobody confirmed"), std::string::npos) << done->error;
   EXPECT_FALSE(done->prompt);
-  for (const auto& l : (*ws)->rig_status()["lasers"]) EXPECT_FALSE(l["on"].get<bool>());
+  const nlohmann::json rig = (*ws)->rig_status();  // held: a range-for does not keep a temporary's member alive
+  for (const auto& l : rig["lasers"]) EXPECT_FALSE(l["on"].get<bool>());
 }
 
 }  // namespace
