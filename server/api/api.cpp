@@ -2,6 +2,8 @@
 
 #include <sodium.h>
 
+#include <cctype>
+
 #include "recon/core/json_text.hpp"
 #include "server/api/static_files.hpp"
 
@@ -60,6 +62,15 @@ bool foreign_origin(const HttpRequest& r) {
   const std::string host = scheme == std::string::npos ? origin : origin.substr(scheme + 3);
   const std::string forwarded = r.via_trusted_proxy ? r.header("x-forwarded-host") : std::string();
   return host != r.header("host") && (forwarded.empty() || host != forwarded);
+}
+
+// A Host (or forwarded host) as RFC 3986 allows it: a name, an IPv4 address or
+// a bracketed IPv6 literal, and a port. It ends up in share links and answers.
+bool valid_host(const std::string& host) {
+  if (host.size() > 255) return false;
+  for (const unsigned char c : host)
+    if (!std::isalnum(c) && c != '-' && c != '.' && c != ':' && c != '[' && c != ']' && c != '_') return false;
+  return true;
 }
 
 }  // namespace
@@ -126,6 +137,9 @@ std::optional<HttpResponse> Api::refuse_events(const HttpRequest& request, Sessi
 }
 
 HttpResponse Api::handle(const HttpRequest& request) {
+  if (!valid_host(request.header("host")) ||
+      (request.via_trusted_proxy && !valid_host(request.header("x-forwarded-host"))))
+    return error_response(400, "malformed Host header");
   if (request.path.rfind("/api/", 0) != 0 && request.path != "/api") return serve_static(options_.web_root, request);
   const std::vector<std::string> path = split_path(request.path);
   const Route* route = nullptr;

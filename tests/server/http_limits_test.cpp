@@ -56,6 +56,8 @@ TEST_F(HttpLimits, WrongTypesBadEncodingsAndConflictingLengthsAre400) {
   EXPECT_EQ(status_of(raw(port, "POST /api/login HTTP/1.1\r\nHost: x\r\nContent-Length: 2\r\n"
                                 "Content-Length: 3\r\n\r\n{}")),
             400);
+  // A Host that is no host name (it would end up in a share link).
+  EXPECT_EQ(status_of(raw(port, "GET /api/health HTTP/1.1\r\nHost: \x8f\x8f\r\n\r\n")), 400);
   // Fields of the wrong JSON type.
   Client admin = server_->as("admin");
   EXPECT_EQ(admin.request("POST", "/api/accounts", R"({"username": "zed", "password": "long enough pw", "role": 5})").status,
