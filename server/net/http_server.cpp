@@ -140,6 +140,18 @@ asio::ip::address plain(const asio::ip::address& a) {
   return a;
 }
 
+// NetOptions::trusted_proxies as addresses; an entry that is not one is refused.
+StatusOr<std::vector<asio::ip::address>> trusted_addresses(const NetOptions& options) {
+  std::vector<asio::ip::address> out;
+  for (const std::string& proxy : options.trusted_proxies) {
+    beast::error_code ec;
+    const auto a = asio::ip::make_address(proxy, ec);
+    if (ec) return invalid_argument("trusted proxy '" + proxy + "' is not an IP address");
+    out.push_back(plain(a));
+  }
+  return out;
+}
+
 bool is_trusted(const std::vector<asio::ip::address>& trusted, const asio::ip::address& a) {
   return std::find(trusted.begin(), trusted.end(), a) != trusted.end();
 }
@@ -630,12 +642,8 @@ RequestBytes parse_request_bytes(std::string_view bytes, const NetOptions& optio
     out.status = refused ? refused->first : 0;
     return out;
   }
-  std::vector<asio::ip::address> trusted;
-  for (const std::string& proxy : options.trusted_proxies) {
-    beast::error_code e;
-    const auto a = asio::ip::make_address(proxy, e);
-    if (!e) trusted.push_back(plain(a));
-  }
+  const auto parsed = trusted_addresses(options);
+  const std::vector<asio::ip::address> trusted = parsed.ok() ? *parsed : std::vector<asio::ip::address>{};
   beast::error_code peer_ec;
   const auto peer_address = asio::ip::make_address(peer, peer_ec);
   const std::optional<asio::ip::address> peer_plain =
@@ -680,11 +688,7 @@ StatusOr<std::unique_ptr<HttpServer>> HttpServer::start(Api& api, Workstation& w
   impl->port = impl->acceptor.local_endpoint().port();
   impl->shared = std::make_unique<Shared>(api, ws, options);
   impl->shared->max_connections = connection_cap(options.max_connections);
-  for (const std::string& proxy : options.trusted_proxies) {
-    const auto a = asio::ip::make_address(proxy, ec);
-    if (ec) return invalid_argument("trusted proxy '" + proxy + "' is not an IP address");
-    impl->shared->trusted_proxies.push_back(plain(a));
-  }
+  ASSIGN_OR_RETURN(impl->shared->trusted_proxies, trusted_addresses(options));
   impl->shared->session_watch = ws.auth().watch_sessions([shared = impl->shared.get()](const SessionChange& change) {
     std::vector<std::shared_ptr<EventSessionBase>> live;
     {
