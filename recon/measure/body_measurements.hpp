@@ -44,7 +44,7 @@
 
 namespace bodyscan {
 
-inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-15";
+inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-16";
 
 // A mesh vertex at or above this confidence is measured skin; below, hole filling
 // invented it.

@@ -95,7 +95,7 @@ TEST(MeasureCli, SurfaceLengthsAndTheAutomaticSet) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["schema"], "bodyscan.measurements/1");
-  EXPECT_EQ(j["algorithm"], "iso8559-auto-15");
+  EXPECT_EQ(j["algorithm"], "iso8559-auto-16");
   EXPECT_NEAR(j["floor_y_mm"].get<double>(), 0.0, 1e-3);
   EXPECT_TRUE(j["skipped"].empty());
   EXPECT_GE(j["landmarks"].size(), 20u);

@@ -8,6 +8,8 @@
 #include <tuple>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
+
 #include "recon/measure/profile.hpp"
 
 namespace bodyscan::rules {
@@ -33,6 +35,18 @@ constexpr double kWristFlareMm = 7;
 // A second narrowing of the forearm's cuts nearer the hand, past a rise of more
 // than this (mm) and within this of the narrowest, is the wrist (wrist_cut).
 constexpr double kSecondNarrowMm = 2;
+// The axes are fitted again to cuts square to them (square_cut_axis): over this
+// length of each segment (fractions of the stature), starting this far from the
+// elbow, where the cuts across the bend take in both segments.
+constexpr double kSquareFromElbow = 0.02;
+constexpr double kSquareUpper = 0.07;
+constexpr double kSquareFore = 0.08;
+constexpr double kSquareStepMm = 4;
+constexpr int kSquareRounds = 3;
+// An arm against the flank is read from its outer side seen from the front:
+// between these fractions of the stature below where it parts from the body.
+constexpr double kOuterSideFrom = 0.01;
+constexpr double kOuterSideTo = 0.08;
 // The arm's horizontal cuts, mm apart.
 constexpr double kArmStepMm = 3;
 // The cuts across the forearm near the wrist, mm apart.
@@ -161,7 +175,87 @@ StatusOr<Girth> upper_arm_girth(const BodyCuts& cuts, const Eigen::Vector3d& mid
   return not_found("the cut never clears the chest");
 }
 
+// The line through the centres of cuts square to `dir`, taken along it from
+// `elbow` between `from` and `from + length` (mm), each the limb's own loop
+// (winds round the line, reaches no farther than 5 % of the stature from its
+// centre); the walk ends at the first cut that is not, past the first that is.
+// Horizontal cuts of a tapering limb centre off its axis by an amount that
+// changes with the limb's slope; cuts square to the axis meet the same skin
+// however the arm is raised. Nothing under five cuts.
+std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> square_cut_axis(const BodyCuts& cuts,
+                                                                            const Eigen::Vector3d& elbow,
+                                                                            const Eigen::Vector3d& dir, double from,
+                                                                            double length,
+                                                                            const std::vector<uint32_t>& triangles) {
+  const double reach_limit = 0.05 * cuts.stature();
+  std::vector<Eigen::Vector3d> centres;
+  for (double t = from; t <= from + length; t += kSquareStepMm) {
+    const Eigen::Vector3d p = elbow + t * dir;
+    StatusOr<Girth> g = mesh_girth(cuts.mesh(), Plane{p, dir}, p, &triangles);
+    bool own = g.ok() && !g->loop.empty() && winds_round(g->loop, p, dir);
+    if (own) {
+      const Eigen::Vector3d centre = loop_centre(g->loop);
+      double reach = 0;
+      for (const Eigen::Vector3d& q : g->loop) reach = std::max(reach, (q - centre).norm());
+      own = reach < reach_limit;
+      if (own) centres.push_back(centre);
+    }
+    if (!own && !centres.empty()) break;
+  }
+  if (centres.size() < 5) return std::nullopt;
+  // The walk's end moves a cut at a time with the skin (where the limb meets the
+  // armpit or the hand): the last third's weights fall to zero toward it, so the
+  // line does not jump when one cut more or less is its own.
+  const double n = static_cast<double>(centres.size()), taper = n / 3;
+  std::vector<double> weights(centres.size());
+  for (size_t i = 0; i < centres.size(); ++i) weights[i] = std::min(1.0, (n - static_cast<double>(i)) / taper);
+  double total = 0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < centres.size(); ++i) mean += weights[i] * centres[i], total += weights[i];
+  mean /= total;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < centres.size(); ++i) cov += weights[i] * (centres[i] - mean) * (centres[i] - mean).transpose();
+  Eigen::Vector3d d = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(2);
+  if (d.y() < 0) d = -d;
+  return std::make_pair(mean, d);
+}
+
+// Where the upper arm's axis passes closest to the forearm's; c_e's place on the
+// upper arm's axis when the arm is nearly straight (no meeting point to speak of)
+// or the lines meet farther than 3 % of the stature from it.
+Eigen::Vector3d elbow_centre(const ArmAxes& arm, const Eigen::Vector3d& c_e, double stature) {
+  const Eigen::Vector3d &uc = arm.upper_centre, &ud = arm.upper_dir;
+  const Eigen::Vector3d &fc = arm.fore_centre, &fd = arm.fore_dir;
+  const Eigen::Vector3d at = on_axis(uc, ud, c_e);
+  if (const double cross = 1 - std::pow(ud.dot(fd), 2); cross > std::pow(std::sin(kMinElbowBend), 2)) {
+    const Eigen::Vector3d w0 = uc - fc;
+    const Eigen::Vector3d meet = uc + (ud.dot(fd) * fd.dot(w0) - ud.dot(w0)) / cross * ud;
+    if ((meet - at).norm() < 0.03 * stature) return meet;
+  }
+  return at;
+}
+
 }  // namespace
+
+std::optional<Eigen::Vector3d> outer_side_axis(const BodyCuts& cuts, double arm_apart_y, Side side) {
+  const double mid_x = cuts.midline_x(), stature = cuts.stature(), s = sign(side);
+  const double top = arm_apart_y - kOuterSideFrom * stature, bottom = arm_apart_y - kOuterSideTo * stature;
+  cuts.prefetch(top, bottom, -kArmStepMm);
+  // Least squares x = a + b y over the cuts' outermost points on the side.
+  double n = 0, sy = 0, sx = 0, syy = 0, sxy = 0;
+  for (double y = top; y >= bottom; y -= kArmStepMm) {
+    double out = -std::numeric_limits<double>::infinity();
+    for (const Ring& r : cuts.at(y))
+      for (const Eigen::Vector3d& q : r.points) out = std::max(out, s * (q.x() - mid_x));
+    if (!std::isfinite(out)) continue;
+    const double x = mid_x + s * out;
+    n += 1, sy += y, sx += x, syy += y * y, sxy += x * y;
+  }
+  const double spread = n * syy - sy * sy;
+  if (n < 10 || spread <= 0) return std::nullopt;
+  const double slope = (n * sxy - sx * sy) / spread;  // dx/dy
+  return Eigen::Vector3d(slope, 1, 0).normalized();
+}
 
 std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y,
                                      double crotch_y, Side side) {
@@ -187,6 +281,32 @@ std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& she
   arm.wrist = w, arm.elbow = e;
   std::tie(arm.upper_centre, arm.upper_dir) = fit_line(c, 0, e + 1);
   std::tie(arm.fore_centre, arm.fore_dir) = fit_line(c, e, w + 1);
+  arm.hand = (c[w] - c[e]).dot(arm.fore_dir) > 0 ? 1 : -1;
+  // The elbow: where the axes meet, cut square to them. Horizontal cuts of a
+  // tapering limb centre off its axis by an amount that changes with the limb's
+  // slope, and the meeting point of their lines slides along a heavy arm as it is
+  // raised; cuts square to each segment's axis, away from the bend, meet the same
+  // skin however the arm is held. Each round cuts square to the last round's
+  // lines, from the last round's meeting point. The lines themselves stay the
+  // horizontal cuts' (fitted over the whole segment, they are steadier under the
+  // skin's noise, and the shoulder rule reads the arm's slope from them).
+  const double stature = cuts.stature();
+  arm.elbow_centre = elbow_centre(arm, c[e], stature);
+  const std::vector<uint32_t> triangles = cuts.triangles_near(
+      arm.elbow_centre, (kSquareFromElbow + std::max(kSquareUpper, kSquareFore) + 0.05) * stature);
+  ArmAxes square = arm;
+  for (int round = 0; round < kSquareRounds; ++round) {
+    const auto upper = square_cut_axis(cuts, square.elbow_centre, square.upper_dir, kSquareFromElbow * stature,
+                                       kSquareUpper * stature, triangles);
+    const auto fore = square_cut_axis(cuts, square.elbow_centre, square.hand * square.fore_dir,
+                                      kSquareFromElbow * stature, kSquareFore * stature, triangles);
+    if (!upper || !fore) break;
+    std::tie(square.upper_centre, square.upper_dir) = *upper;
+    std::tie(square.fore_centre, square.fore_dir) = *fore;
+    square.hand = (c[w] - square.elbow_centre).dot(square.fore_dir) > 0 ? 1 : -1;
+    square.elbow_centre = elbow_centre(square, square.elbow_centre, stature);
+  }
+  arm.elbow_centre = square.elbow_centre;
   const size_t index = side == Side::kLeft ? 0 : 1;
   sheet.posture().arm_abduction_deg[index] = std::acos(std::clamp(arm.upper_dir.y(), -1.0, 1.0)) * 180 / M_PI;
   sheet.posture().elbow_bend_deg[index] =
@@ -202,19 +322,10 @@ void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, const std::optio
     return;
   }
   const std::vector<Eigen::Vector3d>& c = axes->centres;
-  const size_t w = axes->wrist, e = axes->elbow;
+  const size_t w = axes->wrist;
   const Eigen::Vector3d &uc = axes->upper_centre, &ud = axes->upper_dir;
   const Eigen::Vector3d &fc = axes->fore_centre, &fd = axes->fore_dir;
-  // The elbow's centre: where the upper arm's axis passes closest to the forearm's.
-  // The bend's cut c[e] moves in the cuts' steps, and with the armpit's level,
-  // where they start; where two lines meet moves with the skin. An arm nearly
-  // straight has no meeting point to speak of: there c[e] stands.
-  Eigen::Vector3d elbow_c = on_axis(uc, ud, c[e]);
-  if (const double cross = 1 - std::pow(ud.dot(fd), 2); cross > std::pow(std::sin(kMinElbowBend), 2)) {
-    const Eigen::Vector3d w0 = uc - fc;
-    const Eigen::Vector3d meet = uc + (ud.dot(fd) * fd.dot(w0) - ud.dot(w0)) / cross * ud;
-    if ((meet - elbow_c).norm() < 0.03 * stature) elbow_c = meet;
-  }
+  const Eigen::Vector3d elbow_c = axes->elbow_centre;
   Eigen::Vector3d wrist_c = on_axis(fc, fd, c[w]);
   // Outward: across the arm, in the frontal plane, away from the body.
   auto outward = [&](const Eigen::Vector3d& d) {
@@ -231,8 +342,7 @@ void measure_arm(const BodyCuts& cuts, MeasurementSheet& sheet, const std::optio
     if (std::optional<Eigen::Vector3d> p = ray_exit(g.loop, loop_centre(g.loop), out, across)) return *p;
     return middle_of_extreme(g.loop, out, across, kFlatBand);
   };
-  const double hand = (c[w] - c[e]).dot(fd) > 0 ? 1 : -1;
-  const StatusOr<Girth> wg = wrist_girth(cuts, fd, hand, &wrist_c);
+  const StatusOr<Girth> wg = wrist_girth(cuts, fd, axes->hand, &wrist_c);
   const std::vector<uint32_t> elbow_tris = cuts.triangles_near(elbow_c, 0.08 * stature);
   const StatusOr<Girth> eg = mesh_girth(cuts.mesh(), Plane{elbow_c, ud}, elbow_c, &elbow_tris);
   const Eigen::Vector3d wrist_p = wg.ok() && !wg->loop.empty() ? outer_point(*wg, fd, outward(fd)) : wrist_c;

@@ -21,6 +21,10 @@ struct ArmAxes {
   // Each segment's axis: a point on it and its unit direction (pointing up).
   Eigen::Vector3d upper_centre = Eigen::Vector3d::Zero(), upper_dir = Eigen::Vector3d::UnitY();
   Eigen::Vector3d fore_centre = Eigen::Vector3d::Zero(), fore_dir = Eigen::Vector3d::UnitY();
+  // Where the two axes meet (the elbow's centre), and +1 where the hand lies along
+  // +fore_dir from it, else -1.
+  Eigen::Vector3d elbow_centre = Eigen::Vector3d::Zero();
+  double hand = 1;
 };
 
 // The arm on `side`, followed down from `arm_apart_y` (where its own loop ends)
@@ -32,6 +36,13 @@ struct ArmAxes {
 // which the posture records).
 std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y,
                                      double crotch_y, Side side);
+
+// The slope of an arm that lies against the flank (find_arm_axes found nothing),
+// from its outer side seen from the front: a line fitted to the cuts' outermost
+// points on that side below `arm_apart_y`, over the upper arm. A unit direction in
+// the frontal plane pointing up the arm, like ArmAxes::upper_dir. Nothing where
+// the cuts are too few.
+std::optional<Eigen::Vector3d> outer_side_axis(const BodyCuts& cuts, double arm_apart_y, Side side);
 
 // The arm on `side` from its axes: records `wrist_point_<side>` and
 // `elbow_point_<side>`, the wrist and upper-arm girths and the outer arm length
