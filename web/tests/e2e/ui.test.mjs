@@ -16,7 +16,6 @@ const TAILOR = ['theo', 'tailor pass 12'];
 
 let server;
 let browser;
-let context;
 let page;
 const errors = [];
 const suite = { errors };
@@ -99,7 +98,7 @@ function nextMeasure() {
 describe('the browser UI', { timeout: 1_800_000 }, () => {
   before(async () => {
     await openSuite(suite, { contextOptions: { viewport: { width: 1366, height: 1024 }, acceptDownloads: true, hasTouch: true } });
-    ({ server, browser, context, page } = suite);
+    ({ server, browser, page } = suite);
   });
 
   after(() => closeSuite(suite, assert));
@@ -169,11 +168,11 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.equal(await page.locator('table.measurements .posture-flag').count(), 0);
     await shot(page, 'viewer-operator');
     // A row highlights its line: the picture changes.
-    const before = await coverage(page, '#viewport canvas');
+    const unselected = await coverage(page, '#viewport canvas');
     await page.click('table.measurements tr[data-name=hip_girth]');
     await page.waitForTimeout(300);
     assert.equal(await page.locator('tr[data-name=hip_girth]').getAttribute('aria-selected'), 'true');
-    assert.notEqual(await coverage(page, '#viewport canvas'), before);
+    assert.notEqual(await coverage(page, '#viewport canvas'), unselected);
   });
 
   it('measures a girth line drawn across the body: the server evaluates the plane the screen shows', async () => {
@@ -214,12 +213,12 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
 
   it('calibrates the rig from the station, and cancels a scan with the lasers left off', async () => {
     await login(page, server.url, ...OPERATOR);
-    const before = await page.locator('#calibration-age').innerText();
+    const ageBefore = await page.locator('#calibration-age').innerText();
     await page.click('#rig-status button:has-text("Calibrate")');
     await page.locator('#job .job-state[data-state=running]').waitFor({ timeout: 30000 });
     assert.match(await page.locator('#job h2').innerText(), /Calibration/);
     await page.locator('#job .job-state[data-state=complete]').waitFor({ timeout: 180000 });
-    await page.waitForFunction((old) => document.querySelector('#calibration-age').innerText !== old, before, { timeout: 30000 });
+    await page.waitForFunction((old) => document.querySelector('#calibration-age').innerText !== old, ageBefore, { timeout: 30000 });
     assert.match(await page.locator('#calibration-age').innerText(), /Calibrated (just now|\d+ s ago)/);
     assert.match(await page.locator('#rig-status table').innerText(), /\d\.\d{3} px/);
     await shot(page, 'station-calibrated');
