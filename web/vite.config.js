@@ -11,6 +11,7 @@ import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { gzipAsync } from '@gfx/zopfli';
 
+/** @returns {import('vite').Plugin} */
 function gzipTwins() {
   const compressible = /\.(js|mjs|css|html|svg|json|wasm|txt)$/;
   const walk = (dir) =>

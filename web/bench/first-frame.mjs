@@ -38,7 +38,7 @@ async function timings(page) {
       openToDecoded: mark('bodyscan:model-decoded') - open,
       normalsMs: mark('bodyscan:normals-done') - mark('bodyscan:model-decoded'),
       drawMs: mark('bodyscan:first-frame') - mark('bodyscan:normals-done'),
-      triangles: Number(document.querySelector('#viewport').dataset.triangles),
+      triangles: Number(/** @type {HTMLElement} */ (document.querySelector('#viewport')).dataset.triangles),
     };
   });
 }

@@ -3,6 +3,7 @@
 // neighbours, normals, orientation, kernels, field, mesh, done); the bar gives
 // each stage its share of a typical job's time on the thesis rig.
 
+/** @type {[stage: string, from: number, to: number, text: string][]} */
 const SPANS = [
   ['starting', 0, 0, 'Starting'],
   ['calibration: lens', 0, 0.04, 'Calibrating: lenses'],

@@ -11,7 +11,8 @@ export class Router {
     this.seq = 0;
     window.addEventListener('popstate', () => this.render());
     document.addEventListener('click', (e) => {
-      const a = e.target.closest && e.target.closest('a[href]');
+      /** @type {HTMLAnchorElement | null} */
+      const a = e.target instanceof Element ? e.target.closest('a[href]') : null;
       if (!a || a.target || a.hasAttribute('download') || e.defaultPrevented || e.button !== 0) return;
       if (e.metaKey || e.ctrlKey || e.shiftKey || e.altKey) return;
       const url = new URL(a.href, window.location.href);

@@ -33,11 +33,18 @@ export function formatDifference(mm, unit) {
 
 const STORAGE_KEY = 'bodyscan.unit';
 
+/** @typedef {Pick<Storage, 'getItem' | 'setItem'>} UnitStore the browser's localStorage, or a stand-in */
+
+/** @param {UnitStore} [storage] */
 export function preferredUnit(storage = globalThis.localStorage) {
   const u = storage?.getItem(STORAGE_KEY);
   return u && UNITS[u] ? u : 'cm';
 }
 
+/**
+ * @param {string} unit
+ * @param {UnitStore} [storage]
+ */
 export function setPreferredUnit(unit, storage = globalThis.localStorage) {
   if (!UNITS[unit]) throw new Error(`unknown unit ${unit}`);
   storage?.setItem(STORAGE_KEY, unit);

@@ -29,6 +29,7 @@ export async function mount(container, { id }, ctx) {
         if (chosen.size > 2) {
           const first = [...chosen][0];
           chosen.delete(first);
+          /** @type {HTMLInputElement | null} */
           const other = container.querySelector(`input[data-scan="${CSS.escape(first)}"]`);
           if (other) other.checked = false;
         }

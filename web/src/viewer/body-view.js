@@ -48,6 +48,13 @@ export class ModelDecoding {
 // The decoder's script and wasm start loading as soon as the viewer's code does.
 dracoLoader();
 
+/**
+ * three.js's own test for a mesh (a Mesh or a subclass of it).
+ * @param {THREE.Object3D} o
+ * @returns {o is THREE.Mesh}
+ */
+const isMesh = (o) => /** @type {THREE.Mesh} */ (o).isMesh === true;
+
 const SKIN = 0xd8b49c;
 const VIEWS = {
   front: new THREE.Vector3(0, 0, 1),
@@ -147,9 +154,10 @@ export class BodyView {
       if (this.disposed) return null;
       performance.mark('bodyscan:model-decoded');
       gltf.scene.updateMatrixWorld(true);
+      /** @type {THREE.Mesh | null} */
       let found = null;
       gltf.scene.traverse((o) => {
-        if (!found && o.isMesh) found = o;
+        if (!found && isMesh(o)) found = o;
       });
       if (!found) throw new Error('the model holds no mesh');
       const geometry = found.geometry;

@@ -99,10 +99,10 @@ export class MeasureTool {
   drawLine(e) {
     const r = this.view.canvas.getBoundingClientRect();
     const d = this.down;
-    this.line.setAttribute('x1', d.x - r.left);
-    this.line.setAttribute('y1', d.y - r.top);
-    this.line.setAttribute('x2', e.clientX - r.left);
-    this.line.setAttribute('y2', e.clientY - r.top);
+    this.line.setAttribute('x1', String(d.x - r.left));
+    this.line.setAttribute('y1', String(d.y - r.top));
+    this.line.setAttribute('x2', String(e.clientX - r.left));
+    this.line.setAttribute('y2', String(e.clientY - r.top));
   }
 
   girthFromLine(a, b) {

@@ -16,7 +16,7 @@ export function postureLines(posture) {
   const check = new Map((posture.checks || []).map((c) => [c.part, c]));
   const lines = [];
   const arms = posture.arm_abduction_deg || [];
-  for (const [i, side] of [[0, 'left'], [1, 'right']]) {
+  for (const [i, side] of ['left', 'right'].entries()) {
     if (arms[i] === null || arms[i] === undefined) continue;
     const bend = posture.elbow_bend_deg?.[i];
     const c = check.get(`arm_${side}`) || { ok: true, message: '' };

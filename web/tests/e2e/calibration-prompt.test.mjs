@@ -16,11 +16,14 @@ const suite = { errors: [] };
 async function nextPrompt(last, oldJob = null) {
   const handle = await page.waitForFunction(
     ([old, oldJobId]) => {
+      /** @type {HTMLElement | null} */
       const done = document.querySelector('#job .job-state');
       if (done && done.dataset.job === oldJobId) return null;
       if (done && done.dataset.state !== 'running') return { ended: done.dataset.state };
+      /** @type {HTMLButtonElement | null} */
       const b = document.querySelector('#job .prompt button[data-prompt]');
       if (!b || b.disabled || b.dataset.prompt === old) return null;
+      /** @type {HTMLElement} */
       const box = b.closest('.prompt');
       return { id: b.dataset.prompt, kind: box.dataset.kind, camera: box.dataset.camera, title: box.querySelector('h3').textContent };
     },

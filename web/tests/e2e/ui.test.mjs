@@ -218,7 +218,7 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await page.locator('#job .job-state[data-state=running]').waitFor({ timeout: 30000 });
     assert.match(await page.locator('#job h2').innerText(), /Calibration/);
     await page.locator('#job .job-state[data-state=complete]').waitFor({ timeout: 180000 });
-    await page.waitForFunction((old) => document.querySelector('#calibration-age').innerText !== old, ageBefore, { timeout: 30000 });
+    await page.waitForFunction((old) => /** @type {HTMLElement} */ (document.querySelector('#calibration-age')).innerText !== old, ageBefore, { timeout: 30000 });
     assert.match(await page.locator('#calibration-age').innerText(), /Calibrated (just now|\d+ s ago)/);
     assert.match(await page.locator('#rig-status table').innerText(), /\d\.\d{3} px/);
     await shot(page, 'station-calibrated');
