@@ -9,6 +9,12 @@ export function setCsrfToken(token) {
 }
 
 export class ApiError extends Error {
+  /**
+   * @param {number} status the HTTP status; 0 when the server did not answer
+   * @param {string} code the server's error code, or 'error' or 'network'
+   * @param {string} message
+   * @param {number | null} [retryAfter] seconds, from Retry-After
+   */
   constructor(status, code, message, retryAfter = null) {
     super(message);
     this.name = 'ApiError';
@@ -18,6 +24,7 @@ export class ApiError extends Error {
   }
 }
 
+/** @param {Response} response */
 async function errorFrom(response) {
   let code = 'error';
   let message = `${response.status} ${response.statusText}`.trim();
@@ -36,12 +43,29 @@ async function errorFrom(response) {
 
 // Called with every 401 from a staff call (the session ended): main.js sends the
 // user to the login page.
+/** @type {(error: ApiError) => void} */
 let onUnauthorised = () => {};
+/** @param {(error: ApiError) => void} fn */
 export function setUnauthorisedHandler(fn) {
   onUnauthorised = fn;
 }
 
+/**
+ * @typedef {object} RequestOptions
+ * @property {string} [method]
+ * @property {unknown} [body] sent as JSON
+ * @property {AbortSignal} [signal]
+ * @property {boolean} [raw] answer with the Response rather than its JSON
+ * @property {boolean} [quiet401] a 401 is only thrown, not reported as the session's end
+ */
+
+/**
+ * @param {string} path
+ * @param {RequestOptions} [options]
+ * @returns {Promise<any>}
+ */
 export async function request(path, { method = 'GET', body, signal, raw = false, quiet401 = false } = {}) {
+  /** @type {Record<string, string>} */
   const headers = { Accept: 'application/json' };
   if (body !== undefined) headers['Content-Type'] = 'application/json';
   if (method !== 'GET' && method !== 'HEAD' && csrfToken) headers['X-CSRF-Token'] = csrfToken;
@@ -74,6 +98,7 @@ export const put = (path, body, opts) => request(path, { ...opts, method: 'PUT',
 export const del = (path, opts) => request(path, { ...opts, method: 'DELETE' });
 
 // A query string from an object, skipping empty values.
+/** @param {Record<string, string | number | boolean | null | undefined>} params */
 export function query(params) {
   const q = new URLSearchParams();
   for (const [k, v] of Object.entries(params)) if (v !== undefined && v !== null && v !== '') q.set(k, String(v));

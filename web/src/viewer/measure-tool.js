@@ -21,6 +21,12 @@ const TAP_PX = 8;
 const MIN_LINE_PX = 24;
 
 export class MeasureTool {
+  /**
+   * @param {import('./body-view.js').BodyView} view
+   * @param {object} handlers
+   * @param {(request: object, toolName: string) => void} handlers.onRequest
+   * @param {(hint: string) => void} [handlers.onHint]
+   */
   constructor(view, { onRequest, onHint = () => {} }) {
     this.view = view;
     this.onRequest = onRequest;

@@ -29,6 +29,18 @@ export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
 }
 
 // rows: [{m, other?}] - `other` is the same measurement on a second scan (compare).
+/**
+ * @param {object} options
+ * @param {any[]} options.measurements
+ * @param {string} options.unit
+ * @param {string | null} options.selected the name of the selected row
+ * @param {(m: any) => void} options.onSelect
+ * @param {((m: any) => void) | null} [options.onDelete] a Delete button on each saved row
+ * @param {any[] | null} [options.compareWith] the same scan's measurements on another scan
+ * @param {[string, string]} [options.columns] the headings of the two values compared
+ * @param {string} [options.caption]
+ * @param {Record<string, string>} [options.groups] the heading of each source's rows
+ */
 export function measurementTable({
   measurements,
   unit,
