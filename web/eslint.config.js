@@ -1,12 +1,12 @@
 // ESLint for the UI's plain ES modules: the recommended set plus rules that find
 // bugs rather than enforce a style (formatting is left alone). `npm run lint`
 // runs it with no warnings allowed. src/ runs in the browser; the tests, the
-// benchmark and the config files run under Node.js.
+// benchmark, the scripts and the config files run under Node.js.
 import js from '@eslint/js';
 import globals from 'globals';
 
 export default [
-  { ignores: ['dist/', 'node_modules/', 'test-results/', 'src/api-types.d.ts'] },
+  { ignores: ['dist/', 'node_modules/', 'test-results/'] },
   js.configs.recommended,
   {
     // The bundle's target (vite.config.js).
@@ -34,7 +34,7 @@ export default [
     languageOptions: { globals: globals.browser },
   },
   {
-    files: ['tests/**/*.mjs', 'bench/**/*.mjs', '*.config.js'],
+    files: ['tests/**/*.mjs', 'bench/**/*.mjs', 'scripts/**/*.mjs', '*.config.js'],
     languageOptions: { globals: globals.node },
   },
   {

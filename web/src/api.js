@@ -1,6 +1,61 @@
 // The server's REST API (docs/api.md): JSON in and out, the session cookie sent
 // by the browser, the CSRF token on every state-changing call, and the server's
 // error body turned into an ApiError whose message the UI can show as it is.
+//
+// Each call the UI makes is a function below, typed from the server's OpenAPI
+// document through src/api-types.d.ts (made by `npm run gen:api-types`): its path
+// must be one the document has, with the document's path parameters, and its
+// query, body and answer are the document's. A path, parameter or field renamed
+// in the document makes `npm run typecheck` fail where the UI still uses the old
+// one.
+
+/** @typedef {import('./api-types').paths} Paths */
+/** @typedef {import('./api-types').components['schemas']} Schemas */
+/** @typedef {Schemas['Session']} Session */
+/** @typedef {Schemas['Role']} Role */
+/** @typedef {Schemas['Account']} Account */
+/** @typedef {Schemas['Job']} Job */
+/** @typedef {Schemas['JobPrompt']} JobPrompt */
+/** @typedef {Schemas['RigStatus']} RigStatus */
+/** @typedef {Schemas['Customer']} Customer */
+/** @typedef {Schemas['Scan']} Scan */
+/** @typedef {Schemas['MeasureRequest']} MeasureRequest */
+/** @typedef {Schemas['Measurement']} Measurement */
+/** @typedef {Schemas['StoredMeasurement']} StoredMeasurement */
+/** @typedef {Schemas['Share']} Share */
+/** @typedef {Schemas['NewShare']} NewShare */
+/** @typedef {Schemas['Posture']} Posture */
+/** @typedef {Answer<'/api/share/{token}', 'get', 200>} ShareView */
+
+/** @typedef {'get' | 'put' | 'post' | 'delete'} Method */
+
+/**
+ * The JSON the server answers method M on path P with, under status S.
+ * @template {keyof Paths} P
+ * @template {Method} M
+ * @template {number} S
+ * @typedef {Paths[P][M] extends { responses: Record<S, { content: { 'application/json': infer J } }> } ? J : never} Answer
+ */
+
+/**
+ * The JSON body method M on path P takes.
+ * @template {keyof Paths} P
+ * @template {Method} M
+ * @typedef {Paths[P][M] extends { requestBody: { content: { 'application/json': infer B } } } ? B : never} Body
+ */
+
+/**
+ * The query parameters method M on path P takes.
+ * @template {keyof Paths} P
+ * @template {Method} M
+ * @typedef {Paths[P][M] extends { parameters: { query?: infer Q } } ? Q : never} Query
+ */
+
+/**
+ * The names of a path's parameters: `id` and `mid` of '/api/scans/{id}/measurements/{mid}'.
+ * @template {string} T
+ * @typedef {T extends `${string}{${infer K}}${infer Rest}` ? K | ParamNames<Rest> : never} ParamNames
+ */
 
 let csrfToken = null;
 
@@ -29,6 +84,7 @@ async function errorFrom(response) {
   let code = 'error';
   let message = `${response.status} ${response.statusText}`.trim();
   try {
+    /** @type {Schemas['Error']} */
     const body = await response.json();
     if (body && body.error) {
       code = body.error.code || code;
@@ -64,7 +120,7 @@ export function setUnauthorisedHandler(fn) {
  * @param {RequestOptions} [options]
  * @returns {Promise<any>}
  */
-export async function request(path, { method = 'GET', body, signal, raw = false, quiet401 = false } = {}) {
+async function request(path, { method = 'GET', body, signal, raw = false, quiet401 = false } = {}) {
   /** @type {Record<string, string>} */
   const headers = { Accept: 'application/json' };
   if (body !== undefined) headers['Content-Type'] = 'application/json';
@@ -92,10 +148,226 @@ export async function request(path, { method = 'GET', body, signal, raw = false,
   return response.json();
 }
 
-export const get = (path, opts) => request(path, { ...opts, method: 'GET' });
-export const post = (path, body, opts) => request(path, { ...opts, method: 'POST', body: body ?? {} });
-export const put = (path, body, opts) => request(path, { ...opts, method: 'PUT', body });
-export const del = (path, opts) => request(path, { ...opts, method: 'DELETE' });
+/** @typedef {Omit<RequestOptions, 'method' | 'body'>} CallOptions */
+
+/** @type {(path: string, opts?: CallOptions) => Promise<any>} */
+const get = (path, opts) => request(path, { ...opts, method: 'GET' });
+/** @type {(path: string, body?: unknown, opts?: CallOptions) => Promise<any>} */
+const post = (path, body, opts) => request(path, { ...opts, method: 'POST', body: body ?? {} });
+/** @type {(path: string, body: unknown, opts?: CallOptions) => Promise<any>} */
+const put = (path, body, opts) => request(path, { ...opts, method: 'PUT', body });
+/** @type {(path: string, opts?: CallOptions) => Promise<any>} */
+const del = (path, opts) => request(path, { ...opts, method: 'DELETE' });
+
+/**
+ * A path of the document with its parameters filled in, each URI-encoded; a
+ * path with parameters takes an object naming each of them.
+ * @template {keyof Paths} P
+ * @param {P} path
+ * @param {[ParamNames<P>] extends [never] ? [] : [Record<ParamNames<P>, string | number>]} params
+ * @returns {string}
+ */
+function at(path, ...params) {
+  const [values] = params;
+  return path.replace(/\{(\w+)\}/g, (_, name) => enc(String(values[name])));
+}
+
+// ---- session
+
+/** @returns {Promise<Answer<'/api/session', 'get', 200>>} */
+const getSession = () => get(at('/api/session'), { quiet401: true });
+
+/**
+ * @param {Body<'/api/login', 'post'>} credentials
+ * @returns {Promise<Answer<'/api/login', 'post', 200>>}
+ */
+const login = (credentials) => post(at('/api/login'), credentials, { quiet401: true });
+
+/** @returns {Promise<null>} */
+const logout = () => post(at('/api/logout'), {}, { quiet401: true });
+
+// ---- accounts
+
+/** @returns {Promise<Answer<'/api/accounts', 'get', 200>>} */
+const listAccounts = () => get(at('/api/accounts'));
+
+/**
+ * @param {Body<'/api/accounts', 'post'>} account
+ * @returns {Promise<Answer<'/api/accounts', 'post', 201>>}
+ */
+const addAccount = (account) => post(at('/api/accounts'), account);
+
+/**
+ * @param {string} username
+ * @param {Body<'/api/accounts/{username}', 'put'>} change
+ * @returns {Promise<Answer<'/api/accounts/{username}', 'put', 200>>}
+ */
+const changeAccount = (username, change) => put(at('/api/accounts/{username}', { username }), change);
+
+/**
+ * @param {string} username
+ * @returns {Promise<null>}
+ */
+const deleteAccount = (username) => del(at('/api/accounts/{username}', { username }));
+
+// ---- the rig and its jobs
+
+/** @returns {Promise<Answer<'/api/rig', 'get', 200>>} */
+const getRig = () => get(at('/api/rig'));
+
+/** @returns {Promise<Answer<'/api/rig/calibrate', 'post', 202>>} */
+const calibrate = () => post(at('/api/rig/calibrate'), {});
+
+/**
+ * @param {Body<'/api/scans', 'post'>} scan
+ * @returns {Promise<Answer<'/api/scans', 'post', 202>>}
+ */
+const startScan = (scan) => post(at('/api/scans'), scan);
+
+/**
+ * @param {string} id the job's
+ * @param {Body<'/api/jobs/{id}/prompt', 'post'>} answer
+ * @returns {Promise<Answer<'/api/jobs/{id}/prompt', 'post', 202>>}
+ */
+const answerPrompt = (id, answer) => post(at('/api/jobs/{id}/prompt', { id }), answer);
+
+/**
+ * @param {string} id the job's
+ * @returns {Promise<Answer<'/api/jobs/{id}/cancel', 'post', 202>>}
+ */
+const cancelJob = (id) => post(at('/api/jobs/{id}/cancel', { id }), {});
+
+// ---- customers and scans
+
+/**
+ * @param {Query<'/api/customers', 'get'>} [params]
+ * @returns {Promise<Answer<'/api/customers', 'get', 200>>}
+ */
+const findCustomers = (params = {}) => get(at('/api/customers') + query(params));
+
+/**
+ * @param {string} id
+ * @returns {Promise<Answer<'/api/customers/{id}', 'get', 200>>}
+ */
+const getCustomer = (id) => get(at('/api/customers/{id}', { id }));
+
+/**
+ * @param {string} id
+ * @returns {Promise<null>}
+ */
+const eraseCustomer = (id) => del(at('/api/customers/{id}', { id }));
+
+/**
+ * @param {Query<'/api/scans', 'get'>} [params]
+ * @returns {Promise<Answer<'/api/scans', 'get', 200>>}
+ */
+const findScans = (params = {}) => get(at('/api/scans') + query(params));
+
+/**
+ * @param {string} id
+ * @returns {Promise<Answer<'/api/scans/{id}', 'get', 200>>}
+ */
+const getScan = (id) => get(at('/api/scans/{id}', { id }));
+
+/**
+ * @param {string} id
+ * @returns {Promise<null>}
+ */
+const deleteScan = (id) => del(at('/api/scans/{id}', { id }));
+
+/**
+ * @param {string} id
+ * @returns {Promise<Answer<'/api/scans/{id}/reprocess', 'post', 202>>}
+ */
+const reprocess = (id) => post(at('/api/scans/{id}/reprocess', { id }), {});
+
+// ---- measurements
+
+/**
+ * @param {string} id the scan's
+ * @returns {Promise<Answer<'/api/scans/{id}/measurements', 'get', 200>>}
+ */
+const getMeasurements = (id) => get(at('/api/scans/{id}/measurements', { id }));
+
+/**
+ * @param {string} id the scan's
+ * @param {Body<'/api/scans/{id}/measure', 'post'>} measureRequest
+ * @returns {Promise<Answer<'/api/scans/{id}/measure', 'post', 200>>}
+ */
+const measure = (id, measureRequest) => post(at('/api/scans/{id}/measure', { id }), measureRequest);
+
+/**
+ * @param {string} id the scan's
+ * @param {Body<'/api/scans/{id}/measurements', 'post'>} measurement
+ * @returns {Promise<Answer<'/api/scans/{id}/measurements', 'post', 201>>}
+ */
+const saveMeasurement = (id, measurement) => post(at('/api/scans/{id}/measurements', { id }), measurement);
+
+/**
+ * @param {string} id the scan's
+ * @param {number} mid the measurement's
+ * @returns {Promise<null>}
+ */
+const deleteMeasurement = (id, mid) => del(at('/api/scans/{id}/measurements/{mid}', { id, mid }));
+
+// ---- share links
+
+/**
+ * @param {string} id the scan's
+ * @returns {Promise<Answer<'/api/scans/{id}/shares', 'get', 200>>}
+ */
+const listShares = (id) => get(at('/api/scans/{id}/shares', { id }));
+
+/**
+ * @param {string} id the scan's
+ * @param {Body<'/api/scans/{id}/shares', 'post'>} share
+ * @returns {Promise<Answer<'/api/scans/{id}/shares', 'post', 201>>}
+ */
+const makeShare = (id, share) => post(at('/api/scans/{id}/shares', { id }), share);
+
+/**
+ * @param {string} id the share's
+ * @returns {Promise<null>}
+ */
+const withdrawShare = (id) => del(at('/api/shares/{id}', { id }));
+
+/**
+ * The customer's view of a share link; a 401 here is not a staff session's end.
+ * @param {string} token
+ * @returns {Promise<Answer<'/api/share/{token}', 'get', 200>>}
+ */
+const getShare = (token) => get(at('/api/share/{token}', { token }), { quiet401: true });
+
+// Every call, as `api.getScan(id)` and so on.
+export const api = {
+  getSession,
+  login,
+  logout,
+  listAccounts,
+  addAccount,
+  changeAccount,
+  deleteAccount,
+  getRig,
+  calibrate,
+  startScan,
+  answerPrompt,
+  cancelJob,
+  findCustomers,
+  getCustomer,
+  eraseCustomer,
+  findScans,
+  getScan,
+  deleteScan,
+  reprocess,
+  getMeasurements,
+  measure,
+  saveMeasurement,
+  deleteMeasurement,
+  listShares,
+  makeShare,
+  withdrawShare,
+  getShare,
+};
 
 // A query string from an object, skipping empty values.
 /** @param {Record<string, string | number | boolean | null | undefined>} params */

@@ -2,9 +2,23 @@
 // reconnected with backoff when the network drops, its JSON messages handed to
 // whoever listens (docs/api.md "Jobs and events").
 
+/** @typedef {import('./api.js').Job} Job */
+/** @typedef {import('./api.js').RigStatus} RigStatus */
+/**
+ * A message of the stream, as the document's /api/events lists them (in words:
+ * a WebSocket's messages have no schema there), or the stream's own news of its
+ * connection.
+ * @typedef {{ type: 'hello' | 'rig', rig: RigStatus }
+ *   | { type: 'job' | 'scan_finished', job: Job }
+ *   | { type: 'preview', job: string, camera: string, frame_id: number, png_base64: string }
+ *   | { type: 'connection', state: string }} EventMessage
+ */
+/** @typedef {(msg: EventMessage) => void} Listener */
+
 export class EventStream {
   constructor(url = eventsUrl()) {
     this.url = url;
+    /** @type {Set<Listener>} */
     this.listeners = new Set();
     this.socket = null;
     this.closed = false;
@@ -44,11 +58,16 @@ export class EventStream {
     };
   }
 
+  /** @param {string} state */
   setState(state) {
     this.state = state;
     for (const fn of this.listeners) fn({ type: 'connection', state });
   }
 
+  /**
+   * @param {Listener} fn
+   * @returns {() => void} stops the listening
+   */
   subscribe(fn) {
     this.listeners.add(fn);
     return () => this.listeners.delete(fn);

@@ -23,9 +23,12 @@ const routes = [
 const session = new Session();
 let events = null;
 
+// What every page's mount() is handed.
+/** @typedef {typeof ctx} PageContext */
 const ctx = {
   session,
   can,
+  /** @type {Router} */
   router: null,
   // The event stream, opened on first use by a staff page and closed at logout.
   events() {

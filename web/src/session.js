@@ -1,7 +1,7 @@
 // Who is logged in: the session from /api/session (or /api/login), its CSRF
 // token handed to api.js, and what the role may do (as the server's
 // x-bodyscan-access says; the server checks again on every call).
-import { get, post, setCsrfToken } from './api.js';
+import { api, setCsrfToken } from './api.js';
 
 export const can = {
   runRig: (role) => role === 'operator' || role === 'admin',
@@ -18,7 +18,8 @@ export function homeFor(role) {
 
 export class Session {
   constructor() {
-    this.user = null; // {username, role, csrf_token, expires_at}
+    /** @type {import('./api.js').Session | null} */
+    this.user = null;
     this.checked = false;
   }
 
@@ -34,7 +35,7 @@ export class Session {
 
   async refresh() {
     try {
-      this.set(await get('/api/session', { quiet401: true }));
+      this.set(await api.getSession());
     } catch (e) {
       if (e.status !== 401) throw e;
       this.set(null);
@@ -43,14 +44,14 @@ export class Session {
   }
 
   async login(username, password) {
-    const user = await post('/api/login', { username, password }, { quiet401: true });
+    const user = await api.login({ username, password });
     this.set(user);
     return user;
   }
 
   async logout() {
     try {
-      await post('/api/logout', {}, { quiet401: true });
+      await api.logout();
     } finally {
       this.set(null);
     }

@@ -1,10 +1,17 @@
 // Staff accounts (admin): add, change role or password, delete (never the last
 // admin; the server refuses).
-import { del, enc, get, post, put } from '../api.js';
+import { api } from '../api.js';
 import { clear, confirmDialog, errorText, formDialog, h, label, toast, when } from '../ui/dom.js';
+
+/** @typedef {import('../api.js').Account} Account */
 
 const ROLES = ['operator', 'tailor', 'admin'];
 
+/**
+ * @param {HTMLElement} container
+ * @param {Record<string, string>} _params
+ * @param {import('../main.js').PageContext} ctx
+ */
 export async function mount(container, _params, ctx) {
   const list = h('div', { class: 'results' });
   container.append(
@@ -19,7 +26,7 @@ export async function mount(container, _params, ctx) {
 
   async function load() {
     try {
-      const { accounts } = await get('/api/accounts');
+      const { accounts } = await api.listAccounts();
       clear(
         list,
         h(
@@ -68,7 +75,7 @@ export async function mount(container, _params, ctx) {
     ]);
     if (!data) return;
     try {
-      await post('/api/accounts', { username: data.get('username'), role: data.get('role'), password: data.get('password') });
+      await api.addAccount({ username: data.get('username'), role: data.get('role'), password: data.get('password') });
       toast(`Account ${data.get('username')} added.`, 'ok');
       load();
     } catch (e) {
@@ -76,9 +83,13 @@ export async function mount(container, _params, ctx) {
     }
   }
 
+  /**
+   * @param {Account} a
+   * @param {Parameters<typeof api.changeAccount>[1]} body
+   */
   async function change(a, body) {
     try {
-      await put(`/api/accounts/${enc(a.username)}`, body);
+      await api.changeAccount(a.username, body);
       toast(`${a.username} changed.`, 'ok');
     } catch (e) {
       toast(errorText(e), 'error');
@@ -86,6 +97,7 @@ export async function mount(container, _params, ctx) {
     load();
   }
 
+  /** @param {Account} a */
   async function password(a) {
     const data = await formDialog(`New password for ${a.username}`, [
       label('Password', h('input', { name: 'password', type: 'password', required: true, minlength: 10, autocomplete: 'new-password' }), 'at least 10 characters; their sessions end'),
@@ -93,10 +105,11 @@ export async function mount(container, _params, ctx) {
     if (data) change(a, { password: data.get('password') });
   }
 
+  /** @param {Account} a */
   async function remove(a) {
     if (!(await confirmDialog(`Delete the account ${a.username}?`, { confirm: 'Delete', danger: true }))) return;
     try {
-      await del(`/api/accounts/${enc(a.username)}`);
+      await api.deleteAccount(a.username);
       load();
     } catch (e) {
       toast(errorText(e), 'error');

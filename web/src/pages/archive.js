@@ -1,8 +1,13 @@
 // Find scans by customer, text and date; open, or (admin) delete with
 // confirmation.
-import { del, enc, get, query } from '../api.js';
+import { api, enc, query } from '../api.js';
 import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 
+/**
+ * @param {HTMLElement} container
+ * @param {Record<string, string>} _params
+ * @param {import('../main.js').PageContext} ctx
+ */
 export async function mount(container, _params, ctx) {
   const params = new URLSearchParams(location.search);
   const q = h('input', { type: 'search', name: 'q', value: params.get('q') || '', placeholder: 'Customer name, contact, operator or scan id', 'aria-label': 'Search' });
@@ -41,8 +46,8 @@ export async function mount(container, _params, ctx) {
     try {
       // The server compares "to" as a prefix of the ISO 8601 time: the whole day counts.
       const [{ scans }, { customers }] = await Promise.all([
-        get(`/api/scans${query({ q: q.value.trim(), from: from.value, to: to.value, limit: 500 })}`),
-        get('/api/customers'),
+        api.findScans({ q: q.value.trim(), from: from.value, to: to.value, limit: 500 }),
+        api.findCustomers(),
       ]);
       const names = new Map(customers.map((c) => [c.id, c]));
       if (!scans.length) {
@@ -84,11 +89,15 @@ export async function mount(container, _params, ctx) {
     }
   }
 
+  /**
+   * @param {import('../api.js').Scan} s
+   * @param {import('../api.js').Customer | undefined} c its customer, when known
+   */
   async function remove(s, c) {
     const who = c ? `${c.name}’s scan` : 'the scan';
     if (!(await confirmDialog(`Delete ${who} of ${when(s.started_at)}, with its model, measurements and share links? This cannot be undone.`, { title: 'Delete scan', confirm: 'Delete', danger: true }))) return;
     try {
-      await del(`/api/scans/${enc(s.id)}`);
+      await api.deleteScan(s.id);
       toast('Scan deleted.', 'ok');
       load();
     } catch (e) {

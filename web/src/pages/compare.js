@@ -1,6 +1,6 @@
 // Two scans of one customer side by side: the bodies turn together, the table
 // gives both values and the change; a row draws its line on both bodies.
-import { enc, get } from '../api.js';
+import { api, enc } from '../api.js';
 import { preferredUnit } from '../units.js';
 import { unitSelect } from '../ui/unit-select.js';
 import { clear, errorText, h, when } from '../ui/dom.js';
@@ -10,9 +10,10 @@ import { COLOURS, drawMeasurement, measurementTable } from '../viewer/measuremen
 export async function mount(container, { a, b }) {
   let unit = preferredUnit();
   let selected = null;
+  /** @type {import('../api.js').Scan[]} */
   let scans;
   try {
-    scans = await Promise.all([a, b].map((id) => get(`/api/scans/${enc(id)}`)));
+    scans = await Promise.all([a, b].map((id) => api.getScan(id)));
   } catch (e) {
     container.append(h('section', { class: 'page narrow' }, h('h1', {}, 'Scans not found'), h('p', {}, errorText(e))));
     return;
@@ -20,7 +21,7 @@ export async function mount(container, { a, b }) {
   // Older first on the left.
   scans.sort((x, y) => (x.started_at < y.started_at ? -1 : 1));
   const [older, newer] = scans;
-  const customer = await get(`/api/customers/${enc(newer.customer_id)}`).catch(() => null);
+  const customer = await api.getCustomer(newer.customer_id).catch(() => null);
   const ports = scans.map(() => h('div', { class: 'viewport' }));
   const tableBox = h('div', { class: 'table-box' });
   container.append(
@@ -58,6 +59,7 @@ export async function mount(container, { a, b }) {
       syncing = false;
     }),
   );
+  /** @type {[import('../api.js').StoredMeasurement[], import('../api.js').StoredMeasurement[]]} the earlier scan's, the later's */
   let sets = [[], []];
   function render() {
     clear(
@@ -81,7 +83,7 @@ export async function mount(container, { a, b }) {
     );
   }
   try {
-    const [m0, m1] = await Promise.all(scans.map((s) => get(`/api/scans/${enc(s.id)}/measurements`)));
+    const [m0, m1] = await Promise.all(scans.map((s) => api.getMeasurements(s.id)));
     sets = [m0.measurements, m1.measurements];
     render();
   } catch (e) {

@@ -1,12 +1,18 @@
 // A customer: their scans, two of them compared side by side, and (admin) the
 // customer erased with everything stored about them.
-import { del, enc, get } from '../api.js';
+import { api, enc } from '../api.js';
 import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 
+/**
+ * @param {HTMLElement} container
+ * @param {Record<string, string>} params
+ * @param {import('../main.js').PageContext} ctx
+ */
 export async function mount(container, { id }, ctx) {
+  /** @type {import('../api.js').Customer} */
   let customer;
   try {
-    customer = await get(`/api/customers/${enc(id)}`);
+    customer = await api.getCustomer(id);
   } catch (e) {
     container.append(h('section', { class: 'page narrow' }, h('h1', {}, 'Customer not found'), h('p', {}, errorText(e)), h('a', { href: '/archive' }, 'Back to the archive')));
     return;
@@ -71,7 +77,7 @@ export async function mount(container, { id }, ctx) {
                 onclick: async () => {
                   if (!(await confirmDialog(`Erase ${customer.name} and all ${scans.length} scan(s)? This cannot be undone.`, { title: 'Erase customer', confirm: 'Erase', danger: true }))) return;
                   try {
-                    await del(`/api/customers/${enc(id)}`);
+                    await api.eraseCustomer(id);
                     toast(`${customer.name} erased.`, 'ok');
                     ctx.router.navigate('/archive');
                   } catch (e) {

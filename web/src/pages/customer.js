@@ -1,7 +1,7 @@
 // The customer's page, opened from a share link: that scan's model and the
 // measurements staff chose, read-only. It calls only /api/share/{token}/…; the
 // token is the whole of the customer's access.
-import { enc, get } from '../api.js';
+import { api, enc } from '../api.js';
 import { preferredUnit } from '../units.js';
 import { unitSelect } from '../ui/unit-select.js';
 import { clear, errorText, h, when } from '../ui/dom.js';
@@ -12,9 +12,10 @@ export async function mount(container, { token }) {
   const t0 = performance.now();
   let unit = preferredUnit();
   let selected = null;
+  /** @type {import('../api.js').ShareView} */
   let share;
   try {
-    share = await get(`/api/share/${enc(token)}`, { quiet401: true });
+    share = await api.getShare(token);
   } catch (e) {
     container.append(
       h(

@@ -4,6 +4,11 @@ import { ApiError } from '../api.js';
 import { homeFor } from '../session.js';
 import { h } from '../ui/dom.js';
 
+/**
+ * @param {HTMLElement} container
+ * @param {Record<string, string>} _params
+ * @param {import('../main.js').PageContext} ctx
+ */
 export function mount(container, _params, ctx) {
   const next = new URLSearchParams(location.search).get('next');
   const message = h('p', { class: 'form-error', role: 'alert', hidden: true });

@@ -1,10 +1,15 @@
 // A customer share link: which measurements the customer sees, how long the link
 // lasts; the link is shown once (the server keeps only its hash). The scan's
 // other links are listed with their expiry and can be withdrawn.
-import { del, enc, get, post } from '../api.js';
+import { api } from '../api.js';
 import { formatLength } from '../units.js';
 import { clear, errorText, h, toast, when } from '../ui/dom.js';
 
+/**
+ * @param {string} scanId
+ * @param {import('../api.js').StoredMeasurement[]} measurements the scan's, to choose from
+ * @param {string} unit
+ */
 export async function shareDialog(scanId, measurements, unit) {
   const list = h('div', { class: 'share-list' });
   const checks = measurements.map((m) =>
@@ -29,7 +34,7 @@ export async function shareDialog(scanId, measurements, unit) {
 
   async function refresh() {
     try {
-      const { shares } = await get(`/api/scans/${enc(scanId)}/shares`);
+      const { shares } = await api.listShares(scanId);
       const now = Date.now() / 1000;
       clear(
         list,
@@ -51,7 +56,7 @@ export async function shareDialog(scanId, measurements, unit) {
                           class: 'link danger-text',
                           onclick: async () => {
                             try {
-                              await del(`/api/shares/${enc(s.id)}`);
+                              await api.withdrawShare(s.id);
                               refresh();
                             } catch (e) {
                               toast(errorText(e), 'error');
@@ -75,7 +80,7 @@ export async function shareDialog(scanId, measurements, unit) {
     e.preventDefault();
     const names = checks.map((c) => c.querySelector('input')).filter((i) => i.checked).map((i) => i.value);
     try {
-      const share = await post(`/api/scans/${enc(scanId)}/shares`, { days: Number(days.value), measurements: names });
+      const share = await api.makeShare(scanId, { days: Number(days.value), measurements: names });
       const url = share.url && /^https?:/.test(share.url) ? share.url : `${location.origin}/s/${share.token}`;
       const field = h('input', { readonly: true, value: url, class: 'share-url', 'aria-label': 'Share link', onfocus: (ev) => ev.target.select() });
       clear(

@@ -2,14 +2,33 @@
 // returning customer, its progress live over the WebSocket (stage, progress,
 // the cameras' previews, what the job asks the operator to do), cancel, and the
 // result opening by itself when done.
-import { enc, get, post, query } from '../api.js';
+import { api, enc } from '../api.js';
 import { overallFraction, stageText } from '../progress.js';
 import { ago, clear, errorText, h, toast, when } from '../ui/dom.js';
 import { wantedPostureCard } from '../viewer/posture.js';
 
+/** @typedef {import('../api.js').Job} Job */
+/** @typedef {import('../api.js').RigStatus} RigStatus */
+// The document leaves the cameras' fields open; these are the ones this page
+// reads, as /api/rig sends them (error: a fault to show, when the server gives one).
+/** @typedef {{ id: string, width: number, height: number, error?: string }} RigCamera */
+/** @typedef {{ id: string, side: string, lens_held_out_rms_px: number, ray_spread_mm: number }} CalibratedCamera */
 
+/**
+ * @param {HTMLElement} container
+ * @param {Record<string, string>} _params
+ * @param {import('../main.js').PageContext} ctx
+ */
 export async function mount(container, _params, ctx) {
-  const state = { rig: null, job: null, connection: 'connecting', customerMode: 'new', customerId: null, previews: new Map(), myJob: null };
+  const state = {
+    /** @type {RigStatus | null} */ rig: null,
+    /** @type {Job | null} */ job: null,
+    connection: 'connecting',
+    customerMode: 'new',
+    /** @type {string | null} */ customerId: null,
+    /** @type {Map<string, HTMLImageElement>} */ previews: new Map(),
+    /** @type {string | null} the job this page started */ myJob: null,
+  };
   const rigBox = h('div', { class: 'card rig-card', id: 'rig-status' });
   const jobBox = h('div', { class: 'card job-card', id: 'job', 'aria-live': 'polite' });
   const formBox = h('div', { class: 'card scan-card' });
@@ -32,7 +51,7 @@ export async function mount(container, _params, ctx) {
       return;
     }
     const cal = rig.calibration;
-    const calByCamera = new Map((cal?.cameras || []).map((c) => [c.id, c]));
+    const calByCamera = new Map(/** @type {CalibratedCamera[]} */ (cal?.cameras || []).map((c) => [c.id, c]));
     const busy = rig.busy || (state.job && state.job.state === 'running');
     clear(
       rigBox,
@@ -49,7 +68,7 @@ export async function mount(container, _params, ctx) {
         h(
           'tbody',
           {},
-          rig.cameras.map((c) => {
+          /** @type {RigCamera[]} */ (rig.cameras).map((c) => {
             const k = calByCamera.get(c.id);
             return h(
               'tr',
@@ -69,7 +88,7 @@ export async function mount(container, _params, ctx) {
 
   async function calibrate() {
     try {
-      const { job } = await post('/api/rig/calibrate', {});
+      const { job } = await api.calibrate();
       state.myJob = job.id;
       startedJob(job);
     } catch (e) {
@@ -93,7 +112,7 @@ export async function mount(container, _params, ctx) {
 
   async function findCustomers() {
     try {
-      const { customers } = await get(`/api/customers${query({ q: search.value.trim() })}`);
+      const { customers } = await api.findCustomers({ q: search.value.trim() });
       clear(
         results,
         customers.length
@@ -173,7 +192,7 @@ export async function mount(container, _params, ctx) {
           }
           startButton.disabled = true;
           try {
-            const { job } = await post('/api/scans', body);
+            const { job } = await api.startScan(body);
             state.myJob = job.id;
             startedJob(job);
             name.value = '';
@@ -205,10 +224,12 @@ export async function mount(container, _params, ctx) {
   const previewGrid = h('div', { class: 'previews' });
   // The answer to starting a job is older than any event about it that came
   // first (a prompt asked at once): it only shows a job not heard of yet.
+  /** @param {Job} job */
   function startedJob(job) {
     if (!state.job || state.job.id !== job.id) setJob(job);
   }
 
+  /** @param {Job} job */
   function setJob(job) {
     if (!state.job || state.job.id !== job.id) {
       state.lastFraction = 0;
@@ -253,6 +274,7 @@ export async function mount(container, _params, ctx) {
   // What the job waits for a person to do: hold the lens board before a camera,
   // or take it out of the rig. Confirming answers that very prompt; a newer one
   // (the picture could not be used) replaces it with the reason.
+  /** @param {Job} j a job with a prompt */
   function promptBox(j) {
     const p = j.prompt;
     const title = p.kind === 'remove_dot_grid' ? 'Clear the rig' : `Lens board before camera ${p.camera}`;
@@ -268,11 +290,16 @@ export async function mount(container, _params, ctx) {
     );
   }
 
+  /**
+   * @param {Job} j
+   * @param {import('../api.js').JobPrompt} p
+   * @param {HTMLButtonElement} button
+   */
   async function answer(j, p, button) {
     button.disabled = true;
     state.answered = `${j.id}/${p.id}`;
     try {
-      await post(`/api/jobs/${enc(j.id)}/prompt`, { prompt: p.id });
+      await api.answerPrompt(j.id, { prompt: p.id });
     } catch (e) {
       state.answered = null;
       button.disabled = false;
@@ -280,14 +307,16 @@ export async function mount(container, _params, ctx) {
     }
   }
 
+  /** @param {Job} j */
   async function cancel(j) {
     try {
-      await post(`/api/jobs/${enc(j.id)}/cancel`, {});
+      await api.cancelJob(j.id);
     } catch (e) {
       toast(errorText(e), 'error');
     }
   }
 
+  /** @param {Extract<import('../events.js').EventMessage, { type: 'preview' }>} p */
   function showPreview(p) {
     let img = state.previews.get(p.camera);
     if (!img) {
@@ -300,7 +329,7 @@ export async function mount(container, _params, ctx) {
 
   async function renderRecent() {
     try {
-      const [{ scans }, { customers }] = await Promise.all([get(`/api/scans${query({ limit: 6 })}`), get('/api/customers')]);
+      const [{ scans }, { customers }] = await Promise.all([api.findScans({ limit: 6 }), api.findCustomers()]);
       const names = new Map(customers.map((c) => [c.id, c.name]));
       clear(
         recentBox,
@@ -353,7 +382,7 @@ export async function mount(container, _params, ctx) {
   renderJob();
   renderRecent();
   try {
-    const rig = await get('/api/rig');
+    const rig = await api.getRig();
     state.rig = rig;
     if (rig.job) state.job = rig.job;
     renderRig();

@@ -1,6 +1,6 @@
 // The tailor's page: one scan's body, its measurements, new ones drawn on it and
 // evaluated by the server, saved by name, exported, shared with the customer.
-import { del, enc, get, post } from '../api.js';
+import { api, enc } from '../api.js';
 import { formatLength, preferredUnit } from '../units.js';
 import { unitSelect } from '../ui/unit-select.js';
 import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
@@ -9,6 +9,18 @@ import { MeasureTool, TOOLS } from '../viewer/measure-tool.js';
 import { COLOURS, drawMeasurement, KIND_LABEL, measurementTable, slug } from '../viewer/measurement-table.js';
 import { postureCard } from '../viewer/posture.js';
 import { shareDialog } from './share-dialog.js';
+
+/** @typedef {import('../api.js').Customer} Customer */
+/** @typedef {import('../api.js').MeasureRequest} MeasureRequest */
+/** @typedef {import('../api.js').Measurement} Measurement */
+/** @typedef {import('../api.js').Posture} Posture */
+/** @typedef {import('../api.js').Scan} Scan */
+/** @typedef {import('../api.js').StoredMeasurement} StoredMeasurement */
+/**
+ * A measurement drawn and sent to the server: waiting for its answer, answered,
+ * or refused.
+ * @typedef {{ request: MeasureRequest, toolName: string, pending?: boolean, result?: Measurement, error?: string }} Fresh
+ */
 
 // The model's bytes, asked for at once (the current version, revalidated by its
 // ETag), beside the scan's record rather than after it.
@@ -21,11 +33,16 @@ function fetchModel(id) {
   return bytes;
 }
 
+/**
+ * @param {HTMLElement} container
+ * @param {Record<string, string>} params
+ * @param {import('../main.js').PageContext} ctx
+ */
 export async function mount(container, { id }, ctx) {
   const t0 = performance.now();
   performance.mark('bodyscan:open-scan');
   const bytes = fetchModel(id);
-  const record = get(`/api/scans/${enc(id)}`);
+  const record = api.getScan(id);
   record.catch(() => {});
   // The model decodes in a worker while the page and its renderer are built:
   // wait (briefly) for its bytes, then one task more, so that the decoder's
@@ -34,7 +51,15 @@ export async function mount(container, { id }, ctx) {
   const nextTask = () => new Promise((r) => setTimeout(r, 0));
   await Promise.race([bytes.then(nextTask, () => {}), new Promise((r) => setTimeout(r, 250))]);
   const role = ctx.session.role;
-  const state = { unit: preferredUnit(), selected: null, fresh: null, measurements: [], posture: null, scan: null, customer: null };
+  const state = {
+    unit: preferredUnit(),
+    /** @type {string | null} the name of the measurement drawn on the body */ selected: null,
+    /** @type {Fresh | null} */ fresh: null,
+    /** @type {StoredMeasurement[]} */ measurements: [],
+    /** @type {Posture | null} */ posture: null,
+    /** @type {Scan | null} */ scan: null,
+    /** @type {Customer | null} */ customer: null,
+  };
 
   const viewport = h('div', { class: 'viewport', id: 'viewport' });
   const hint = h('p', { class: 'hint', role: 'status' }, TOOLS.rotate.hint);
@@ -93,7 +118,7 @@ export async function mount(container, { id }, ctx) {
   // ---- data
   async function loadCustomer() {
     try {
-      state.customer = await get(`/api/customers/${enc(state.scan.customer_id)}`);
+      state.customer = await api.getCustomer(state.scan.customer_id);
     } catch {
       state.customer = null;
     }
@@ -101,7 +126,7 @@ export async function mount(container, { id }, ctx) {
   }
 
   async function loadMeasurements() {
-    const m = await get(`/api/scans/${enc(id)}/measurements`);
+    const m = await api.getMeasurements(id);
     state.measurements = m.measurements;
     state.posture = m.posture || null;
     clear(postureBox, postureCard(state.posture, state.measurements));
@@ -146,6 +171,7 @@ export async function mount(container, { id }, ctx) {
     );
   }
 
+  /** @param {StoredMeasurement} m */
   function select(m) {
     state.selected = state.selected === m.name ? null : m.name;
     view.clearOverlays('sel');
@@ -159,12 +185,16 @@ export async function mount(container, { id }, ctx) {
 
   // ---- a new measurement, evaluated by the server
   let evaluating = 0;
+  /**
+   * @param {MeasureRequest} request
+   * @param {string} toolName
+   */
   async function evaluate(request, toolName) {
     const seq = ++evaluating;
     state.fresh = { request, toolName, pending: true };
     renderResult();
     try {
-      const result = await post(`/api/scans/${enc(id)}/measure`, request);
+      const result = await api.measure(id, request);
       if (seq !== evaluating || disposed) return;
       state.fresh = { request, toolName, result };
       view.clearOverlays('pick:');
@@ -221,11 +251,15 @@ export async function mount(container, { id }, ctx) {
     renderResult();
   }
 
+  /**
+   * @param {string} labelText
+   * @param {MeasureRequest} request
+   */
   async function save(labelText, request) {
     if (!labelText) return;
     const taken = new Set(state.measurements.map((m) => m.name));
     try {
-      const saved = await post(`/api/scans/${enc(id)}/measurements`, { name: slug(labelText, taken), label: labelText, request });
+      const saved = await api.saveMeasurement(id, { name: slug(labelText, taken), label: labelText, request });
       toast(`Saved “${saved.label}”: ${formatLength(saved.value_mm, state.unit)}`, 'ok');
       discard();
       await loadMeasurements();
@@ -235,10 +269,11 @@ export async function mount(container, { id }, ctx) {
     }
   }
 
+  /** @param {StoredMeasurement} m */
   async function removeMeasurement(m) {
     if (!(await confirmDialog(`Delete the saved measurement “${m.label || m.name}”?`, { confirm: 'Delete', danger: true }))) return;
     try {
-      await del(`/api/scans/${enc(id)}/measurements/${m.id}`);
+      await api.deleteMeasurement(id, m.id);
       if (state.selected === m.name) select(m);
       await loadMeasurements();
     } catch (e) {
@@ -272,7 +307,7 @@ export async function mount(container, { id }, ctx) {
   async function reprocess() {
     if (!(await confirmDialog('Process this scan again from its raw record? It becomes a new version; the old one is kept.', { confirm: 'Reprocess' }))) return;
     try {
-      await post(`/api/scans/${enc(id)}/reprocess`, {});
+      await api.reprocess(id);
       toast('Reprocessing; the new version opens when it is done.', 'ok');
       watchJob();
     } catch (e) {
@@ -283,7 +318,7 @@ export async function mount(container, { id }, ctx) {
   async function deleteScan() {
     if (!(await confirmDialog('Delete this scan, its model, measurements and share links? This cannot be undone.', { title: 'Delete scan', confirm: 'Delete', danger: true }))) return;
     try {
-      await del(`/api/scans/${enc(id)}`);
+      await api.deleteScan(id);
       toast('Scan deleted.', 'ok');
       ctx.router.navigate(state.scan?.customer_id ? `/customers/${enc(state.scan.customer_id)}` : '/archive');
     } catch (e) {

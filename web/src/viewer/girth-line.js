@@ -4,6 +4,8 @@
 // holding both is the plane the user sees edge-on. Pure: tested under node.
 import { Plane, Ray, Vector3 } from 'three';
 
+/** @typedef {import('../api.js').MeasureRequest} MeasureRequest */
+
 // The ray from the camera through a point in normalised device coordinates.
 export function rayThrough(camera, ndc) {
   camera.updateMatrixWorld();
@@ -15,6 +17,13 @@ export function rayThrough(camera, ndc) {
 // The girth request for a screen line from `a` to `b` (NDC). Its ends are put at
 // the depth of `depthPoint` (the skin under the line's middle, or the orbit
 // centre): the server goes round the loop nearest the line's midpoint.
+/**
+ * @param {import('three').Camera} camera
+ * @param {{ x: number, y: number }} a
+ * @param {{ x: number, y: number }} b
+ * @param {Vector3} depthPoint
+ * @returns {MeasureRequest | null} null when the line does not meet that depth
+ */
 export function girthRequestFromScreenLine(camera, a, b, depthPoint) {
   const ra = rayThrough(camera, a);
   const rb = rayThrough(camera, b);
@@ -30,6 +39,12 @@ export function girthRequestFromScreenLine(camera, a, b, depthPoint) {
 
 // The arc along the tape between two picked points: the plane holds both and
 // the view direction (the tape the tailor would lay across what they see).
+/**
+ * @param {import('three').Camera} camera
+ * @param {number[]} from [x, y, z] mm
+ * @param {number[]} to [x, y, z] mm
+ * @returns {MeasureRequest}
+ */
 export function arcRequest(camera, from, to) {
   const eye = new Vector3().setFromMatrixPosition(camera.matrixWorld);
   const mid = new Vector3().fromArray(from).add(new Vector3().fromArray(to)).multiplyScalar(0.5);
@@ -38,6 +53,7 @@ export function arcRequest(camera, from, to) {
 }
 
 // The cutting plane a girth request stands for: {point, normal} (unit normal).
+/** @param {MeasureRequest} request */
 export function requestPlane(request) {
   const from = new Vector3().fromArray(request.line.from);
   const to = new Vector3().fromArray(request.line.to);

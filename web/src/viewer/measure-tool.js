@@ -24,7 +24,7 @@ export class MeasureTool {
   /**
    * @param {import('./body-view.js').BodyView} view
    * @param {object} handlers
-   * @param {(request: object, toolName: string) => void} handlers.onRequest
+   * @param {(request: import('../api.js').MeasureRequest, toolName: string) => void} handlers.onRequest
    * @param {(hint: string) => void} [handlers.onHint]
    */
   constructor(view, { onRequest, onHint = () => {} }) {
@@ -143,6 +143,7 @@ export class MeasureTool {
     }
     const [from, to] = this.picked;
     this.picked = [];
+    /** @type {import('../api.js').MeasureRequest} */
     const request =
       this.mode === 'arc' ? arcRequest(this.view.camera, from, to) : { kind: this.mode === 'surface' ? 'surface' : 'distance', from, to };
     this.onRequest(request, TOOLS[this.mode].label);

@@ -3,6 +3,8 @@
 import { formatDifference, formatLength } from '../units.js';
 import { h } from '../ui/dom.js';
 
+/** @typedef {import('../api.js').StoredMeasurement} StoredMeasurement */
+
 export const KIND_LABEL = {
   girth: 'girth',
   height: 'height',
@@ -31,12 +33,12 @@ export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
 // rows: [{m, other?}] - `other` is the same measurement on a second scan (compare).
 /**
  * @param {object} options
- * @param {any[]} options.measurements
+ * @param {StoredMeasurement[]} options.measurements
  * @param {string} options.unit
  * @param {string | null} options.selected the name of the selected row
- * @param {(m: any) => void} options.onSelect
- * @param {((m: any) => void) | null} [options.onDelete] a Delete button on each saved row
- * @param {any[] | null} [options.compareWith] the same scan's measurements on another scan
+ * @param {(m: StoredMeasurement) => void} options.onSelect
+ * @param {((m: StoredMeasurement) => void) | null} [options.onDelete] a Delete button on each saved row
+ * @param {StoredMeasurement[] | null} [options.compareWith] the same scan's measurements on another scan
  * @param {[string, string]} [options.columns] the headings of the two values compared
  * @param {string} [options.caption]
  * @param {Record<string, string>} [options.groups] the heading of each source's rows
