@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the browser UI's npm packages (web/node_modules) exactly as
 # web/package-lock.json pins them: three, three-mesh-bvh, Vite, terser,
-# playwright-core. Idempotent: skipped while the lockfile is unchanged since the
+# playwright-core, and ESLint, TypeScript and openapi-typescript for
+# `npm run check`. Idempotent: skipped while the lockfile is unchanged since the
 # last install. Needs Node.js >= 18.19 (Debian 12's nodejs 18.20 will do; the
 # lockfile's packages are held to it by web/tests/unit/toolchain.test.mjs) and the
 # npm registry (no CDN at run time: the UI is bundled from these packages by the
