@@ -27,16 +27,17 @@ namespace {
 void print_accuracy(const TriangleMesh& mesh, const TriangleMesh& truth) {
   const MeshComparison c = compare_meshes(mesh, truth, 1'000'000, 12345);
   auto row = [](const char* name, const DistanceStats& d) {
-    std::printf("%-16s mean %.3f  rms %.3f  p95 %.3f  p99 %.3f  max %.3f mm\n", name, d.mean, d.rms, d.p95,
-                d.p99, d.max);
+    std::printf("%-16s mean %.3f  rms %.3f  p95 %.3f  p99 %.3f  max %.3f mm\n", name, d.mean, d.rms, d.p95, d.p99,
+                d.max);
   };
   row("output->truth", c.output_to_truth);
   row("truth->output", c.truth_to_output);
   const MeshTopology t = analyze_topology(mesh);
-  std::printf("topology        %zu vertices, %zu triangles, %zu components, %zu boundary edges, "
-              "%zu non-manifold edges, Euler %ld\n",
-              mesh.num_vertices(), mesh.num_triangles(), t.components, t.boundary_edges, t.non_manifold_edges,
-              t.euler_characteristic);
+  std::printf(
+      "topology        %zu vertices, %zu triangles, %zu components, %zu boundary edges, "
+      "%zu non-manifold edges, Euler %ld\n",
+      mesh.num_vertices(), mesh.num_triangles(), t.components, t.boundary_edges, t.non_manifold_edges,
+      t.euler_characteristic);
 }
 
 }  // namespace
@@ -56,19 +57,30 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--body") body = next();
-    else if (a == "--points") points = std::strtoull(next(), nullptr, 10);
-    else if (a == "--noise") noise = std::atof(next());
-    else if (a == "--seed") seed = std::strtoull(next(), nullptr, 10);
-    else if (a == "--cloud-out") cloud_out = next();
-    else if (a == "--mesh-out") mesh_out = next();
-    else if (a == "--evaluate") evaluate = next();
-    else if (a == "--voxel") opt.voxel_size = static_cast<float>(std::atof(next()));
-    else if (a == "--sigma") opt.sigma_scale = static_cast<float>(std::atof(next()));
-    else if (a == "--normal-sigma") opt.normal_scale = static_cast<float>(std::atof(next()));
+    if (a == "--body")
+      body = next();
+    else if (a == "--points")
+      points = std::strtoull(next(), nullptr, 10);
+    else if (a == "--noise")
+      noise = std::atof(next());
+    else if (a == "--seed")
+      seed = std::strtoull(next(), nullptr, 10);
+    else if (a == "--cloud-out")
+      cloud_out = next();
+    else if (a == "--mesh-out")
+      mesh_out = next();
+    else if (a == "--evaluate")
+      evaluate = next();
+    else if (a == "--voxel")
+      opt.voxel_size = static_cast<float>(std::atof(next()));
+    else if (a == "--sigma")
+      opt.sigma_scale = static_cast<float>(std::atof(next()));
+    else if (a == "--normal-sigma")
+      opt.normal_scale = static_cast<float>(std::atof(next()));
     else {
-      std::fprintf(stderr, "usage: body_benchmark --body MESH.ply [--points N] [--noise MM] [--seed S] "
-                           "[--cloud-out F] [--mesh-out F] [--evaluate MESH.ply]\n");
+      std::fprintf(stderr,
+                   "usage: body_benchmark --body MESH.ply [--points N] [--noise MM] [--seed S] "
+                   "[--cloud-out F] [--mesh-out F] [--evaluate MESH.ply]\n");
       return 2;
     }
   }
@@ -101,8 +113,8 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  std::printf("input           %zu points from %s, noise %.2f mm (per axis), no normals\n", cloud.size(),
-              body.c_str(), noise);
+  std::printf("input           %zu points from %s, noise %.2f mm (per axis), no normals\n", cloud.size(), body.c_str(),
+              noise);
   const auto t0 = std::chrono::steady_clock::now();
   auto r = reconstruct_surface(cloud, opt);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -113,15 +125,17 @@ int main(int argc, char** argv) {
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   const ReconstructStats& s = r->stats;
-  std::printf("wall time       %.2f s (neighbours %.2f, normals %.2f, orientation %.2f, kernels %.2f, "
-              "field %.2f, mesh %.2f)\n",
-              wall, s.t_neighbours, s.t_normals, s.t_orientation, s.t_kernels, s.t_field, s.t_mesh);
+  std::printf(
+      "wall time       %.2f s (neighbours %.2f, normals %.2f, orientation %.2f, kernels %.2f, "
+      "field %.2f, mesh %.2f)\n",
+      wall, s.t_neighbours, s.t_normals, s.t_orientation, s.t_kernels, s.t_field, s.t_mesh);
   std::printf("peak memory     %.0f MB (whole process, includes the input and the truth mesh)\n",
               static_cast<double>(ru.ru_maxrss) / 1024.0);
-  std::printf("parameters      spacing %.3f mm, noise estimate %.3f mm, sigma %.2f, normal-sigma %.2f, "
-              "voxel %.3f mm, normal-k %zu, %zu bricks (%.0f MB)\n",
-              s.median_density_sigma, s.noise_sigma, s.sigma_scale, s.normal_scale, s.voxel_size, s.normal_k,
-              s.bricks, static_cast<double>(s.field_bytes) / 1e6);
+  std::printf(
+      "parameters      spacing %.3f mm, noise estimate %.3f mm, sigma %.2f, normal-sigma %.2f, "
+      "voxel %.3f mm, normal-k %zu, %zu bricks (%.0f MB)\n",
+      s.median_density_sigma, s.noise_sigma, s.sigma_scale, s.normal_scale, s.voxel_size, s.normal_k, s.bricks,
+      static_cast<double>(s.field_bytes) / 1e6);
   print_accuracy(r->mesh, *truth);
   if (!mesh_out.empty()) {
     const Status st = write_ply(mesh_out, r->mesh);

@@ -12,8 +12,8 @@ namespace bodyscan::bench {
 
 inline std::string body_region(const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
   const char* band = p.y() < 80 ? "feet" : p.y() < 800 ? "legs" : p.y() < 1450 ? "trunk" : "head/neck";
-  const char* facing = n.y() > 0.7    ? "up"
-                       : n.y() < -0.7 ? "down"
+  const char* facing = n.y() > 0.7                         ? "up"
+                       : n.y() < -0.7                      ? "down"
                        : std::abs(n.x()) > std::abs(n.z()) ? "side"
                        : n.z() > 0                         ? "front"
                                                            : "back";

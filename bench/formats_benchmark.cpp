@@ -41,10 +41,14 @@ int main(int argc, char** argv) {
   storage::DracoOptions served;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--repeat" && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--level" && i + 1 < argc) served.compression_level = std::atoi(argv[++i]);
-    else if (a == "--normals") served.normals = true;
-    else files.push_back(a);
+    if (a == "--repeat" && i + 1 < argc)
+      repeat = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--level" && i + 1 < argc)
+      served.compression_level = std::atoi(argv[++i]);
+    else if (a == "--normals")
+      served.normals = true;
+    else
+      files.push_back(a);
   }
   if (files.empty()) {
     std::fprintf(stderr, "usage: formats_benchmark MESH.ply... [--repeat N]\n");

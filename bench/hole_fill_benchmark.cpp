@@ -74,15 +74,24 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--max-dp") limits.push_back(std::strtoull(next(), nullptr, 10));
-    else if (a == "--repeat") repeat = std::max(1, std::atoi(next()));
-    else if (a == "--membrane") options.fairing = HoleFairing::kMembrane;
-    else if (a == "--out") out = next();
-    else if (a == "--save-open") save_open = next();
-    else if (a == "--min-weight") min_weight = std::strtof(next(), nullptr);
-    else if (!a.empty() && a[0] != '-' && in.empty()) in = a;
+    if (a == "--max-dp")
+      limits.push_back(std::strtoull(next(), nullptr, 10));
+    else if (a == "--repeat")
+      repeat = std::max(1, std::atoi(next()));
+    else if (a == "--membrane")
+      options.fairing = HoleFairing::kMembrane;
+    else if (a == "--out")
+      out = next();
+    else if (a == "--save-open")
+      save_open = next();
+    else if (a == "--min-weight")
+      min_weight = std::strtof(next(), nullptr);
+    else if (!a.empty() && a[0] != '-' && in.empty())
+      in = a;
     else {
-      std::fprintf(stderr, "usage: hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R] [--save-open OPEN.ply] [--out FILLED.ply] [--min-weight W]\n");
+      std::fprintf(stderr,
+                   "usage: hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R] [--save-open "
+                   "OPEN.ply] [--out FILLED.ply] [--min-weight W]\n");
       return 2;
     }
   }
@@ -124,10 +133,11 @@ int main(int argc, char** argv) {
       stats = fill_holes(filled, options);
       best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
-    std::printf("max_dp %5zu: %8.3f s  loops %zu filled %zu longest %zu  +%zu triangles +%zu vertices  "
-                "area %.0f  checksum %016llx\n",
-                limit, best, stats.holes, stats.holes_filled, stats.largest_hole_edges, stats.triangles_added,
-                stats.vertices_added, stats.area_added, static_cast<unsigned long long>(checksum(filled)));
+    std::printf(
+        "max_dp %5zu: %8.3f s  loops %zu filled %zu longest %zu  +%zu triangles +%zu vertices  "
+        "area %.0f  checksum %016llx\n",
+        limit, best, stats.holes, stats.holes_filled, stats.largest_hole_edges, stats.triangles_added,
+        stats.vertices_added, stats.area_added, static_cast<unsigned long long>(checksum(filled)));
     if (!out.empty() && limit == limits.back()) {
       const Status s = write_ply(out, filled);
       if (!s.ok()) {

@@ -50,13 +50,13 @@
 #include <string>
 #include <vector>
 
+#include "hw/sim/scene.hpp"
 #include "recon/geometry/skin_noise.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_measurements.hpp"
 #include "recon/measure/body_slicer.hpp"
-#include "hw/sim/scene.hpp"
-#include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/rig_backend.hpp"
+#include "server/pipeline/scan_job.hpp"
 
 using namespace bodyscan;
 using Clock = std::chrono::steady_clock;
@@ -119,8 +119,9 @@ std::string sway_error(const SwayEstimate& est, const std::vector<int32_t>& fram
                   est.regularization.ridge_scale, est.regularization.slow_scale > 0 ? ", slow part held" : "");
   }
   char line[256];
-  std::snprintf(line, sizeof line, "%.2f mm RMS off the simulator's %.2f mm RMS (x %.2f, z %.2f; frame offset %.1f); %s",
-                axis.norm(), truth, axis.x(), axis.z(), best, hold);
+  std::snprintf(line, sizeof line,
+                "%.2f mm RMS off the simulator's %.2f mm RMS (x %.2f, z %.2f; frame offset %.1f); %s", axis.norm(),
+                truth, axis.x(), axis.z(), best, hold);
   return line;
 }
 
@@ -162,8 +163,8 @@ StatusOr<Scan> scan(const std::string& rig_name, const std::string& body, uint64
   if (!body.empty()) {
     ASSIGN_OR_RETURN(subject, read_ply_mesh(body));
   }
-  ASSIGN_OR_RETURN(auto sim, body.empty() ? hw::sim::SimulatedRig::create(desc)
-                                          : hw::sim::SimulatedRig::create(desc, subject));
+  ASSIGN_OR_RETURN(auto sim,
+                   body.empty() ? hw::sim::SimulatedRig::create(desc) : hw::sim::SimulatedRig::create(desc, subject));
   pipeline::ScanJobOptions o;
   o.every = every;
   o.surface = g_surface;
@@ -197,7 +198,6 @@ const char* mark(double diff, double allow) {
   const double d = std::abs(diff);
   return d <= allow / 6 ? "aim" : d <= allow / 2 ? "must" : "FAIL";
 }
-
 
 // Fixed planes, the automatic set against the truth's, and (with a second scan's
 // set) the repeatability.
@@ -276,7 +276,8 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
     aim += std::abs(d) <= al / 6;
     std::printf("%-24s %6s %8.1f %8.1f %+7.2f %6.1f  %s%s%s\n", m.name.c_str(), m.iso_clause.c_str(), m.value_mm,
                 s->value_mm, d, al, std::abs(d) <= al ? (std::abs(d) <= al / 2 ? mark(d, al) : "iso") : "OVER",
-                s->crosses_filled_hole() ? "  (crosses fill)" : "", m.outside_posture || s->outside_posture ? "  (outside posture)" : "");
+                s->crosses_filled_hole() ? "  (crosses fill)" : "",
+                m.outside_posture || s->outside_posture ? "  (outside posture)" : "");
   }
   std::printf("%zu measurements: %zu within the ISO allowance, %zu within half, %zu within a sixth\n", n, iso, must,
               aim);
@@ -294,8 +295,8 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
       if (d > worst) worst = d, worst_name = m.name;
     }
     std::sort(diffs.begin(), diffs.end());
-    std::printf("\nrepeatability (seed +1, sway %.0f mm): %zu measurements, median %.2f mm, largest %.2f mm (%s)\n", sway,
-                diffs.size(), diffs.empty() ? 0.0 : diffs[diffs.size() / 2], worst, worst_name.c_str());
+    std::printf("\nrepeatability (seed +1, sway %.0f mm): %zu measurements, median %.2f mm, largest %.2f mm (%s)\n",
+                sway, diffs.size(), diffs.empty() ? 0.0 : diffs[diffs.size() / 2], worst, worst_name.c_str());
     for (const BodyMeasurement& m : scan_body.measurements)
       if (const BodyMeasurement* o = second->find(m.name); o && std::abs(o->value_mm - m.value_mm) > 1.0)
         std::printf("  %-24s %8.1f %8.1f %+6.2f\n", m.name.c_str(), m.value_mm, o->value_mm, o->value_mm - m.value_mm);
@@ -313,7 +314,8 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   auto a = scan(rig, body, g_seed, 0, every);
   if (!a.ok()) return std::fprintf(stderr, "scan: %s\n", a.status().message().c_str()), 1;
   std::printf("scan job %.0f s, mesh %zu triangles\n", secs(t0), a->mesh.triangles.size());
-  const std::string stem = g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
+  const std::string stem =
+      g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
   if (!g_save.empty()) {
     for (const Status& w : {write_ply(stem + "-scan.ply", a->mesh), write_ply(stem + "-truth.ply", a->truth),
                             write_ply(stem + "-cloud.ply", a->cloud)})
@@ -407,7 +409,8 @@ int noise_study(const std::string& body, int n, double rms_mm, const std::string
     const TriangleMesh noisy = with_smooth_skin_noise(*mesh, rms_mm, s);
     if (!noisy_out.empty()) {
       const std::string path = noisy_out + "/noisy" + std::to_string(s) + ".ply";
-      if (Status w = write_ply(path, noisy); !w.ok()) std::fprintf(stderr, "%s: %s\n", path.c_str(), w.message().c_str());
+      if (Status w = write_ply(path, noisy); !w.ok())
+        std::fprintf(stderr, "%s: %s\n", path.c_str(), w.message().c_str());
     }
     auto m = measure_body(noisy);
     if (!m.ok()) {
@@ -458,28 +461,45 @@ int main(int argc, char** argv) {
   std::string noisy_out;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
-    else if (a == "--body" && i + 1 < argc) bodies.push_back(argv[++i]);
-    else if (a == "--repeat") repeat = true;
-    else if (a == "--sway" && i + 1 < argc) sway = std::atof(argv[++i]);
-    else if (a == "--every" && i + 1 < argc) every = std::atoi(argv[++i]);
-    else if (a == "--save" && i + 1 < argc) g_save = argv[++i];
-    else if (a == "--saved" && i + 1 < argc) saved = argv[++i];
-    else if (a == "--resurface") g_resurface = true;
-    else if (a == "--noise-study" && i + 1 < argc) noise_fields = std::atoi(argv[++i]);
-    else if (a == "--noise-rms" && i + 1 < argc) noise_rms = std::atof(argv[++i]);
-    else if (a == "--noisy-out" && i + 1 < argc) noisy_out = argv[++i];
-    else if (a == "--seed" && i + 1 < argc) g_seed = std::strtoull(argv[++i], nullptr, 10);
-    else if (a == "--min-weight" && i + 1 < argc) g_surface.min_relative_weight = std::strtof(argv[++i], nullptr);
-    else if (a == "--posture" && i + 1 < argc && parse_posture(argv[i + 1])) ++i;
+    if (a == "--rig" && i + 1 < argc)
+      rigs.push_back(argv[++i]);
+    else if (a == "--body" && i + 1 < argc)
+      bodies.push_back(argv[++i]);
+    else if (a == "--repeat")
+      repeat = true;
+    else if (a == "--sway" && i + 1 < argc)
+      sway = std::atof(argv[++i]);
+    else if (a == "--every" && i + 1 < argc)
+      every = std::atoi(argv[++i]);
+    else if (a == "--save" && i + 1 < argc)
+      g_save = argv[++i];
+    else if (a == "--saved" && i + 1 < argc)
+      saved = argv[++i];
+    else if (a == "--resurface")
+      g_resurface = true;
+    else if (a == "--noise-study" && i + 1 < argc)
+      noise_fields = std::atoi(argv[++i]);
+    else if (a == "--noise-rms" && i + 1 < argc)
+      noise_rms = std::atof(argv[++i]);
+    else if (a == "--noisy-out" && i + 1 < argc)
+      noisy_out = argv[++i];
+    else if (a == "--seed" && i + 1 < argc)
+      g_seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (a == "--min-weight" && i + 1 < argc)
+      g_surface.min_relative_weight = std::strtof(argv[++i], nullptr);
+    else if (a == "--posture" && i + 1 < argc && parse_posture(argv[i + 1]))
+      ++i;
     else if (a == "--fairing" && i + 1 < argc) {
       const std::string f = argv[++i];
       g_surface.hole_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
-    }
-    else return std::fprintf(stderr, "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
-                        "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W] "
-                        "[--posture ARMS,FEET,TURN]\n"
-                        "       measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body B...\n"), 2;
+    } else
+      return std::fprintf(
+                 stderr,
+                 "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
+                 "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W] "
+                 "[--posture ARMS,FEET,TURN]\n"
+                 "       measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body B...\n"),
+             2;
   }
   if (noise_fields > 0) {
     if (bodies.empty()) return std::fprintf(stderr, "measure_benchmark: --noise-study needs --body B.ply\n"), 2;
@@ -493,6 +513,7 @@ int main(int argc, char** argv) {
   if (!saved.empty() && bodies == std::vector<std::string>{""})
     return std::fprintf(stderr, "measure_benchmark: --saved needs the bodies' names (--body B.ply)\n"), 2;
   for (const std::string& r : rigs)
-    for (const std::string& b : bodies) rc |= saved.empty() ? run(r, b, repeat, sway, every) : remeasure(saved, r, b, sway);
+    for (const std::string& b : bodies)
+      rc |= saved.empty() ? run(r, b, repeat, sway, every) : remeasure(saved, r, b, sway);
   return rc;
 }

@@ -127,7 +127,8 @@ Row compare(const Reference& ref, const std::string& variant, const TriangleMesh
     }
     if (detail && std::abs(change) > 0.5 * iso20685_allowance_mm(m)) {
       char b[160];
-      std::snprintf(b, sizeof b, "%s %+.1f (allowance %.0f; skin moved %.1f mm)", m.name.c_str(), change, iso20685_allowance_mm(m), skin);
+      std::snprintf(b, sizeof b, "%s %+.1f (allowance %.0f; skin moved %.1f mm)", m.name.c_str(), change,
+                    iso20685_allowance_mm(m), skin);
       row.detail.push_back(b);
     }
     if (posed && m.name.rfind("outer_arm_length", 0) == 0) {
@@ -185,12 +186,18 @@ int main(int argc, char** argv) {
       return 2;
     }
     ++i;
-    if (a == "--body") bodies.push_back(v);
-    else if (a == "--arms") arms = list(v);
-    else if (a == "--feet") feet = list(v);
-    else if (a == "--turns") turns = list(v);
-    else if (a == "--shift") shift = std::atof(v);
-    else if (a == "--json") json_out = v;
+    if (a == "--body")
+      bodies.push_back(v);
+    else if (a == "--arms")
+      arms = list(v);
+    else if (a == "--feet")
+      feet = list(v);
+    else if (a == "--turns")
+      turns = list(v);
+    else if (a == "--shift")
+      shift = std::atof(v);
+    else if (a == "--json")
+      json_out = v;
     else {
       std::fprintf(stderr, "posture_benchmark: unknown option %s\n", a.c_str());
       return 2;
@@ -199,7 +206,8 @@ int main(int argc, char** argv) {
   const std::string shared = BODYSCAN_SOURCE_DIR "/../shared/data/bodies";
   if (bodies.empty()) {
     if (std::filesystem::exists(shared + "/male_average.ply")) {
-      for (const char* b : {"male_average", "male_heavy", "male_muscular", "female_average", "female_heavy", "female_slim_tall"})
+      for (const char* b :
+           {"male_average", "male_heavy", "male_muscular", "female_average", "female_heavy", "female_slim_tall"})
         bodies.push_back(shared + "/" + b + ".ply");
     } else {
       for (const char* b : {"male_average", "female_average"})
@@ -212,7 +220,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   nlohmann::json all = nlohmann::json::array();
-  std::printf("| body | variant | heights | torso girths | limb and neck girths | lengths | unmoved skin: within half the allowance | outer arm length vs its points | landmarks to their vertices: median / largest | arms found - true (left / right) | ankles found - true | turn found |\n");
+  std::printf(
+      "| body | variant | heights | torso girths | limb and neck girths | lengths | unmoved skin: within half the "
+      "allowance | outer arm length vs its points | landmarks to their vertices: median / largest | arms found - true "
+      "(left / right) | ankles found - true | turn found |\n");
   std::printf("|---|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n");
   for (const std::string& path : bodies) {
     auto mesh = read_ply_mesh(path);

@@ -27,9 +27,12 @@ int main(int argc, char** argv) {
   double sway = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc) rig_name = argv[++i];
-    else if (a == "--every" && i + 1 < argc) every = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--sway" && i + 1 < argc) sway = std::atof(argv[++i]);
+    if (a == "--rig" && i + 1 < argc)
+      rig_name = argv[++i];
+    else if (a == "--every" && i + 1 < argc)
+      every = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--sway" && i + 1 < argc)
+      sway = std::atof(argv[++i]);
     else {
       std::fprintf(stderr, "usage: render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM]\n");
       return 2;
@@ -76,7 +79,8 @@ int main(int argc, char** argv) {
               desc.cameras.size(), cam.width, cam.height, desc.lasers.size(), desc.laser_groups.size(),
               desc.simulation.frame_rate_hz);
   std::printf("set-up (subject, scene, pixel rays) %.2f s\n", secs(t0, t1));
-  std::printf("calibration: %zu frames in %.2f s (dot grids at 4 x 4 rays per pixel)\n", calibration_frames, secs(t1, t2));
+  std::printf("calibration: %zu frames in %.2f s (dot grids at 4 x 4 rays per pixel)\n", calibration_frames,
+              secs(t1, t2));
   std::printf("scan: %zu frames in %.2f s: %.1f frames/s, %.1f Mpixel/s; the cameras take %.1f s (checksum %llu)\n",
               scan_frames, secs(t2, t3), scan_frames / secs(t2, t3),
               scan_frames * cam.width * cam.height / secs(t2, t3) / 1e6,

@@ -30,12 +30,21 @@ int main(int argc, char** argv) {
   bool cross = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
-    else if (a == "--body" && i + 1 < argc) body = argv[++i];
-    else if (a == "--min-angle" && i + 1 < argc) min_angle = std::atof(argv[++i]);
-    else if (a == "--max-view" && i + 1 < argc) max_view = std::atof(argv[++i]);
-    else if (a == "--cross") cross = true;
-    else return std::fprintf(stderr, "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG] [--max-view DEG] [--cross]\n"), 2;
+    if (a == "--rig" && i + 1 < argc)
+      rigs.push_back(argv[++i]);
+    else if (a == "--body" && i + 1 < argc)
+      body = argv[++i];
+    else if (a == "--min-angle" && i + 1 < argc)
+      min_angle = std::atof(argv[++i]);
+    else if (a == "--max-view" && i + 1 < argc)
+      max_view = std::atof(argv[++i]);
+    else if (a == "--cross")
+      cross = true;
+    else
+      return std::fprintf(
+                 stderr,
+                 "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG] [--max-view DEG] [--cross]\n"),
+             2;
   }
   if (rigs.empty()) rigs = hw::shipped_rig_names();  // all of them
   for (const std::string& name : rigs) {
@@ -74,7 +83,8 @@ int main(int argc, char** argv) {
         any_seen = true;
         const bool front_camera = cams[c].centre().z() > 0;
         for (const hw::LaserDescription& l : desc.lasers) {
-          if (!cross && (l.position.z() > 0) != front_camera) continue;  // the camera sees only its side's lasers on the poles
+          if (!cross && (l.position.z() > 0) != front_camera)
+            continue;  // the camera sees only its side's lasers on the poles
           const Eigen::Vector3d to_laser = l.position - p;
           const double incidence = n.dot(to_laser.normalized());
           if (incidence < min_incidence || scene.occluded(q, to_laser.normalized(), to_laser.norm())) continue;
@@ -126,8 +136,10 @@ int main(int argc, char** argv) {
         }
       }
     }
-    std::printf("%s: covered %.1f %% of the body's area (seen by a camera %.1f %%); lights clear by %.0f mm (tightest: %s); missing:",
-                desc.name.c_str(), 100.0 * covered / s.size(), 100.0 * seen / s.size(), clearance, tightest.c_str());
+    std::printf(
+        "%s: covered %.1f %% of the body's area (seen by a camera %.1f %%); lights clear by %.0f mm (tightest: %s); "
+        "missing:",
+        desc.name.c_str(), 100.0 * covered / s.size(), 100.0 * seen / s.size(), clearance, tightest.c_str());
     std::vector<std::pair<size_t, std::string>> by;
     for (const auto& [k, v] : holes) by.emplace_back(v, k);
     std::sort(by.rbegin(), by.rend());
@@ -135,7 +147,8 @@ int main(int argc, char** argv) {
       std::printf("%s %s %.1f %%", k ? "," : "", by[k].second.c_str(), 100.0 * by[k].first / s.size());
     std::printf("\n  zones:");
     for (int z = 0; z < 3; ++z)
-      std::printf(" %s %.1f %% of %.0f cm2%s", zone_names[z], zone_total[z] ? 100.0 * zone_covered[z] / zone_total[z] : 0.0,
+      std::printf(" %s %.1f %% of %.0f cm2%s", zone_names[z],
+                  zone_total[z] ? 100.0 * zone_covered[z] / zone_total[z] : 0.0,
                   zone_total[z] * surface_area(scene.subject()) / s.size() / 100.0, z < 2 ? "," : "");
     std::printf("\n");
   }

@@ -20,8 +20,8 @@
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/geometry/sample_surface.hpp"
 #include "recon/spatial/knn_index.hpp"
-#include "server/pipeline/scan.hpp"
 #include "server/pipeline/rig_backend.hpp"
+#include "server/pipeline/scan.hpp"
 
 using namespace bodyscan;
 using Clock = std::chrono::steady_clock;
@@ -82,17 +82,20 @@ int run(const std::string& rig_name, const std::string& body, int every) {
   pipeline::CalibrationBuilder builder(desc);
   double calib_acquire = 0;
   {
-    const Status s = pipeline::acquire_calibration(handle, [&](pipeline::Shot&& shot) { return builder.consume(std::move(shot)); });
+    const Status s =
+        pipeline::acquire_calibration(handle, [&](pipeline::Shot&& shot) { return builder.consume(std::move(shot)); });
     if (!s.ok()) return std::fprintf(stderr, "%s\n", s.message().c_str()), 1;
     calib_acquire = secs(t0);
   }
   auto cal = builder.finish();
   if (!cal.ok()) return std::fprintf(stderr, "%s\n", cal.status().message().c_str()), 1;
-  std::printf("calibration: acquisition (rendering) %.1f s, processing %.2f s\n", calib_acquire, cal->processing_seconds);
+  std::printf("calibration: acquisition (rendering) %.1f s, processing %.2f s\n", calib_acquire,
+              cal->processing_seconds);
   for (size_t g = 0; g < cal->group_separation_mm.size(); ++g) {
     std::printf("group %zu:", g);
     for (int l : pipeline::group_lasers(desc, g))
-      std::printf(" %s%s", desc.lasers[static_cast<size_t>(l)].id.c_str(), cal->sweep_reversed[static_cast<size_t>(l)] ? " (reversed)" : "");
+      std::printf(" %s%s", desc.lasers[static_cast<size_t>(l)].id.c_str(),
+                  cal->sweep_reversed[static_cast<size_t>(l)] ? " (reversed)" : "");
     std::printf(", planes at least %.0f mm apart at the sweep ends\n", cal->group_separation_mm[g]);
   }
   std::printf("%-12s %5s %6s %9s %9s %9s %9s %9s %9s\n", "camera", "side", "dots", "held-out", "lens-rms", "lens-max",
@@ -113,7 +116,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       }
     const Eigen::Matrix3d h = *fit_homography(corrected, pinhole);
     std::vector<double> lens_err;
-    for (size_t i = 0; i < corrected.size(); ++i) lens_err.push_back((apply_homography(h, corrected[i]) - pinhole[i]).norm());
+    for (size_t i = 0; i < corrected.size(); ++i)
+      lens_err.push_back((apply_homography(h, corrected[i]) - pinhole[i]).norm());
     double lens_ss = 0;
     for (double e : lens_err) lens_ss += e * e;
     // Markers against the lights' true images.
@@ -121,7 +125,9 @@ int run(const std::string& rig_name, const std::string& body, int every) {
     for (Pole p : kPoles)
       for (int i = 0; i < 2; ++i) {
         const auto truth = model.project(cc.frame.light(p, cc.side, i));
-        marker_worst = std::max(marker_worst, (cc.lens.distort(cc.markers[static_cast<size_t>(p)][static_cast<size_t>(i)]) - *truth).norm());
+        marker_worst =
+            std::max(marker_worst,
+                     (cc.lens.distort(cc.markers[static_cast<size_t>(p)][static_cast<size_t>(i)]) - *truth).norm());
       }
     std::printf("%-12s %5s %6d %9.3f %9.3f %9.3f %9.3f %9.2f %9.2f\n", cc.camera_id.c_str(), to_string(cc.side),
                 cc.lens.dots_used(), cc.lens.held_out_rms_px(), std::sqrt(lens_ss / lens_err.size()),
@@ -157,7 +163,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
   const Status s = pipeline::acquire_scan(
       handle,
       [&](pipeline::Shot&& shot) -> Status {
-        if (shot.kind == pipeline::ShotKind::kLaserBase) bases[static_cast<size_t>(shot.group)][shot.camera] = shot.frame;
+        if (shot.kind == pipeline::ShotKind::kLaserBase)
+          bases[static_cast<size_t>(shot.group)][shot.camera] = shot.frame;
         if (shot.kind == pipeline::ShotKind::kScanStep) {
           // The plane against the true plane of the laser this camera sees.
           const auto& seen = cal->lasers_seen[shot.camera];
@@ -165,7 +172,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
             if (std::find(seen.begin(), seen.end(), l.laser) == seen.end()) continue;
             auto plane = finders[shot.camera].find(pipeline::view(shot.frame),
                                                    pipeline::view(bases[static_cast<size_t>(shot.group)][shot.camera]));
-            if (plane.ok()) plane_errors.push_back(plane_error(*plane, desc.lasers[static_cast<size_t>(l.laser)], l.step));
+            if (plane.ok())
+              plane_errors.push_back(plane_error(*plane, desc.lasers[static_cast<size_t>(l.laser)], l.step));
           }
         }
         for (size_t k = 1; k < processors.size(); ++k) {
@@ -185,16 +193,19 @@ int run(const std::string& rig_name, const std::string& body, int every) {
   }
   const pipeline::ScanStats stats = processors[0]->stats();
   const Quantiles pe = quantiles(plane_errors);
-  std::printf("grazing points dropped (seen more than %.0f deg from their normal): %zu; redundant points dropped (a "
-              "point with twice the confidence within %.1f mm): %zu\n",
-              processors[0]->options().view.max_view_deg, stats.points_grazing, g_redundant, stats.points_redundant);
-  std::printf("scan: %zu frames per camera-step, %zu without a plane, far bottom estimated in %zu; acquisition + "
-              "processing %.1f s, processing (frames -> points, one method) %.2f s = %.2f ms per frame\n",
-              stats.frames, stats.frames_without_plane, stats.far_bottom_estimated, scan_total,
-              stats.processing_seconds, 1e3 * stats.processing_seconds / std::max<size_t>(1, stats.frames));
-  std::printf("laser planes vs truth (worst corner of the body's box): mean %.3f mm, p95 %.3f, max %.3f over %zu; "
-              "fourth pole point off the other three's plane: RMS %.3f mm\n",
-              pe.mean, pe.p95, pe.max, plane_errors.size(), stats.fourth_point_rms_mm);
+  std::printf(
+      "grazing points dropped (seen more than %.0f deg from their normal): %zu; redundant points dropped (a "
+      "point with twice the confidence within %.1f mm): %zu\n",
+      processors[0]->options().view.max_view_deg, stats.points_grazing, g_redundant, stats.points_redundant);
+  std::printf(
+      "scan: %zu frames per camera-step, %zu without a plane, far bottom estimated in %zu; acquisition + "
+      "processing %.1f s, processing (frames -> points, one method) %.2f s = %.2f ms per frame\n",
+      stats.frames, stats.frames_without_plane, stats.far_bottom_estimated, scan_total, stats.processing_seconds,
+      1e3 * stats.processing_seconds / std::max<size_t>(1, stats.frames));
+  std::printf(
+      "laser planes vs truth (worst corner of the body's box): mean %.3f mm, p95 %.3f, max %.3f over %zu; "
+      "fourth pole point off the other three's plane: RMS %.3f mm\n",
+      pe.mean, pe.p95, pe.max, plane_errors.size(), stats.fourth_point_rms_mm);
 
   // Against the body's true surface.
   const TriangleMesh& truth = rig.scene().subject();
@@ -204,10 +215,11 @@ int run(const std::string& rig_name, const std::string& body, int every) {
     // The true axis: the line through the laser's position along its axis.
     const Eigen::Vector3d d = r.axis_point - l.position;
     const double axis_off = (d - d.dot(l.axis.normalized()) * l.axis.normalized()).norm();
-    std::printf("laser %-12s sweep %s: %zu pole points (%zu rejected) %.3f mm RMS from their planes; %.5f deg/step "
-                "(true %.5f), axis %.2f mm from the true one\n",
-                l.id.c_str(), r.fitted ? "fitted" : r.error.c_str(), r.points_used, r.points_rejected, r.rms_mm,
-                r.degrees_per_step, l.step_angle_deg, axis_off);
+    std::printf(
+        "laser %-12s sweep %s: %zu pole points (%zu rejected) %.3f mm RMS from their planes; %.5f deg/step "
+        "(true %.5f), axis %.2f mm from the true one\n",
+        l.id.c_str(), r.fitted ? "fitted" : r.error.c_str(), r.points_used, r.points_rejected, r.rms_mm,
+        r.degrees_per_step, l.step_angle_deg, axis_off);
   }
   for (size_t k = 0; k < processors.size(); ++k) {
     const PointCloud& cloud = clouds[k];
@@ -223,8 +235,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       for (size_t i = 0; i < dd.size(); ++i)
         if (cloud.camera[i] == static_cast<int>(c)) dc.push_back(dd[i]);
       const Quantiles qc = quantiles(dc);
-      std::printf("    camera %-12s %8zu points: mean %.3f mm, p95 %.3f\n", cal->cameras[c].camera_id.c_str(), dc.size(),
-                  qc.mean, qc.p95);
+      std::printf("    camera %-12s %8zu points: mean %.3f mm, p95 %.3f\n", cal->cameras[c].camera_id.c_str(),
+                  dc.size(), qc.mean, qc.p95);
     }
     if (k != 0) continue;
     // The far points' share of the mean, and where they are.
@@ -239,8 +251,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
         if (dd[i] <= 50) continue;
         ++shown;
         const Vec3f& p = cloud.positions[i];
-        std::printf("      %.0f mm off at (%.0f, %.0f, %.0f): camera %s, laser %s, frame %d, confidence %.2f\n", dd[i], p.x(),
-                    p.y(), p.z(), desc.cameras[static_cast<size_t>(cloud.camera[i])].id.c_str(),
+        std::printf("      %.0f mm off at (%.0f, %.0f, %.0f): camera %s, laser %s, frame %d, confidence %.2f\n", dd[i],
+                    p.x(), p.y(), p.z(), desc.cameras[static_cast<size_t>(cloud.camera[i])].id.c_str(),
                     desc.lasers[static_cast<size_t>(cloud.laser[i])].id.c_str(), cloud.frame[i], cloud.confidence[i]);
       }
     }
@@ -261,7 +273,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
                                       .cast<double>()
                                       .normalized();
         const Eigen::Vector3d to_cam =
-            (desc.cameras[static_cast<size_t>(cloud.camera[i])].position - cloud.positions[i].cast<double>()).normalized();
+            (desc.cameras[static_cast<size_t>(cloud.camera[i])].position - cloud.positions[i].cast<double>())
+                .normalized();
         err.push_back(dd[i]);
         signed_err.push_back(cp.signed_distance);
         camera_bias[static_cast<size_t>(cloud.camera[i])] += cp.signed_distance;
@@ -313,8 +326,10 @@ int run(const std::string& rig_name, const std::string& body, int every) {
         }
         for (size_t li = 0; li < desc.lasers.size(); ++li) {
           const double n = static_cast<double>(std::max<size_t>(nl[li], 1));
-          std::printf("    laser %-16s %7zu points within 5 mm: signed mean %+.3f mm, of which the plane %+.3f, the rest (camera, stripe) %+.3f\n",
-                      desc.lasers[li].id.c_str(), nl[li], on_body[li] / n, plane_off[li] / n, plane_corrected[li] / n);
+          std::printf(
+              "    laser %-16s %7zu points within 5 mm: signed mean %+.3f mm, of which the plane %+.3f, the rest "
+              "(camera, stripe) %+.3f\n",
+              desc.lasers[li].id.c_str(), nl[li], on_body[li] / n, plane_off[li] / n, plane_corrected[li] / n);
         }
       }
       std::printf("    signed mean within 5 mm by camera:");
@@ -355,7 +370,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
               if (std::abs(den) < 0.17) continue;  // under 10 degrees: no triangulation
               const Eigen::Vector3d t =
                   model.centre() + ((l.plane_offset(st) - l.plane_normal(st).dot(model.centre())) / den) * ray;
-              const Eigen::Vector3d q = plane.triangulate(cc, cc.lens.correct(*raw), TriangulationMethod::kLaserHomography);
+              const Eigen::Vector3d q =
+                  plane.triangulate(cc, cc.lens.correct(*raw), TriangulationMethod::kLaserHomography);
               const double e = (q - t).dot(vn[v].cast<double>().normalized());
               sum += e, sum_abs += std::abs(e), ++n;
             }
@@ -399,19 +415,33 @@ int main(int argc, char** argv) {
   int every = 1;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc) rigs.push_back(argv[++i]);
-    else if (a == "--body" && i + 1 < argc) bodies.push_back(argv[++i]);
-    else if (a == "--every" && i + 1 < argc) every = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--min-angle" && i + 1 < argc) g_min_angle = std::atof(argv[++i]);
-    else if (a == "--smooth" && i + 1 < argc) g_smooth = std::atoi(argv[++i]);
-    else if (a == "--radius" && i + 1 < argc) g_radius = std::atoi(argv[++i]);
-    else if (a == "--max-view" && i + 1 < argc) g_max_view = std::atof(argv[++i]);
-    else if (a == "--keep-sway") g_keep_sway = true;
-    else if (a == "--threshold" && i + 1 < argc) g_threshold = std::atoi(argv[++i]);
-    else if (a == "--redundant" && i + 1 < argc) g_redundant = static_cast<float>(std::atof(argv[++i]));
-    else if (a == "--weak" && i + 1 < argc) g_weak = static_cast<float>(std::atof(argv[++i]));
+    if (a == "--rig" && i + 1 < argc)
+      rigs.push_back(argv[++i]);
+    else if (a == "--body" && i + 1 < argc)
+      bodies.push_back(argv[++i]);
+    else if (a == "--every" && i + 1 < argc)
+      every = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--min-angle" && i + 1 < argc)
+      g_min_angle = std::atof(argv[++i]);
+    else if (a == "--smooth" && i + 1 < argc)
+      g_smooth = std::atoi(argv[++i]);
+    else if (a == "--radius" && i + 1 < argc)
+      g_radius = std::atoi(argv[++i]);
+    else if (a == "--max-view" && i + 1 < argc)
+      g_max_view = std::atof(argv[++i]);
+    else if (a == "--keep-sway")
+      g_keep_sway = true;
+    else if (a == "--threshold" && i + 1 < argc)
+      g_threshold = std::atoi(argv[++i]);
+    else if (a == "--redundant" && i + 1 < argc)
+      g_redundant = static_cast<float>(std::atof(argv[++i]));
+    else if (a == "--weak" && i + 1 < argc)
+      g_weak = static_cast<float>(std::atof(argv[++i]));
     else {
-      std::fprintf(stderr, "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] [--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C] [--keep-sway]\n");
+      std::fprintf(
+          stderr,
+          "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] "
+          "[--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C] [--keep-sway]\n");
       return 2;
     }
   }

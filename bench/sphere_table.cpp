@@ -33,12 +33,11 @@ namespace {
 const std::vector<size_t> kSizes = {16384, 4096, 1024, 256, 128};
 const std::vector<double> kNoise = {0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.1};
 // Thesis Table 4.1, rows kSizes, columns kNoise.
-const double kThesis[5][7] = {
-    {0.00168, 0.003702, 0.006593, 0.007977, 0.008106, 0.010805, 0.023484},
-    {0.002356, 0.005056, 0.008021, 0.010576, 0.012244, 0.014794, 0.02999},
-    {0.004395, 0.006308, 0.010053, 0.012786, 0.01579, 0.01947, 0.034901},
-    {0.011795, 0.013112, 0.015654, 0.021765, 0.024259, 0.02649, 0.044915},
-    {0.029443, 0.030343, 0.03398, 0.040067, 0.037699, 0.045917, 0.064353}};
+const double kThesis[5][7] = {{0.00168, 0.003702, 0.006593, 0.007977, 0.008106, 0.010805, 0.023484},
+                              {0.002356, 0.005056, 0.008021, 0.010576, 0.012244, 0.014794, 0.02999},
+                              {0.004395, 0.006308, 0.010053, 0.012786, 0.01579, 0.01947, 0.034901},
+                              {0.011795, 0.013112, 0.015654, 0.021765, 0.024259, 0.02649, 0.044915},
+                              {0.029443, 0.030343, 0.03398, 0.040067, 0.037699, 0.045917, 0.064353}};
 
 struct Cell {
   double rms = NAN;
@@ -117,11 +116,16 @@ int main(int argc, char** argv) {
   std::vector<std::pair<size_t, double>> cells;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--defaults") defaults = true;
-    else if (a == "--tuned") tuned = true;
-    else if (a == "--nonuniform" && i + 1 < argc) nonuniform = std::atof(argv[++i]);
-    else if (a == "--seed" && i + 1 < argc) seed = std::strtoull(argv[++i], nullptr, 10);
-    else if (a == "--cloud-dir" && i + 1 < argc) cloud_dir = argv[++i];
+    if (a == "--defaults")
+      defaults = true;
+    else if (a == "--tuned")
+      tuned = true;
+    else if (a == "--nonuniform" && i + 1 < argc)
+      nonuniform = std::atof(argv[++i]);
+    else if (a == "--seed" && i + 1 < argc)
+      seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (a == "--cloud-dir" && i + 1 < argc)
+      cloud_dir = argv[++i];
     else if (a == "--cells" && i + 1 < argc) {
       std::string s = argv[++i];
       size_t pos = 0;
@@ -134,7 +138,9 @@ int main(int argc, char** argv) {
         pos = comma + 1;
       }
     } else {
-      std::fprintf(stderr, "usage: sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S] [--cloud-dir DIR]\n");
+      std::fprintf(stderr,
+                   "usage: sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S] "
+                   "[--cloud-dir DIR]\n");
       return 2;
     }
   }
@@ -145,7 +151,8 @@ int main(int argc, char** argv) {
 
   std::printf("| N | s | thesis |%s%s\n", defaults ? " defaults | ratio |" : "",
               tuned ? " tuned | ratio | sigma | normal-sigma | sharpen | normal-k | voxel/spacing |" : "");
-  std::printf("|---:|---:|---:|%s%s\n", defaults ? "---:|---:|" : "", tuned ? "---:|---:|---:|---:|---:|---:|---:|" : "");
+  std::printf("|---:|---:|---:|%s%s\n", defaults ? "---:|---:|" : "",
+              tuned ? "---:|---:|---:|---:|---:|---:|---:|" : "");
   double worst_default = 0, worst_tuned = 0;
   for (auto [n, s] : cells) {
     double thesis = NAN;

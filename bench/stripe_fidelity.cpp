@@ -126,10 +126,12 @@ struct EndFeatures {
       if (!by_length[b].empty()) std::printf("    %-6s ", lengths[b]), Bins::print_row(by_length[b]);
     std::printf("  run ends by peak / the run's median peak: signed mean, median, |err| p50 / p90, n, over 2 / 4\n");
     for (size_t b = 0; b < 6; ++b)
-      if (!by_ratio[b].empty()) std::printf("    %.2f-%.2f  ", ratio_edges[b], std::min(9.0, ratio_edges[b + 1])), Bins::print_row(by_ratio[b]);
+      if (!by_ratio[b].empty())
+        std::printf("    %.2f-%.2f  ", ratio_edges[b], std::min(9.0, ratio_edges[b + 1])), Bins::print_row(by_ratio[b]);
     std::printf("  run ends by |raw column - the run's line| (px)\n");
     for (size_t b = 0; b < 6; ++b)
-      if (!by_resid[b].empty()) std::printf("    %.2f-%.2f  ", resid_edges[b], std::min(9.0, resid_edges[b + 1])), Bins::print_row(by_resid[b]);
+      if (!by_resid[b].empty())
+        std::printf("    %.2f-%.2f  ", resid_edges[b], std::min(9.0, resid_edges[b + 1])), Bins::print_row(by_resid[b]);
     std::printf("  over 2 mm / n, rows peak ratio, columns residual\n");
     for (size_t a = 0; a < 6; ++a) {
       std::printf("    %.2f-%.2f ", ratio_edges[a], std::min(9.0, ratio_edges[a + 1]));
@@ -164,8 +166,8 @@ std::vector<int> rows_from_run_end(const std::vector<StripeSample>& s, double ma
 // lens's spread and the pixel's integration. The sub-ray's own footprint (1/k of a
 // pixel) on the tangent plane widens the profile as a box: at that scale the
 // surface is flat enough for it.
-double laser_radiance(const Scene& scene, const CameraModel& model, const LaserDescription& l,
-                      int step, double px, double py, int k) {
+double laser_radiance(const Scene& scene, const CameraModel& model, const LaserDescription& l, int step, double px,
+                      double py, int k) {
   const Vec3d n = l.plane_normal(step);
   const double offset = l.plane_offset(step), sigma = l.line_width_mm / 2.354820045;
   const Vec3d aim = Eigen::AngleAxisd(step * l.step_angle_deg * M_PI / 180.0, l.axis) * l.aim;
@@ -207,8 +209,7 @@ double box_gauss(double u, double s) {
 
 std::vector<uint16_t> to_pixels(const std::vector<float>& img) {
   std::vector<uint16_t> out(img.size());
-  for (size_t i = 0; i < img.size(); ++i)
-    out[i] = static_cast<uint16_t>(std::clamp(img[i] * 20000.0f, 0.f, 65535.f));
+  for (size_t i = 0; i < img.size(); ++i) out[i] = static_cast<uint16_t>(std::clamp(img[i] * 20000.0f, 0.f, 65535.f));
   return out;
 }
 
@@ -261,9 +262,8 @@ int main(int argc, char** argv) {
   if (!rig.ok()) return std::fprintf(stderr, "%s\n", rig.status().message().c_str()), 1;
   const Scene& scene = (*rig)->scene();
   const MeshDistance truth(scene.subject());
-  std::printf("rig %s, body %s, every %d steps, %dx%d rays per pixel, centroid radius %d\n",
-              desc->name.c_str(), body.empty() ? "(the rig's)" : body.c_str(), every, sub, sub,
-              radius);
+  std::printf("rig %s, body %s, every %d steps, %dx%d rays per pixel, centroid radius %d\n", desc->name.c_str(),
+              body.empty() ? "(the rig's)" : body.c_str(), every, sub, sub, radius);
   Bins shipped_all, reference_all;
   RunBins shipped_runs, reference_runs;
   EndFeatures end_features;
@@ -297,8 +297,7 @@ int main(int argc, char** argv) {
               for (int dy = -3 - reach; dy <= 3 + reach; ++dy)
                 for (int dx = -3 - reach; dx <= 3 + reach; ++dx) {
                   const int xx = x + dx, yy = y + dy;
-                  if (xx >= 0 && yy >= 0 && xx < w && yy < h)
-                    want[static_cast<size_t>(yy) * w + xx] = 1;
+                  if (xx >= 0 && yy >= 0 && xx < w && yy < h) want[static_cast<size_t>(yy) * w + xx] = 1;
                 }
             }
           std::vector<float> fine(static_cast<size_t>(sw) * h * k, 0.f);
@@ -308,8 +307,7 @@ int main(int argc, char** argv) {
               for (int j = 0; j < k; ++j)
                 for (int i = 0; i < k; ++i)
                   fine[static_cast<size_t>(y * k + j) * sw + x * k + i] = static_cast<float>(
-                      laser_radiance(scene, model, l, step, x - 0.5 + (i + 0.5) / k,
-                                     y - 0.5 + (j + 0.5) / k, k));
+                      laser_radiance(scene, model, l, step, x - 0.5 + (i + 0.5) / k, y - 0.5 + (j + 0.5) / k, k));
             }
           });
           std::vector<double> wt(static_cast<size_t>((2 * reach + 1) * k));
@@ -322,8 +320,7 @@ int main(int argc, char** argv) {
               for (int dy = -3; dy <= 3 && !near; ++dy)
                 for (int dx = -3; dx <= 3 && !near; ++dx) {
                   const int xx = x + dx, yy = y + dy;
-                  near = xx >= 0 && yy >= 0 && xx < w && yy < h &&
-                         lit_mask[static_cast<size_t>(yy) * w + xx];
+                  near = xx >= 0 && yy >= 0 && xx < w && yy < h && lit_mask[static_cast<size_t>(yy) * w + xx];
                 }
               if (!near) continue;
               double acc = 0;
@@ -361,8 +358,8 @@ int main(int argc, char** argv) {
                         b0 = renderer.render(scene, Lighting{}, e, frame_id + 777);
             StripeOptions pso;
             pso.radius = radius;
-            samples = extract_stripe(ImageView{f.pixels.data(), w, h},
-                                     ImageView{b0.pixels.data(), w, h}, pso, f.max_value());
+            samples =
+                extract_stripe(ImageView{f.pixels.data(), w, h}, ImageView{b0.pixels.data(), w, h}, pso, f.max_value());
             if (samples.ok()) raw = *samples;
             if (samples.ok() && smooth > 0) smooth_stripe(*samples, smooth);
           } else {
@@ -381,7 +378,8 @@ int main(int argc, char** argv) {
             // Each raw sample's run length (the smoothing's continuation rule).
             size_t a = 0;
             for (size_t i = 1; i <= raw.size(); ++i)
-              if (i == raw.size() || raw[i].row - raw[i - 1].row != 1 || std::abs(raw[i].column - raw[i - 1].column) > 1.5) {
+              if (i == raw.size() || raw[i].row - raw[i - 1].row != 1 ||
+                  std::abs(raw[i].column - raw[i - 1].column) > 1.5) {
                 for (size_t j = a; j < i; ++j) run_length[j] = static_cast<int>(i - a);
                 at_end[a] = at_end[i - 1] = 1;
                 a = i;
@@ -428,8 +426,7 @@ int main(int argc, char** argv) {
             if (cp.distance > 10) continue;  // the frame, or lost
             const Triangle& tri = scene.subject().triangles[cp.triangle];
             const auto& v = scene.subject().vertices;
-            const Vec3d nn =
-                (v[tri[1]] - v[tri[0]]).cross(v[tri[2]] - v[tri[0]]).cast<double>().normalized();
+            const Vec3d nn = (v[tri[1]] - v[tri[0]]).cross(v[tri[2]] - v[tri[0]]).cast<double>().normalized();
             const Vec3d to_cam = (model.centre() - p).normalized();
             const double view = std::acos(std::min(1.0, std::abs(nn.dot(to_cam)))) * 180 / M_PI;
             (which == 0 ? shipped : reference).add(view, cp.signed_distance);

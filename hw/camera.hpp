@@ -20,8 +20,8 @@ struct Frame {
   int width = 0, height = 0;
   PixelFormat format = PixelFormat::kMono8;
   std::vector<uint16_t> pixels;
-  uint64_t frame_id = 0;        // per camera, counting from 1
-  int64_t timestamp_ns = 0;     // the camera's clock (the simulator's scene time)
+  uint64_t frame_id = 0;     // per camera, counting from 1
+  int64_t timestamp_ns = 0;  // the camera's clock (the simulator's scene time)
   double exposure_us = 0, gain_db = 0;
 
   uint16_t at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
@@ -29,7 +29,7 @@ struct Frame {
 };
 
 struct CameraInfo {
-  std::string id;       // the rig description's id
+  std::string id;  // the rig description's id
   std::string vendor, model, serial;
   int width = 0, height = 0;
   std::vector<PixelFormat> formats;

@@ -12,9 +12,7 @@ class DeviceRig::Mirror : public Controller {
   Mirror(Controller& real, Controller& sim) : real_(real), sim_(sim) {}
   int num_lasers() const override { return real_.num_lasers(); }
   Status set_room_lights(bool on) override { return both(&Controller::set_room_lights, on); }
-  Status set_frame_light_circuits(bool f, bool b) override {
-    return both(&Controller::set_frame_light_circuits, f, b);
-  }
+  Status set_frame_light_circuits(bool f, bool b) override { return both(&Controller::set_frame_light_circuits, f, b); }
   Status set_laser(int laser, bool on) override {
     Status st = real_.set_laser(laser, on);
     (void)sim_.set_laser(laser, st.ok() && on);
@@ -89,8 +87,9 @@ Status DeviceRig::hold_dot_grid(size_t camera, bool held) {
     return Status::Ok();
   }
   if (!held) return Status::Ok();
-  return failed_precondition("camera '" + rig_.cameras[camera].id +
-                             "' is real: hold the dot-grid board before it by hand (docs/hardware.md, \"Lens calibration\")");
+  return failed_precondition(
+      "camera '" + rig_.cameras[camera].id +
+      "' is real: hold the dot-grid board before it by hand (docs/hardware.md, \"Lens calibration\")");
 }
 
 }  // namespace bodyscan::hw

@@ -181,8 +181,9 @@ FrameGeometry read_frame(const Reader& r) {
     }
   }
   if (f.light_x.size() != 2 || std::abs(f.light_x[0] - f.light_x[1]) < 2 * f.light_diameter) {
-    r.fail("light_x must list 2 distinct positions along the poles (each pole face carries 2 lights; a camera "
-           "sees 4 per frame, thesis §2.1)");
+    r.fail(
+        "light_x must list 2 distinct positions along the poles (each pole face carries 2 lights; a camera "
+        "sees 4 per frame, thesis §2.1)");
   }
   for (double x : f.light_x) {
     if (std::abs(x) > 0.5 * f.width - f.tube) r.fail("a light lies beyond the pole's ends (|x| > width/2 - tube)");
@@ -202,8 +203,8 @@ Distortion read_distortion(const Reader& r) {
 }
 
 CameraDescription read_camera(const Reader& r) {
-  r.only({"id", "position", "look_at", "focal_mm", "pixel_size_um", "width", "height", "distortion",
-          "pixel_format", "full_well_e", "read_noise_e", "exposure_us", "gain_db", "blur_px", "device"});
+  r.only({"id", "position", "look_at", "focal_mm", "pixel_size_um", "width", "height", "distortion", "pixel_format",
+          "full_well_e", "read_noise_e", "exposure_us", "gain_db", "blur_px", "device"});
   CameraDescription c;
   c.id = r.text("id", "", true);
   if (c.id.empty()) r.fail("id must not be empty");
@@ -237,10 +238,14 @@ CameraDescription read_camera(const Reader& r) {
   }
   if (r.has("distortion")) c.distortion = read_distortion(r.child("distortion"));
   const std::string fmt = r.text("pixel_format", "mono8");
-  if (fmt == "mono8") c.pixel_format = PixelFormat::kMono8;
-  else if (fmt == "mono12") c.pixel_format = PixelFormat::kMono12;
-  else if (fmt == "mono16") c.pixel_format = PixelFormat::kMono16;
-  else r.fail("pixel_format must be mono8, mono12 or mono16, got '" + fmt + "'");
+  if (fmt == "mono8")
+    c.pixel_format = PixelFormat::kMono8;
+  else if (fmt == "mono12")
+    c.pixel_format = PixelFormat::kMono12;
+  else if (fmt == "mono16")
+    c.pixel_format = PixelFormat::kMono16;
+  else
+    r.fail("pixel_format must be mono8, mono12 or mono16, got '" + fmt + "'");
   c.full_well_e = r.positive("full_well_e", c.full_well_e);
   c.read_noise_e = r.non_negative("read_noise_e", c.read_noise_e);
   c.blur_px = r.non_negative("blur_px", c.blur_px);
@@ -286,7 +291,8 @@ uint16_t usb_id(const Reader& r, const char* key, uint16_t fallback) {
   const std::string t = r.text(key, "");
   char* end = nullptr;
   const unsigned long v = std::strtoul(t.c_str(), &end, 16);
-  if (t.empty() || t.size() > 4 || *end != '\0') r.fail(std::string("'") + key + "' must be 4 hex digits, got '" + t + "'");
+  if (t.empty() || t.size() > 4 || *end != '\0')
+    r.fail(std::string("'") + key + "' must be 4 hex digits, got '" + t + "'");
   return static_cast<uint16_t>(v);
 }
 
@@ -313,7 +319,8 @@ ControllerDescription read_controller(const Reader& r, const std::vector<LaserDe
   c.move_timeout_ms = r.integer("move_timeout_ms", c.move_timeout_ms);
   c.home_timeout_ms = r.integer("home_timeout_ms", c.home_timeout_ms);
   c.watchdog_ms = r.integer("watchdog_ms", c.watchdog_ms);
-  if (c.reply_timeout_ms < 10 || c.move_timeout_ms < 10 || c.home_timeout_ms < 10) r.fail("timeouts must be at least 10 ms");
+  if (c.reply_timeout_ms < 10 || c.move_timeout_ms < 10 || c.home_timeout_ms < 10)
+    r.fail("timeouts must be at least 10 ms");
   if (c.watchdog_ms != 0 && (c.watchdog_ms < 100 || c.watchdog_ms > 60000)) {
     r.fail("watchdog_ms must be 0 (none) or 100..60000");
   }
@@ -323,8 +330,9 @@ ControllerDescription read_controller(const Reader& r, const std::vector<LaserDe
   // (SIGKILL, a hung machine, the USB cable pulled), the board's watchdog is what
   // switches them off (docs/hardware.md).
   if (c.watchdog_ms == 0 && !lasers.empty())
-    r.fail("watchdog_ms 0 (none) is refused for a board that switches lasers: its watchdog switches them off "
-           "when the workstation dies unseen");
+    r.fail(
+        "watchdog_ms 0 (none) is refused for a board that switches lasers: its watchdog switches them off "
+        "when the workstation dies unseen");
   std::set<int> outputs, axes;
   auto output = [&](const Reader& at, int o, const std::string& what) {
     if (o < 0) return;
@@ -364,7 +372,8 @@ SimulationDescription read_simulation(const Reader& r, const std::string& source
   SimulationDescription s;
   s.subject = r.text("subject", "");
   if (!s.subject.empty() && std::filesystem::path(s.subject).is_relative()) {
-    s.subject = std::filesystem::absolute(std::filesystem::path(source).parent_path() / s.subject).lexically_normal().string();
+    s.subject =
+        std::filesystem::absolute(std::filesystem::path(source).parent_path() / s.subject).lexically_normal().string();
   }
   if (r.has("posture")) {
     const Reader p = r.child("posture");
@@ -413,9 +422,10 @@ SimulationDescription read_simulation(const Reader& r, const std::string& source
 // Where two lasers' vertical planes cross: outside the frame for every pair of steps
 // (thesis §2.3). Planes are vertical when the axes are; otherwise the line of
 // intersection is tested against the frame's box.
-bool planes_cross_inside(const LaserDescription& a, const LaserDescription& b, const FrameGeometry& f,
-                         int* step_a, int* step_b) {
-  const Eigen::AlignedBox3d box(Vec3d(-0.5 * f.width, 0, -0.5 * f.depth), Vec3d(0.5 * f.width, f.top_height, 0.5 * f.depth));
+bool planes_cross_inside(const LaserDescription& a, const LaserDescription& b, const FrameGeometry& f, int* step_a,
+                         int* step_b) {
+  const Eigen::AlignedBox3d box(Vec3d(-0.5 * f.width, 0, -0.5 * f.depth),
+                                Vec3d(0.5 * f.width, f.top_height, 0.5 * f.depth));
   for (int sa = a.min_step; sa <= a.max_step; ++sa) {
     const Vec3d na = a.plane_normal(sa);
     const double da = na.dot(a.position);
@@ -481,8 +491,9 @@ RigDescription read_rig(const json& j, const std::string& source) {
       for (size_t k = i + 1; k < group.size(); ++k) {
         int sa = 0, sb = 0;
         if (planes_cross_inside(*rig.find_laser(group[i]), *rig.find_laser(group[k]), rig.frame, &sa, &sb)) {
-          g.fail("lasers '" + group[i] + "' and '" + group[k] + "' cannot run together: their planes cross inside the frame (steps " +
-                 std::to_string(sa) + " and " + std::to_string(sb) + ")");
+          g.fail("lasers '" + group[i] + "' and '" + group[k] +
+                 "' cannot run together: their planes cross inside the frame (steps " + std::to_string(sa) + " and " +
+                 std::to_string(sb) + ")");
         }
       }
     rig.laser_groups.push_back(std::move(group));
@@ -532,8 +543,8 @@ std::string to_json(const RigDescription& rig) {
   json j;
   j["name"] = rig.name;
   const FrameGeometry& f = rig.frame;
-  j["frame"] = {{"width", f.width},   {"depth", f.depth},     {"top_height", f.top_height},
-                {"tube", f.tube},     {"light_x", f.light_x}, {"light_diameter", f.light_diameter}};
+  j["frame"] = {{"width", f.width}, {"depth", f.depth},     {"top_height", f.top_height},
+                {"tube", f.tube},   {"light_x", f.light_x}, {"light_diameter", f.light_diameter}};
   j["cameras"] = json::array();
   for (const CameraDescription& c : rig.cameras) {
     j["cameras"].push_back({{"id", c.id},

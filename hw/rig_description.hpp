@@ -4,8 +4,8 @@
 // the poses: it finds them (thesis §3.1).
 #pragma once
 
-#include <cstdint>
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,12 +25,12 @@ namespace bodyscan::hw {
 // §2.1, §3.1.2: eight per camera, four per frame), which is what a plane transform
 // needs - four lights along one pole would be collinear.
 struct FrameGeometry {
-  double width = 1800;        // X distance between the side poles' centre lines, mm
-  double depth = 1100;        // Z distance between the front and back poles' centre lines
-  double top_height = 2300;   // Y of the top frame's light centres
-  double tube = 40;           // side of the square tubing
+  double width = 1800;                        // X distance between the side poles' centre lines, mm
+  double depth = 1100;                        // Z distance between the front and back poles' centre lines
+  double top_height = 2300;                   // Y of the top frame's light centres
+  double tube = 40;                           // side of the square tubing
   std::vector<double> light_x = {-700, 700};  // along each front and back pole, both faces
-  double light_diameter = 30;  // the diffuser disc
+  double light_diameter = 30;                 // the diffuser disc
 };
 
 // The centres of the eight frame lights a camera on the front (front = true) or back
@@ -45,11 +45,11 @@ int bits_per_pixel(PixelFormat f);  // significant bits: 8, 12 or 16
 // Which device a camera is: the simulator renders it, or a GenICam camera is
 // opened through Aravis (hw/aravis). docs/rig-description.md, "Devices".
 struct CameraDevice {
-  std::string backend = "sim";        // "sim" or "aravis"
-  std::string id;                     // aravis: as `bodyscan devices` lists it, or the camera's IP address
-  std::string trigger = "software";   // "software", or the line a hardware trigger arrives on ("Line1")
-  int timeout_ms = 2000;              // a frame not complete by then is an error
-  int packet_size = 0;                // GigE Vision: bytes per stream packet; 0 negotiates the largest
+  std::string backend = "sim";       // "sim" or "aravis"
+  std::string id;                    // aravis: as `bodyscan devices` lists it, or the camera's IP address
+  std::string trigger = "software";  // "software", or the line a hardware trigger arrives on ("Line1")
+  int timeout_ms = 2000;             // a frame not complete by then is an error
+  int packet_size = 0;               // GigE Vision: bytes per stream packet; 0 negotiates the largest
 };
 
 struct CameraDescription {
@@ -87,8 +87,8 @@ struct LaserDescription {
   Vec3d aim = -Vec3d::UnitZ();  // horizontal pointing direction at step 0
   double step_angle_deg = 0.05;
   int min_step = -200, max_step = 200;
-  double line_width_mm = 1.0;   // full width at half maximum of the stripe's cross profile
-  double power = 1.0;           // stripe brightness relative to a full-scale white target
+  double line_width_mm = 1.0;  // full width at half maximum of the stripe's cross profile
+  double power = 1.0;          // stripe brightness relative to a full-scale white target
 
   // Unit normal of the plane at a step, and the plane's offset d (n . x = d).
   Vec3d plane_normal(int step) const;
@@ -99,27 +99,27 @@ struct LaserDescription {
 // outputs switch the lasers and lights (through relays or the lasers' TTL enable)
 // and whose axes turn the lasers. docs/rig-description.md, "Devices".
 struct ControllerDescription {
-  std::string backend = "sim";        // "sim" or "tmcl"
-  std::string port;                   // a serial device node; empty: USB through libusb
+  std::string backend = "sim";                         // "sim" or "tmcl"
+  std::string port;                                    // a serial device node; empty: USB through libusb
   uint16_t usb_vendor = 0x2a3c, usb_product = 0x0100;  // Trinamic's TMCM modules
-  std::string usb_serial;             // to pick one of several boards; empty: the first
+  std::string usb_serial;                              // to pick one of several boards; empty: the first
   int module_address = 1;
   struct LaserWiring {
-    int output = -1;                  // digital output switching this laser
-    int axis = -1;                    // motor axis turning it
-    int microsteps_per_step = 1;      // motor microsteps per laser step (step_angle_deg)
-    int home_offset = 0;              // microsteps from the reference switch to step 0
+    int output = -1;              // digital output switching this laser
+    int axis = -1;                // motor axis turning it
+    int microsteps_per_step = 1;  // motor microsteps per laser step (step_angle_deg)
+    int home_offset = 0;          // microsteps from the reference switch to step 0
   };
-  std::vector<LaserWiring> lasers;    // by laser index
+  std::vector<LaserWiring> lasers;                                                 // by laser index
   int room_lights_output = -1, front_lights_output = -1, back_lights_output = -1;  // -1: not wired
   int reply_timeout_ms = 250;
   int move_timeout_ms = 10000;
   int home_timeout_ms = 60000;
-  int watchdog_ms = 500;              // board-side laser watchdog period; 0: none
+  int watchdog_ms = 500;  // board-side laser watchdog period; 0: none
 };
 
 struct SubjectMotion {
-  double sway_mm = 0, sway_hz = 0.25;        // side-to-side (X) and front-back (Z) sway
+  double sway_mm = 0, sway_hz = 0.25;            // side-to-side (X) and front-back (Z) sway
   double breathing_mm = 0, breathing_hz = 0.25;  // chest radius change
 };
 
@@ -134,16 +134,16 @@ struct SubjectPosture {
 };
 
 struct SimulationDescription {
-  std::string subject;   // body mesh (PLY, mm, Y up), relative to the description file
+  std::string subject;                   // body mesh (PLY, mm, Y up), relative to the description file
   SubjectPosture posture;                // applied to the mesh first
   Vec3d subject_offset = Vec3d::Zero();  // added to the mesh (after standing it on the floor)
   double subject_yaw_deg = 0;            // turn about the vertical axis: + turns the face from +Z toward +X
   SubjectMotion motion;
   double frame_rate_hz = 30;
   uint64_t seed = 1;
-  double room_light = 0.6;       // white-surface brightness with room lights on, fraction of full scale
-  double ambient_light = 0.02;   // with room lights off
-  double frame_light = 1.5;      // frame light brightness (saturates a little, like a real diffuser)
+  double room_light = 0.6;         // white-surface brightness with room lights on, fraction of full scale
+  double ambient_light = 0.02;     // with room lights off
+  double frame_light = 1.5;        // frame light brightness (saturates a little, like a real diffuser)
   double speckle_contrast = 0.25;  // std/mean of laser speckle
 };
 

@@ -128,30 +128,45 @@ int run_archive(int argc, char** argv) {
     if (!need(3)) return 2;
     auto r = ar.scan(args[2]);
     if (!r.ok()) return fail(r.status());
-    nlohmann::json j = {{"id", r->id}, {"customer", r->customer_id}, {"operator", r->operator_name},
-                        {"calibration", r->calibration_id}, {"rig", r->rig},
-                        {"status", to_string(r->status)}, {"status_reason", r->status_reason},
-                        {"started_at", r->started_at}, {"finished_at", r->finished_at},
-                        {"current_version", r->current_version}, {"raw", files_json(r->raw)},
-                        {"versions", nlohmann::json::array()}, {"measurements", nlohmann::json::array()}};
+    nlohmann::json j = {{"id", r->id},
+                        {"customer", r->customer_id},
+                        {"operator", r->operator_name},
+                        {"calibration", r->calibration_id},
+                        {"rig", r->rig},
+                        {"status", to_string(r->status)},
+                        {"status_reason", r->status_reason},
+                        {"started_at", r->started_at},
+                        {"finished_at", r->finished_at},
+                        {"current_version", r->current_version},
+                        {"raw", files_json(r->raw)},
+                        {"versions", nlohmann::json::array()},
+                        {"measurements", nlohmann::json::array()}};
     for (const auto& v : r->versions)
-      j["versions"].push_back({{"version", v.version}, {"created_at", v.created_at}, {"algorithms", v.algorithms},
-                               {"note", v.note}, {"files", files_json(v.files)}});
+      j["versions"].push_back({{"version", v.version},
+                               {"created_at", v.created_at},
+                               {"algorithms", v.algorithms},
+                               {"note", v.note},
+                               {"files", files_json(v.files)}});
     if (r->status == storage::ScanStatus::kComplete) {
       auto ms = ar.measurements(r->id);
       if (!ms.ok()) return fail(ms.status());
       for (const auto& m : *ms)
-        j["measurements"].push_back({{"id", m.id}, {"source", m.source}, {"name", m.name}, {"iso_clause", m.iso_clause},
-                                     {"value_mm", m.value_mm}, {"version", m.version}});
+        j["measurements"].push_back({{"id", m.id},
+                                     {"source", m.source},
+                                     {"name", m.name},
+                                     {"iso_clause", m.iso_clause},
+                                     {"value_mm", m.value_mm},
+                                     {"version", m.version}});
     }
     std::printf("%s\n", j.dump(1).c_str());
     return 0;
   }
   if (cmd == "verify") {
     if (!need(2)) return 2;
-    std::printf("recovered on open: %zu interrupted scan(s) marked failed, %zu stray version(s), %zu orphan folder(s), "
-                "%zu temporary file(s) removed\n",
-                rep.scans_failed.size(), rep.versions_removed, rep.orphans_removed, rep.temp_files_removed);
+    std::printf(
+        "recovered on open: %zu interrupted scan(s) marked failed, %zu stray version(s), %zu orphan folder(s), "
+        "%zu temporary file(s) removed\n",
+        rep.scans_failed.size(), rep.versions_removed, rep.orphans_removed, rep.temp_files_removed);
     const Status v = ar.verify();
     if (!v.ok()) return fail(v);
     std::printf("archive %s: consistent, every file matches its checksum\n", ar.dir().c_str());
@@ -192,7 +207,8 @@ int run_archive(int argc, char** argv) {
     return 0;
   }
   auto ends = [&](const char* suffix) {
-    return out.size() >= std::strlen(suffix) && out.compare(out.size() - std::strlen(suffix), std::string::npos, suffix) == 0;
+    return out.size() >= std::strlen(suffix) &&
+           out.compare(out.size() - std::strlen(suffix), std::string::npos, suffix) == 0;
   };
   auto surface = [&](const std::string& scan) { return pipeline::archived_surface(ar, scan); };
   if (cmd == "mesh") {
@@ -204,10 +220,14 @@ int run_archive(int argc, char** argv) {
     auto mesh = surface(args[2]);
     if (!mesh.ok()) return fail(mesh.status());
     Status w;
-    if (ends(".ply")) w = write_ply(out, *mesh);
-    else if (ends(".obj")) w = storage::write_obj(out, *mesh);
-    else if (ends(".stl")) w = storage::write_stl(out, *mesh);
-    else w = storage::write_glb(out, *mesh).status();
+    if (ends(".ply"))
+      w = write_ply(out, *mesh);
+    else if (ends(".obj"))
+      w = storage::write_obj(out, *mesh);
+    else if (ends(".stl"))
+      w = storage::write_stl(out, *mesh);
+    else
+      w = storage::write_glb(out, *mesh).status();
     if (!w.ok()) return fail(w);
     ar.log(actor, "export mesh", "scan", args[2], out);
     std::printf("wrote %s: %zu triangles\n", out.c_str(), mesh->num_triangles());

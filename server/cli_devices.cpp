@@ -32,8 +32,10 @@ int run_devices(int argc, char** argv) {
   bool json_out = false, fake = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--json") json_out = true;
-    else if (a == "--include-fake") fake = true;
+    if (a == "--json")
+      json_out = true;
+    else if (a == "--include-fake")
+      fake = true;
     else if (a == "-h" || a == "--help") {
       usage(stdout);
       return 0;
@@ -53,15 +55,24 @@ int run_devices(int argc, char** argv) {
     nlohmann::json j;
     j["cameras"] = nlohmann::json::array();
     for (const auto& c : cameras)
-      j["cameras"].push_back({{"id", c.id}, {"vendor", c.vendor}, {"model", c.model}, {"serial", c.serial},
-                              {"protocol", c.protocol}, {"address", c.address}});
+      j["cameras"].push_back({{"id", c.id},
+                              {"vendor", c.vendor},
+                              {"model", c.model},
+                              {"serial", c.serial},
+                              {"protocol", c.protocol},
+                              {"address", c.address}});
     j["usb"] = nlohmann::json::array();
     if (usb.ok()) {
       for (const auto& d : *usb) {
         char ids[16];
         std::snprintf(ids, sizeof ids, "%04x:%04x", d.vendor, d.product);
-        j["usb"].push_back({{"ids", ids}, {"bus", d.bus}, {"address", d.address}, {"manufacturer", d.manufacturer},
-                            {"product", d.product_name}, {"serial", d.serial}, {"bodyscan_board", d.known_as}});
+        j["usb"].push_back({{"ids", ids},
+                            {"bus", d.bus},
+                            {"address", d.address},
+                            {"manufacturer", d.manufacturer},
+                            {"product", d.product_name},
+                            {"serial", d.serial},
+                            {"bodyscan_board", d.known_as}});
       }
     } else {
       j["usb_error"] = usb.status().message();
@@ -73,16 +84,19 @@ int run_devices(int argc, char** argv) {
   std::printf("Cameras (Aravis):\n");
   if (cameras.empty()) std::printf("  none found (check the network link, its MTU, and that the camera is powered)\n");
   for (const auto& c : cameras)
-    std::printf("  %-32s %s %s, serial %s, %s at %s\n", c.id.c_str(), c.vendor.c_str(), c.model.c_str(), c.serial.c_str(),
-                c.protocol.c_str(), c.address.c_str());
+    std::printf("  %-32s %s %s, serial %s, %s at %s\n", c.id.c_str(), c.vendor.c_str(), c.model.c_str(),
+                c.serial.c_str(), c.protocol.c_str(), c.address.c_str());
   std::printf("USB devices:\n");
-  if (!usb.ok()) std::printf("  %s\n", usb.status().message().c_str());
-  else if (usb->empty()) std::printf("  none\n");
+  if (!usb.ok())
+    std::printf("  %s\n", usb.status().message().c_str());
+  else if (usb->empty())
+    std::printf("  none\n");
   else
     for (const auto& d : *usb)
       std::printf("  %04x:%04x bus %d device %d  %s %s%s%s%s\n", d.vendor, d.product, d.bus, d.address,
-                  d.manufacturer.c_str(), d.product_name.c_str(), d.serial.empty() ? "" : (", serial " + d.serial).c_str(),
-                  d.known_as.empty() ? "" : "  <- ", d.known_as.c_str());
+                  d.manufacturer.c_str(), d.product_name.c_str(),
+                  d.serial.empty() ? "" : (", serial " + d.serial).c_str(), d.known_as.empty() ? "" : "  <- ",
+                  d.known_as.c_str());
   std::printf("Serial ports:\n");
   if (ports.empty()) std::printf("  none under /dev/serial/by-id\n");
   for (const auto& p : ports) std::printf("  %s\n", p.c_str());

@@ -147,9 +147,8 @@ int run_measure(int argc, char** argv) {
   const std::string start_option = from ? "--distance" : surface_from ? "--surface" : "--arc";
   auto fail = [&](const Status& st) {
     std::string m = st.message();
-    for (const auto& [field, option] : {std::pair<std::string, std::string>{"'near'", "--near"},
-                                        {"'from'", start_option},
-                                        {"'to'", "--to"}}) {
+    for (const auto& [field, option] :
+         {std::pair<std::string, std::string>{"'near'", "--near"}, {"'from'", start_option}, {"'to'", "--to"}}) {
       for (size_t at = m.find(field); at != std::string::npos; at = m.find(field, at + option.size()))
         m.replace(at, field.size(), option);
     }
@@ -196,7 +195,10 @@ int run_measure(int argc, char** argv) {
   if (!is_mesh) {
     if (surface_from || automatic || arc_from) {
       std::fprintf(stderr, "bodyscan measure: %s needs a mesh (%s is a point cloud)\n",
-                   automatic ? "--auto" : surface_from ? "--surface" : "--arc", file.c_str());
+                   automatic      ? "--auto"
+                   : surface_from ? "--surface"
+                                  : "--arc",
+                   file.c_str());
       return 1;
     }
     // The thesis's girth on a cloud: the points within a slab of the plane.

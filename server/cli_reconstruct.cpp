@@ -1,9 +1,9 @@
 // bodyscan reconstruct: points (PLY) to a watertight mesh (PLY).
+#include <unistd.h>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
-#include <unistd.h>
 
 #include "recon/io/ply.hpp"
 #include "recon/surface/reconstruct.hpp"
@@ -213,18 +213,19 @@ int run_reconstruct(int argc, char** argv) {
     std::printf("points      %zu (used %zu)\n", s.input_points, s.used_points);
     std::printf("triangles   %zu\nvertices    %zu\n", rec->mesh.num_triangles(), rec->mesh.num_vertices());
     std::printf("normals     %s\n", to_string(s.normals));
-    std::printf("spacing     %.4g (median density sigma)\nnoise       %.4g (estimated)\n",
-                s.median_density_sigma, s.noise_sigma);
-    std::printf("parameters  sigma %.3g  normal-sigma %.3g  sharpen %.3g  voxel %.4g  normal-k %zu\n",
-                s.sigma_scale, s.normal_scale, s.sharpening, s.voxel_size, s.normal_k);
+    std::printf("spacing     %.4g (median density sigma)\nnoise       %.4g (estimated)\n", s.median_density_sigma,
+                s.noise_sigma);
+    std::printf("parameters  sigma %.3g  normal-sigma %.3g  sharpen %.3g  voxel %.4g  normal-k %zu\n", s.sigma_scale,
+                s.normal_scale, s.sharpening, s.voxel_size, s.normal_k);
     std::printf("field       %zu bricks, %.1f MB\n", s.bricks, static_cast<double>(s.field_bytes) / 1e6);
     const MeshTopology topology = analyze_topology(rec->mesh);
     std::printf("surface     %s, %zu component%s; %zu hole%s filled (%.4g square units), %zu flap triangles trimmed\n",
                 topology.closed() ? "closed" : "open", topology.components, topology.components == 1 ? "" : "s",
                 s.holes_filled, s.holes_filled == 1 ? "" : "s", s.hole_area, s.flap_triangles_trimmed);
-    std::printf("time        %.2f s total (neighbours %.2f, normals %.2f, orientation %.2f, "
-                "kernels %.2f, field %.2f, mesh %.2f)\n",
-                total, s.t_neighbours, s.t_normals, s.t_orientation, s.t_kernels, s.t_field, s.t_mesh);
+    std::printf(
+        "time        %.2f s total (neighbours %.2f, normals %.2f, orientation %.2f, "
+        "kernels %.2f, field %.2f, mesh %.2f)\n",
+        total, s.t_neighbours, s.t_normals, s.t_orientation, s.t_kernels, s.t_field, s.t_mesh);
     std::printf("wrote       %s%s\n", out.c_str(), glb_note.c_str());
   }
   return 0;

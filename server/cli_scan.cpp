@@ -12,10 +12,10 @@
 #include "hw/rig_description.hpp"
 #include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
-#include "server/pipeline/archive_scan.hpp"
-#include "server/pipeline/scan_job.hpp"
 #include "server/cli_subject.hpp"
+#include "server/pipeline/archive_scan.hpp"
 #include "server/pipeline/rig_backend.hpp"
+#include "server/pipeline/scan_job.hpp"
 
 namespace bodyscan::cli {
 
@@ -23,52 +23,53 @@ namespace {
 
 void usage(FILE* out) {
   std::fprintf(out,
-      "usage: bodyscan scan --rig RIG --out DIR [options]\n"
-      "\n"
-      "Calibrates the rig from what its cameras see (dot grid, frame lights, lasers on\n"
-      "the frame's poles), scans the subject, turns the laser stripes into one point\n"
-      "cloud, reconstructs a closed surface and measures it. Writes DIR/points.ply,\n"
-      "DIR/mesh.ply, DIR/mesh.glb, DIR/measurements.json (docs/measurements.md),\n"
-      "DIR/calibration.json, DIR/scan.json and DIR/raw/ (the raw record that\n"
-      "`bodyscan reprocess` makes the scan again from).\n"
-      "\n"
-      "  --rig RIG        sim (the thesis rig and the demo body), thesis, square, tiered,\n"
-      "                   or a rig description file (JSON)\n"
-      "%s"
-      "  --out DIR        output folder (created)\n"
-      "  --every N        scan every Nth laser step only (default 1: all)\n"
-      "  --method M       homography (default: the thesis's image-to-laser-plane\n"
-      "                   transform, eq. 3.6) or ray (the pixel's two-plane ray met\n"
-      "                   with the laser plane)\n"
-      "  --max-view DEG   drop points their camera saw more than DEG from the\n"
-      "                   surface normal (grazing views put points inside the\n"
-      "                   body; default: the rig description's processing\n"
-      "                   .max_view_deg, else 90: keep them all)\n"
-      "  --no-surface     stop at the point cloud\n"
-      "  --keep-sway      keep every point where it was measured (default: the\n"
-      "                   subject's sway between sweeps is estimated from the\n"
-      "                   cloud and undone; scan.json \"sway\" has its path)\n"
-      "  --archive DIR    also store the scan in the archive in DIR (created;\n"
-      "                   docs/archive.md); --out is then optional\n"
-      "  --customer ID    the archived scan's customer (default: a new one)\n"
-      "  --new-customer NAME  a new customer with this name\n"
-      "  --operator NAME  who runs the scan (the archive's audit log)\n"
-      "  --operator-dot-grid  ask on the terminal for the lens board before the\n"
-      "                   simulated cameras too, as for real ones (a line on\n"
-      "                   standard input answers each request)\n"
-      "  -q, --quiet      print only errors\n"
-      "\n"
-      "Before each real camera a person holds the lens dot-grid board: the request\n"
-      "is printed, and Enter (a line on standard input) answers it.\n",
-      kSubjectOptionsHelp);
+               "usage: bodyscan scan --rig RIG --out DIR [options]\n"
+               "\n"
+               "Calibrates the rig from what its cameras see (dot grid, frame lights, lasers on\n"
+               "the frame's poles), scans the subject, turns the laser stripes into one point\n"
+               "cloud, reconstructs a closed surface and measures it. Writes DIR/points.ply,\n"
+               "DIR/mesh.ply, DIR/mesh.glb, DIR/measurements.json (docs/measurements.md),\n"
+               "DIR/calibration.json, DIR/scan.json and DIR/raw/ (the raw record that\n"
+               "`bodyscan reprocess` makes the scan again from).\n"
+               "\n"
+               "  --rig RIG        sim (the thesis rig and the demo body), thesis, square, tiered,\n"
+               "                   or a rig description file (JSON)\n"
+               "%s"
+               "  --out DIR        output folder (created)\n"
+               "  --every N        scan every Nth laser step only (default 1: all)\n"
+               "  --method M       homography (default: the thesis's image-to-laser-plane\n"
+               "                   transform, eq. 3.6) or ray (the pixel's two-plane ray met\n"
+               "                   with the laser plane)\n"
+               "  --max-view DEG   drop points their camera saw more than DEG from the\n"
+               "                   surface normal (grazing views put points inside the\n"
+               "                   body; default: the rig description's processing\n"
+               "                   .max_view_deg, else 90: keep them all)\n"
+               "  --no-surface     stop at the point cloud\n"
+               "  --keep-sway      keep every point where it was measured (default: the\n"
+               "                   subject's sway between sweeps is estimated from the\n"
+               "                   cloud and undone; scan.json \"sway\" has its path)\n"
+               "  --archive DIR    also store the scan in the archive in DIR (created;\n"
+               "                   docs/archive.md); --out is then optional\n"
+               "  --customer ID    the archived scan's customer (default: a new one)\n"
+               "  --new-customer NAME  a new customer with this name\n"
+               "  --operator NAME  who runs the scan (the archive's audit log)\n"
+               "  --operator-dot-grid  ask on the terminal for the lens board before the\n"
+               "                   simulated cameras too, as for real ones (a line on\n"
+               "                   standard input answers each request)\n"
+               "  -q, --quiet      print only errors\n"
+               "\n"
+               "Before each real camera a person holds the lens dot-grid board: the request\n"
+               "is printed, and Enter (a line on standard input) answers it.\n",
+               kSubjectOptionsHelp);
 }
 
 // What the sway estimate found (pipeline::ScanOptions::compensate_sway).
 void print_sway(const pipeline::ScanStats& scan) {
   if (!scan.sway.empty() && scan.sway.regularization.still) {
-    std::printf("sway: none; where sweeps meet they differ by %.2f mm RMS, and no path explains skin it was not "
-                "fitted to better\n",
-                scan.sway.rms_before_mm);
+    std::printf(
+        "sway: none; where sweeps meet they differ by %.2f mm RMS, and no path explains skin it was not "
+        "fitted to better\n",
+        scan.sway.rms_before_mm);
   } else if (!scan.sway.empty()) {
     std::printf("sway: up to %.1f mm, undone; where sweeps meet they differ by %.2f mm RMS (%.2f as measured)\n",
                 scan.sway.peak_mm, scan.sway.rms_after_mm, scan.sway.rms_before_mm);
@@ -133,8 +134,10 @@ int run_scan(int argc, char** argv) {
       }
       if (a == "--method") {
         const std::string m = v;
-        if (m == "ray") options.scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
-        else if (m == "homography") options.scan.triangulate.method = TriangulationMethod::kLaserHomography;
+        if (m == "ray")
+          options.scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
+        else if (m == "homography")
+          options.scan.triangulate.method = TriangulationMethod::kLaserHomography;
         else {
           std::fprintf(stderr, "bodyscan scan: --method is ray or homography, not '%s'\n", v);
           return 2;
@@ -259,9 +262,10 @@ int run_scan(int argc, char** argv) {
   }
   if (!quiet) {
     for (const CameraCalibration& c : result->calibration.cameras) {
-      std::printf("camera %-12s %s side, centre (%.0f, %.0f, %.0f) mm, lens held-out %.3f px, rays meet within %.2f mm\n",
-                  c.camera_id.c_str(), to_string(c.side), c.centre.x(), c.centre.y(), c.centre.z(),
-                  c.lens.held_out_rms_px(), c.ray_spread_mm);
+      std::printf(
+          "camera %-12s %s side, centre (%.0f, %.0f, %.0f) mm, lens held-out %.3f px, rays meet within %.2f mm\n",
+          c.camera_id.c_str(), to_string(c.side), c.centre.x(), c.centre.y(), c.centre.z(), c.lens.held_out_rms_px(),
+          c.ray_spread_mm);
     }
     std::printf("scan: %zu points from %zu frames (%zu without a laser plane), processing %.2f s\n",
                 result->cloud.size(), result->scan.frames, result->scan.frames_without_plane,
@@ -277,8 +281,11 @@ int run_scan(int argc, char** argv) {
     }
     if (!out.empty())
       std::printf("wrote %s/points.ply%s%s, calibration.json, scan.json, raw/\n", out.c_str(),
-                  result->mesh.triangles.empty() ? "" : ", mesh.ply, mesh.glb", result->body ? ", measurements.json" : "");
-    if (archive) std::printf("archived scan %s for customer %s in %s\n", scan_id.c_str(), customer_id.c_str(), archive_dir.c_str());
+                  result->mesh.triangles.empty() ? "" : ", mesh.ply, mesh.glb",
+                  result->body ? ", measurements.json" : "");
+    if (archive)
+      std::printf("archived scan %s for customer %s in %s\n", scan_id.c_str(), customer_id.c_str(),
+                  archive_dir.c_str());
   }
   if (!result->measure_error.empty()) {
     std::fprintf(stderr, "bodyscan scan: warning: no automatic measurements: %s\n", result->measure_error.c_str());
@@ -310,8 +317,10 @@ int run_reprocess(int argc, char** argv) {
       const std::string v = argv[++i];
       if (a == "--out") out = v;
       if (a == "--method") {
-        if (v == "ray") options.scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
-        else if (v == "homography") options.scan.triangulate.method = TriangulationMethod::kLaserHomography;
+        if (v == "ray")
+          options.scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
+        else if (v == "homography")
+          options.scan.triangulate.method = TriangulationMethod::kLaserHomography;
         else {
           std::fprintf(stderr, "bodyscan reprocess: --method is ray or homography, not '%s'\n", v.c_str());
           return 2;
@@ -365,7 +374,9 @@ int run_reprocess(int argc, char** argv) {
   }
   print_sway(result->scan);
   std::printf("reprocessed: %zu points%s, written to %s\n", result->cloud.size(),
-              result->mesh.triangles.empty() ? "" : (", " + std::to_string(result->mesh.num_triangles()) + " triangles").c_str(),
+              result->mesh.triangles.empty()
+                  ? ""
+                  : (", " + std::to_string(result->mesh.num_triangles()) + " triangles").c_str(),
               out.c_str());
   if (!result->surface_error.empty()) {
     std::fprintf(stderr, "bodyscan reprocess: the surface failed: %s\n", result->surface_error.c_str());

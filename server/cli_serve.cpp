@@ -13,8 +13,8 @@
 
 #include "recon/io/atomic_file.hpp"
 #include "server/api/api.hpp"
-#include "server/net/http_server.hpp"
 #include "server/cli_subject.hpp"
+#include "server/net/http_server.hpp"
 #include "server/workstation/workstation.hpp"
 
 namespace bodyscan::cli {
@@ -36,40 +36,40 @@ const char* signal_name(int sig) {
 
 void usage(FILE* out) {
   std::fprintf(out,
-      "usage: bodyscan serve [options]\n"
-      "\n"
-      "Runs the workstation: the rig (calibration, scans, reconstruction), the\n"
-      "archive, the REST API and WebSocket events (docs/api.md), and the browser UI.\n"
-      "On embedded defaults: the simulated rig with the demo body, the archive in\n"
-      "./bodyscan-data, port 8080.\n"
-      "\n"
-      "  --address A        the address to listen on (default 0.0.0.0)\n"
-      "  --port N           (default 8080; 0 picks a free port)\n"
-      "  --data DIR         the archive and accounts (default ./bodyscan-data)\n"
-      "  --rig RIG          sim (default), thesis, square, tiered or a rig description file\n"
-      "%s"
-      "  --every N          scans use every Nth laser step unless asked otherwise\n"
-      "                     (default 1)\n"
-      "  --operator-dot-grid\n"
-      "                     calibration asks a person to hold the lens board before\n"
-      "                     the simulated cameras too, as it does before real ones\n"
-      "                     (staff training)\n"
-      "  --web DIR          the browser UI's files (default: the UI this build made, BUILD/web)\n"
-      "  --tls-cert PEM --tls-key PEM\n"
-      "                     serve HTTPS (session cookies become Secure)\n"
-      "  --behind-tls-proxy a TLS proxy in front forwards to us: cookies Secure\n"
-      "  --trusted-proxy A  believe X-Forwarded-For/-Proto/-Host from this address\n"
-      "                     (the reverse proxy's; repeatable)\n"
-      "  --public-url URL   the address customers' share links start with\n"
-      "  --admin NAME       the first admin account, made when there is none; its\n"
-      "                     password comes from BODYSCAN_ADMIN_PASSWORD, or one is made\n"
-      "                     up, printed once and kept in DATA/first-admin-password\n"
-      "                     (mode 0600) until changed\n"
-      "  --workers N        threads for requests' work (default 3)\n"
-      "  --max-connections N\n"
-      "                     open HTTP and WebSocket connections at most; more are\n"
-      "                     answered 503 (default: the descriptor limit less 128)\n",
-      kSubjectOptionsHelp);
+               "usage: bodyscan serve [options]\n"
+               "\n"
+               "Runs the workstation: the rig (calibration, scans, reconstruction), the\n"
+               "archive, the REST API and WebSocket events (docs/api.md), and the browser UI.\n"
+               "On embedded defaults: the simulated rig with the demo body, the archive in\n"
+               "./bodyscan-data, port 8080.\n"
+               "\n"
+               "  --address A        the address to listen on (default 0.0.0.0)\n"
+               "  --port N           (default 8080; 0 picks a free port)\n"
+               "  --data DIR         the archive and accounts (default ./bodyscan-data)\n"
+               "  --rig RIG          sim (default), thesis, square, tiered or a rig description file\n"
+               "%s"
+               "  --every N          scans use every Nth laser step unless asked otherwise\n"
+               "                     (default 1)\n"
+               "  --operator-dot-grid\n"
+               "                     calibration asks a person to hold the lens board before\n"
+               "                     the simulated cameras too, as it does before real ones\n"
+               "                     (staff training)\n"
+               "  --web DIR          the browser UI's files (default: the UI this build made, BUILD/web)\n"
+               "  --tls-cert PEM --tls-key PEM\n"
+               "                     serve HTTPS (session cookies become Secure)\n"
+               "  --behind-tls-proxy a TLS proxy in front forwards to us: cookies Secure\n"
+               "  --trusted-proxy A  believe X-Forwarded-For/-Proto/-Host from this address\n"
+               "                     (the reverse proxy's; repeatable)\n"
+               "  --public-url URL   the address customers' share links start with\n"
+               "  --admin NAME       the first admin account, made when there is none; its\n"
+               "                     password comes from BODYSCAN_ADMIN_PASSWORD, or one is made\n"
+               "                     up, printed once and kept in DATA/first-admin-password\n"
+               "                     (mode 0600) until changed\n"
+               "  --workers N        threads for requests' work (default 3)\n"
+               "  --max-connections N\n"
+               "                     open HTTP and WebSocket connections at most; more are\n"
+               "                     answered 503 (default: the descriptor limit less 128)\n",
+               kSubjectOptionsHelp);
 }
 
 std::string random_password() {
@@ -113,34 +113,43 @@ int run_serve(int argc, char** argv) {
       char* end = nullptr;
       const long n = std::strtol(v.c_str(), &end, 10);
       if (v.empty() || *end != '\0' || n < lo || n > hi) {
-        std::fprintf(stderr, "bodyscan serve: %s expects a number from %d to %d, got '%s'\n", a.c_str(), lo, hi, v.c_str());
+        std::fprintf(stderr, "bodyscan serve: %s expects a number from %d to %d, got '%s'\n", a.c_str(), lo, hi,
+                     v.c_str());
         return std::nullopt;
       }
       return static_cast<int>(n);
     };
-    if (a == "--address") no.address = v;
+    if (a == "--address")
+      no.address = v;
     else if (a == "--port") {
       auto n = number(0, 65535);
       if (!n) return 2;
       no.port = static_cast<uint16_t>(*n);
-    } else if (a == "--data") wo.data_dir = v;
-    else if (a == "--rig") wo.rig = v;
+    } else if (a == "--data")
+      wo.data_dir = v;
+    else if (a == "--rig")
+      wo.rig = v;
     else if (is_subject_option(a)) {
       if (Status st = set_subject_option(a, v, &wo.subject); !st.ok()) {
         std::fprintf(stderr, "bodyscan serve: %s\n", st.message().c_str());
         return 2;
       }
-    }
-    else if (a == "--every") {
+    } else if (a == "--every") {
       auto n = number(1, 1000);
       if (!n) return 2;
       wo.default_every = *n;
-    } else if (a == "--web") ao.web_root = v;
-    else if (a == "--trusted-proxy") no.trusted_proxies.push_back(v);
-    else if (a == "--tls-cert") no.tls_cert = v;
-    else if (a == "--tls-key") no.tls_key = v;
-    else if (a == "--public-url") ao.public_url = v;
-    else if (a == "--admin") admin = v;
+    } else if (a == "--web")
+      ao.web_root = v;
+    else if (a == "--trusted-proxy")
+      no.trusted_proxies.push_back(v);
+    else if (a == "--tls-cert")
+      no.tls_cert = v;
+    else if (a == "--tls-key")
+      no.tls_key = v;
+    else if (a == "--public-url")
+      ao.public_url = v;
+    else if (a == "--admin")
+      admin = v;
     else if (a == "--workers") {
       auto n = number(1, 64);
       if (!n) return 2;
@@ -214,8 +223,9 @@ int run_serve(int argc, char** argv) {
     return 1;
   }
   const std::string host = no.address == "0.0.0.0" || no.address == "::" ? "localhost" : no.address;
-  std::printf("bodyscan workstation on %s rig, archive in %s\nopen %s://%s:%u/\n", (*ws)->rig_status()["rig"].get<std::string>().c_str(),
-              wo.data_dir.c_str(), (*http)->tls() ? "https" : "http", host.c_str(), (*http)->port());
+  std::printf("bodyscan workstation on %s rig, archive in %s\nopen %s://%s:%u/\n",
+              (*ws)->rig_status()["rig"].get<std::string>().c_str(), wo.data_dir.c_str(),
+              (*http)->tls() ? "https" : "http", host.c_str(), (*http)->port());
   std::fflush(stdout);
 
   int sig = 0;

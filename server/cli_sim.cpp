@@ -9,8 +9,8 @@
 
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/png_image.hpp"
-#include "server/pipeline/acquire.hpp"
 #include "server/cli_subject.hpp"
+#include "server/pipeline/acquire.hpp"
 #include "server/pipeline/rig_backend.hpp"
 
 namespace bodyscan::cli {
@@ -19,20 +19,20 @@ namespace {
 
 void usage(FILE* out) {
   std::fprintf(out,
-      "usage: bodyscan sim render --rig RIG --out DIR [options]\n"
-      "\n"
-      "Renders what the simulated rig's cameras see during one calibration (the\n"
-      "dot-grid target before each camera, room lights, frame lights off, on, front\n"
-      "poles only, each laser alone) and one full scan (per laser group: a base frame\n"
-      "with the lasers off, then every step with the group's lasers on), as PNG\n"
-      "images in DIR with DIR/index.json listing them.\n"
-      "\n"
-      "  --rig RIG        thesis, square, tiered, or a rig description file (JSON)\n"
-      "%s"
-      "  --out DIR        output folder (created)\n"
-      "  --every N        render every Nth laser step only (default 1)\n"
-      "  -q, --quiet      print only errors\n",
-      kSubjectOptionsHelp);
+               "usage: bodyscan sim render --rig RIG --out DIR [options]\n"
+               "\n"
+               "Renders what the simulated rig's cameras see during one calibration (the\n"
+               "dot-grid target before each camera, room lights, frame lights off, on, front\n"
+               "poles only, each laser alone) and one full scan (per laser group: a base frame\n"
+               "with the lasers off, then every step with the group's lasers on), as PNG\n"
+               "images in DIR with DIR/index.json listing them.\n"
+               "\n"
+               "  --rig RIG        thesis, square, tiered, or a rig description file (JSON)\n"
+               "%s"
+               "  --out DIR        output folder (created)\n"
+               "  --every N        render every Nth laser step only (default 1)\n"
+               "  -q, --quiet      print only errors\n",
+               kSubjectOptionsHelp);
 }
 
 }  // namespace
@@ -137,7 +137,8 @@ int run_sim(int argc, char** argv) {
     } else if (shot.kind == pipeline::ShotKind::kLaserBase && shot.group >= 0) {
       name = "group" + std::to_string(shot.group) + "_base";
     } else if (!shot.lasers.empty()) {
-      name += "_" + desc.lasers[static_cast<size_t>(shot.lasers[0].laser)].id + "_step" + std::to_string(shot.lasers[0].step);
+      name += "_" + desc.lasers[static_cast<size_t>(shot.lasers[0].laser)].id + "_step" +
+              std::to_string(shot.lasers[0].step);
     } else if (shot.kind == pipeline::ShotKind::kLaserBase) {
       // Calibration takes one before each laser is identified, in laser order.
       const size_t k = identify_bases[shot.camera]++;

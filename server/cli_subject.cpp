@@ -47,7 +47,8 @@ Status set_subject_option(const std::string& flag, const std::string& value, pip
   } else if (flag == "--arms") {
     const auto v = numbers(value, 1, 2);
     if (!v || (*v)[0] < 0 || (*v)[0] > 80 || v->back() < 0 || v->back() > 80)
-      return invalid_argument("--arms expects degrees from the vertical, 0-80, as DEG or LEFT,RIGHT; got '" + value + "'");
+      return invalid_argument("--arms expects degrees from the vertical, 0-80, as DEG or LEFT,RIGHT; got '" + value +
+                              "'");
     subject->posture.arm_abduction_deg = {(*v)[0], v->back()};
   } else if (flag == "--feet") {
     const auto v = numbers(value, 1, 1);
@@ -56,7 +57,8 @@ Status set_subject_option(const std::string& flag, const std::string& value, pip
     subject->posture.ankle_distance_mm = (*v)[0];
   } else if (flag == "--turn") {
     const auto v = numbers(value, 1, 1);
-    if (!v || std::abs((*v)[0]) > 180) return invalid_argument("--turn expects degrees, -180 to 180; got '" + value + "'");
+    if (!v || std::abs((*v)[0]) > 180)
+      return invalid_argument("--turn expects degrees, -180 to 180; got '" + value + "'");
     subject->turn_deg = (*v)[0];
   } else if (flag == "--at") {
     const auto v = numbers(value, 2, 2);

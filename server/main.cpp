@@ -15,7 +15,7 @@ int run_reprocess(int argc, char** argv);
 int run_archive(int argc, char** argv);
 int run_serve(int argc, char** argv);
 int run_devices(int argc, char** argv);
-}
+}  // namespace bodyscan::cli
 
 namespace {
 void print_usage(FILE* out) {

@@ -12,12 +12,13 @@ namespace bodyscan::testing {
 // A closed prism: the polygon (x, z), star-shaped about `centre`, from y0 to y1,
 // side walls in `rings` layers, caps fanned from the centre.
 inline TriangleMesh prism(const std::vector<Eigen::Vector2d>& poly, Eigen::Vector2d centre, double y0, double y1,
-                   int rings = 8) {
+                          int rings = 8) {
   TriangleMesh m;
   const auto n = static_cast<uint32_t>(poly.size());
   for (int r = 0; r <= rings; ++r) {
     const double y = y0 + (y1 - y0) * r / rings;
-    for (const Eigen::Vector2d& p : poly) m.vertices.emplace_back(static_cast<float>(p.x()), static_cast<float>(y), static_cast<float>(p.y()));
+    for (const Eigen::Vector2d& p : poly)
+      m.vertices.emplace_back(static_cast<float>(p.x()), static_cast<float>(y), static_cast<float>(p.y()));
   }
   for (uint32_t r = 0; r < static_cast<uint32_t>(rings); ++r)
     for (uint32_t i = 0; i < n; ++i) {
@@ -38,7 +39,8 @@ inline TriangleMesh prism(const std::vector<Eigen::Vector2d>& poly, Eigen::Vecto
 
 inline std::vector<Eigen::Vector2d> circle(double r, Eigen::Vector2d c = {0, 0}, int n = 720) {
   std::vector<Eigen::Vector2d> p;
-  for (int i = 0; i < n; ++i) p.push_back(c + r * Eigen::Vector2d(std::cos(2 * M_PI * i / n), -std::sin(2 * M_PI * i / n)));
+  for (int i = 0; i < n; ++i)
+    p.push_back(c + r * Eigen::Vector2d(std::cos(2 * M_PI * i / n), -std::sin(2 * M_PI * i / n)));
   return p;
 }
 

@@ -8,9 +8,7 @@
 
 namespace bodyscan::testing {
 
-std::string data_path(const std::string& name) {
-  return std::string(BODYSCAN_TEST_DATA_DIR) + "/" + name;
-}
+std::string data_path(const std::string& name) { return std::string(BODYSCAN_TEST_DATA_DIR) + "/" + name; }
 
 namespace {
 std::vector<std::filesystem::path>& dirs() {

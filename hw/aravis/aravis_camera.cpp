@@ -81,7 +81,8 @@ struct AravisCamera::Impl {
   static void on_control_lost(ArvDevice*, gpointer self) { static_cast<Impl*>(self)->lost = true; }
 
   Status unplugged() const {
-    return unavailable(name + " is gone: it stopped answering its control channel (unplugged, powered off, or the network "
+    return unavailable(name +
+                       " is gone: it stopped answering its control channel (unplugged, powered off, or the network "
                        "link is down)");
   }
 };
@@ -134,7 +135,8 @@ StatusOr<std::unique_ptr<AravisCamera>> AravisCamera::open(const CameraDescripti
   }
   g_free(formats);
   if (info.formats.empty()) {
-    return failed_precondition(impl->name + " offers no monochrome pixel format (Mono8, Mono12 or Mono16): bodyscan "
+    return failed_precondition(impl->name +
+                               " offers no monochrome pixel format (Mono8, Mono12 or Mono16): bodyscan "
                                "needs a monochrome camera");
   }
 
@@ -144,8 +146,8 @@ StatusOr<std::unique_ptr<AravisCamera>> AravisCamera::open(const CameraDescripti
   if (err) return io_error("cannot read the sensor size of " + impl->name + ": " + err.text());
   if (desc.width > sx || desc.height > sy) {
     return failed_precondition(impl->name + " has a " + std::to_string(sx) + " x " + std::to_string(sy) +
-                               " pixel sensor, smaller than the rig description's " + std::to_string(desc.width) + " x " +
-                               std::to_string(desc.height) + ": correct the description");
+                               " pixel sensor, smaller than the rig description's " + std::to_string(desc.width) +
+                               " x " + std::to_string(desc.height) + ": correct the description");
   }
   arv_camera_set_region(impl->camera, 0, 0, desc.width, desc.height, err.out());
   gint x = 0, y = 0, w = 0, h = 0;
@@ -160,8 +162,10 @@ StatusOr<std::unique_ptr<AravisCamera>> AravisCamera::open(const CameraDescripti
   }
 
   // Manual exposure and gain: the laser's stripe must not be "corrected" away.
-  if (arv_camera_is_exposure_auto_available(impl->camera, err.out())) arv_camera_set_exposure_time_auto(impl->camera, ARV_AUTO_OFF, err.out());
-  if (arv_camera_is_gain_auto_available(impl->camera, err.out())) arv_camera_set_gain_auto(impl->camera, ARV_AUTO_OFF, err.out());
+  if (arv_camera_is_exposure_auto_available(impl->camera, err.out()))
+    arv_camera_set_exposure_time_auto(impl->camera, ARV_AUTO_OFF, err.out());
+  if (arv_camera_is_gain_auto_available(impl->camera, err.out()))
+    arv_camera_set_gain_auto(impl->camera, ARV_AUTO_OFF, err.out());
   arv_camera_set_acquisition_mode(impl->camera, ARV_ACQUISITION_MODE_CONTINUOUS, err.out());
   if (err) return io_error("cannot set up " + impl->name + ": " + err.text());
   arv_camera_set_trigger(impl->camera, impl->software_trigger ? "Software" : desc.device.trigger.c_str(), err.out());
@@ -169,8 +173,10 @@ StatusOr<std::unique_ptr<AravisCamera>> AravisCamera::open(const CameraDescripti
     return failed_precondition(impl->name + " cannot be triggered by '" + desc.device.trigger + "': " + err.text());
   }
   if (arv_camera_is_gv_device(impl->camera)) {
-    if (desc.device.packet_size > 0) arv_camera_gv_set_packet_size(impl->camera, desc.device.packet_size, err.out());
-    else arv_camera_gv_auto_packet_size(impl->camera, err.out());
+    if (desc.device.packet_size > 0)
+      arv_camera_gv_set_packet_size(impl->camera, desc.device.packet_size, err.out());
+    else
+      arv_camera_gv_auto_packet_size(impl->camera, err.out());
     if (err) return io_error("cannot set the packet size of " + impl->name + ": " + err.text());
   }
 
@@ -234,7 +240,9 @@ Status AravisCamera::set_exposure_us(double exposure) {
   std::lock_guard lock(mutex_);
   Err err;
   arv_camera_set_exposure_time(impl_->camera, exposure, err.out());
-  if (err) return invalid_argument("cannot set the exposure of " + impl_->name + " to " + std::to_string(exposure) + " us: " + err.text());
+  if (err)
+    return invalid_argument("cannot set the exposure of " + impl_->name + " to " + std::to_string(exposure) +
+                            " us: " + err.text());
   exposure_us_ = arv_camera_get_exposure_time(impl_->camera, err.out());
   return Status::Ok();
 }
@@ -248,7 +256,9 @@ Status AravisCamera::set_gain_db(double gain) {
     return Status::Ok();
   }
   arv_camera_set_gain(impl_->camera, gain, err.out());
-  if (err) return invalid_argument("cannot set the gain of " + impl_->name + " to " + std::to_string(gain) + " dB: " + err.text());
+  if (err)
+    return invalid_argument("cannot set the gain of " + impl_->name + " to " + std::to_string(gain) +
+                            " dB: " + err.text());
   gain_db_ = arv_camera_get_gain(impl_->camera, err.out());
   return Status::Ok();
 }
@@ -299,9 +309,9 @@ StatusOr<Frame> AravisCamera::grab(std::chrono::milliseconds timeout) {
           status == ARV_BUFFER_STATUS_TIMEOUT || status == ARV_BUFFER_STATUS_SIZE_MISMATCH) {
         last = io_error(m.name + " delivered an incomplete frame (" +
                         (status == ARV_BUFFER_STATUS_MISSING_PACKETS ? std::string("packets lost")
-                         : status == ARV_BUFFER_STATUS_TIMEOUT      ? std::string("packets late")
+                         : status == ARV_BUFFER_STATUS_TIMEOUT       ? std::string("packets late")
                          : status == ARV_BUFFER_STATUS_SIZE_MISMATCH ? std::string("wrong size")
-                                                                      : std::string("packets out of order")) +
+                                                                     : std::string("packets out of order")) +
                         ", twice in a row): check the cable, the network card's MTU and jumbo frames, and the "
                         "camera's packet size and bandwidth");
         continue;  // one more try

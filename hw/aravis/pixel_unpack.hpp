@@ -19,8 +19,8 @@ enum PfncMono : uint32_t {
   kPfncMono12 = 0x01100005u,
   kPfncMono12Packed = 0x010c0006u,  // GigE Vision packing
   kPfncMono16 = 0x01100007u,
-  kPfncMono10p = 0x010a0046u,       // PFNC LSB-first bit stream
-  kPfncMono12p = 0x010c0047u,       // PFNC LSB-first bit stream
+  kPfncMono10p = 0x010a0046u,  // PFNC LSB-first bit stream
+  kPfncMono12p = 0x010c0047u,  // PFNC LSB-first bit stream
 };
 
 const char* pfnc_name(uint32_t code);  // "Mono12Packed"; "" for others

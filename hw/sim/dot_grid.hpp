@@ -14,11 +14,11 @@
 namespace bodyscan::hw::sim {
 
 struct DotGridTarget {
-  Vec3d centre = Vec3d::Zero();  // world mm
+  Vec3d centre = Vec3d::Zero();                  // world mm
   Vec3d u = Vec3d::UnitX(), v = Vec3d::UnitY();  // the grid's row and column directions (unit)
-  double spacing = 30;        // dot centre to centre, mm
+  double spacing = 30;                           // dot centre to centre, mm
   double dot_diameter = 12;
-  int cols = 25, rows = 21;   // dots
+  int cols = 25, rows = 21;  // dots
   Vec3d dot(int col, int row) const {
     return centre + (col - 0.5 * (cols - 1)) * spacing * u + (row - 0.5 * (rows - 1)) * spacing * v;
   }

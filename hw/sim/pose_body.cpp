@@ -37,9 +37,7 @@ double deg(double rad) { return rad * 180.0 / M_PI; }
 double rad(double deg) { return deg * M_PI / 180.0; }
 
 // Angle of v from the downward vertical, degrees.
-double from_down(const Eigen::Vector3d& v) {
-  return deg(std::acos(std::clamp(-v.y() / v.norm(), -1.0, 1.0)));
-}
+double from_down(const Eigen::Vector3d& v) { return deg(std::acos(std::clamp(-v.y() / v.norm(), -1.0, 1.0))); }
 
 // The x in [lo, hi] where f reaches `target`, f falling to its one minimum in that
 // range and rising after it: on the rising side, to `tol`; nothing when out of reach.
@@ -96,7 +94,8 @@ StatusOr<BodyPoser> BodyPoser::load(const std::string& dir) {
     for (size_t v = 0; v < kHm08; ++v) {
       double sum = 0;
       for (const auto& [b, w] : raw[v]) sum += w;
-      if (!(sum > 0)) return invalid_argument("default_weights.mhw: hm08 vertex " + std::to_string(v) + " has no weight");
+      if (!(sum > 0))
+        return invalid_argument("default_weights.mhw: hm08 vertex " + std::to_string(v) + " has no weight");
       for (const auto& [b, w] : raw[v])
         if (w / sum > kDroppedWeight) p.hm08_weights_[v].emplace_back(b, static_cast<float>(w / sum));
     }
@@ -148,8 +147,10 @@ StatusOr<BodyPoser::Match> BodyPoser::recognise(const TriangleMesh& rest) const 
     if (worst < best_err) best_err = worst, best = Match{body, shift};
   }
   if (!best || best_err > kJointMatchMm)
-    return invalid_argument("this mesh is not one of the MakeHuman bodies in its rest pose whose skeleton is shipped "
-                            "(joints.json); the nearest is " + std::to_string(best_err) + " mm off");
+    return invalid_argument(
+        "this mesh is not one of the MakeHuman bodies in its rest pose whose skeleton is shipped "
+        "(joints.json); the nearest is " +
+        std::to_string(best_err) + " mm off");
   return *best;
 }
 
@@ -188,7 +189,8 @@ StatusOr<std::vector<std::vector<std::pair<int, float>>>> BodyPoser::vertex_weig
     w[kHm08 + e] = mean_of(ends[e]);
   }
   for (size_t f = 0; f < edge_points.size(); ++f) {
-    if (edge_points[f].size() != 4) return invalid_argument("not a subdivided hm08 mesh: a face point without four edges");
+    if (edge_points[f].size() != 4)
+      return invalid_argument("not a subdivided hm08 mesh: a face point without four edges");
     std::vector<uint32_t> corners;
     for (uint32_t e : edge_points[f]) corners.insert(corners.end(), ends[e - kHm08].begin(), ends[e - kHm08].end());
     w[f0 + f] = mean_of(corners);
@@ -196,14 +198,15 @@ StatusOr<std::vector<std::vector<std::pair<int, float>>>> BodyPoser::vertex_weig
   return w;
 }
 
-StatusOr<TriangleMesh> BodyPoser::skin(const TriangleMesh& rest,
-                                       const std::map<std::string, std::pair<Eigen::Vector3d, double>>& rotations) const {
+StatusOr<TriangleMesh> BodyPoser::skin(
+    const TriangleMesh& rest, const std::map<std::string, std::pair<Eigen::Vector3d, double>>& rotations) const {
   ASSIGN_OR_RETURN(const Match m, recognise(rest));
   return skin(rest, m, rotations);
 }
 
-StatusOr<TriangleMesh> BodyPoser::skin(const TriangleMesh& rest, const Match& m,
-                                       const std::map<std::string, std::pair<Eigen::Vector3d, double>>& rotations) const {
+StatusOr<TriangleMesh> BodyPoser::skin(
+    const TriangleMesh& rest, const Match& m,
+    const std::map<std::string, std::pair<Eigen::Vector3d, double>>& rotations) const {
   ASSIGN_OR_RETURN(const auto weights, vertex_weights(rest));
   std::vector<Eigen::Isometry3d> local(bones_.size(), Eigen::Isometry3d::Identity());
   for (const auto& [bone, rot] : rotations) {
@@ -221,7 +224,8 @@ StatusOr<TriangleMesh> BodyPoser::skin(const TriangleMesh& rest, const Match& m,
     return *global[b];
   };
   std::vector<bool> moved(bones_.size());
-  for (size_t b = 0; b < bones_.size(); ++b) moved[b] = !g(static_cast<int>(b)).isApprox(Eigen::Isometry3d::Identity(), 0);
+  for (size_t b = 0; b < bones_.size(); ++b)
+    moved[b] = !g(static_cast<int>(b)).isApprox(Eigen::Isometry3d::Identity(), 0);
   TriangleMesh out = rest;
   for (size_t v = 0; v < rest.vertices.size(); ++v) {
     // A vertex on unmoved bones only keeps its coordinates bit for bit.

@@ -36,9 +36,9 @@ struct PostureJoints {
 };
 
 struct PosedBody {
-  TriangleMesh mesh;      // the rest mesh posed; faces unchanged, vertex i the same point
-  std::string body;       // which body of joints.json it was recognised as
-  PostureJoints rest, posed;  // the joints before and after, in the mesh's frame
+  TriangleMesh mesh;                         // the rest mesh posed; faces unchanged, vertex i the same point
+  std::string body;                          // which body of joints.json it was recognised as
+  PostureJoints rest, posed;                 // the joints before and after, in the mesh's frame
   double shoulder_rotation_deg[2] = {0, 0};  // about +Z at each shoulder joint (left, right)
   double hip_adduction_deg = 0;              // each leg toward the midline (negative: apart)
 };
@@ -82,8 +82,8 @@ class BodyPoser {
 
   std::vector<Bone> bones_;
   std::map<std::string, int> bone_index_;
-  std::map<std::string, std::vector<int>> joint_vertices_;  // hm08 indices
-  std::vector<std::vector<std::pair<int, float>>> hm08_weights_;  // per hm08 body vertex, normalised
+  std::map<std::string, std::vector<int>> joint_vertices_;                     // hm08 indices
+  std::vector<std::vector<std::pair<int, float>>> hm08_weights_;               // per hm08 body vertex, normalised
   std::map<std::string, std::map<std::string, Eigen::Vector3d>> rest_joints_;  // body -> joint -> mm
 };
 

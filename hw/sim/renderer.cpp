@@ -243,8 +243,7 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
         const Vec3d p = hit[i].position.cast<double>(), n = hit[i].normal.cast<double>();
         for (const size_t j : {i - 1, i + 1, i - w, i + w}) {
           if (!flat) break;
-          flat = hit[j].surface == hit[i].surface &&
-                 std::abs(n.dot(hit[j].position.cast<double>() - p)) < kFlatMm;
+          flat = hit[j].surface == hit[i].surface && std::abs(n.dot(hit[j].position.cast<double>() - p)) < kFlatMm;
         }
         take[static_cast<size_t>(y)].emplace_back(x, flat ? kFlat : kCast);
         continue;
@@ -303,8 +302,8 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
   };
   // Where the ray r + (u dx + v dy) meets the plane through `at` with normal n,
   // to first order in (u, v): the surface's step per unit of u and of v.
-  auto tangent_steps = [&](const Vec3d& at, const Vec3d& n, const Vec3d& r, const Vec3d& dx, const Vec3d& dy,
-                           Vec3d& ex, Vec3d& ey) {
+  auto tangent_steps = [&](const Vec3d& at, const Vec3d& n, const Vec3d& r, const Vec3d& dx, const Vec3d& dy, Vec3d& ex,
+                           Vec3d& ey) {
     const double nr = n.dot(r);
     if (std::abs(nr) < 1e-6) {
       ex = ey = Vec3d::Zero();
@@ -370,7 +369,8 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
       for (int j = 0; j < k; ++j)
         for (int ox = 0; ox < span; ++ox) {
           double a = 0;
-          for (int i = 0; i < k; ++i) a += weight[static_cast<size_t>(ox * k + i)] * fine[static_cast<size_t>(j * k + i)];
+          for (int i = 0; i < k; ++i)
+            a += weight[static_cast<size_t>(ox * k + i)] * fine[static_cast<size_t>(j * k + i)];
           across[static_cast<size_t>(j * 16 + ox)] = a;
         }
       std::vector<float>& out_row = spill[static_cast<size_t>(y)];
@@ -378,7 +378,8 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
       for (int oy = 0; oy < span; ++oy)
         for (int ox = 0; ox < span; ++ox) {
           double a = 0;
-          for (int j = 0; j < k; ++j) a += weight[static_cast<size_t>(oy * k + j)] * across[static_cast<size_t>(j * 16 + ox)];
+          for (int j = 0; j < k; ++j)
+            a += weight[static_cast<size_t>(oy * k + j)] * across[static_cast<size_t>(j * 16 + ox)];
           out_row.push_back(static_cast<float>(a));
         }
     }
@@ -420,7 +421,8 @@ std::vector<float> blur_kernel(double sigma) {
   const int r = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
   std::vector<float> k(static_cast<size_t>(2 * r + 1));
   float sum = 0;
-  for (int i = -r; i <= r; ++i) sum += k[static_cast<size_t>(i + r)] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
+  for (int i = -r; i <= r; ++i)
+    sum += k[static_cast<size_t>(i + r)] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
   for (float& v : k) v /= sum;
   return k;
 }
@@ -439,8 +441,8 @@ void blur_across(const std::vector<float>& in, std::vector<float>& out, int w, i
     o[x] = acc;
   }
 }
-void blur_down(const std::vector<float>& in, std::vector<float>& out, int w, int h, int y,
-               const std::vector<float>& k, int x0, int x1) {
+void blur_down(const std::vector<float>& in, std::vector<float>& out, int w, int h, int y, const std::vector<float>& k,
+               int x0, int x1) {
   const int r = static_cast<int>(k.size() / 2);
   float* o = out.data() + static_cast<size_t>(y) * w;
   for (int x = x0; x <= x1; ++x) o[x] = 0;
@@ -458,12 +460,15 @@ Spans spans_near(const std::vector<Spans>& rows, int y, int reach, int widen, in
   Spans out;
   const int h = static_cast<int>(rows.size());
   for (int yy = std::max(0, y - reach); yy <= std::min(h - 1, y + reach); ++yy)
-    for (const auto& [a, b] : rows[static_cast<size_t>(yy)]) out.emplace_back(std::max(0, a - widen), std::min(w - 1, b + widen));
+    for (const auto& [a, b] : rows[static_cast<size_t>(yy)])
+      out.emplace_back(std::max(0, a - widen), std::min(w - 1, b + widen));
   std::sort(out.begin(), out.end());
   size_t m = 0;
   for (const auto& sp : out) {
-    if (m > 0 && sp.first <= out[m - 1].second + 1) out[m - 1].second = std::max(out[m - 1].second, sp.second);
-    else out[m++] = sp;
+    if (m > 0 && sp.first <= out[m - 1].second + 1)
+      out[m - 1].second = std::max(out[m - 1].second, sp.second);
+    else
+      out[m++] = sp;
   }
   out.resize(m);
   return out;
@@ -528,7 +533,8 @@ Frame Renderer::render(const Scene& scene, const Lighting& lighting, const Expos
 const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Lighting& lighting) const {
   const std::vector<CachedHit>& hit = hits(scene);
   std::lock_guard<std::mutex> lock(cache_mutex_);
-  const int key = (lighting.room_lights ? 1 : 0) | (lighting.front_frame_lights ? 2 : 0) | (lighting.back_frame_lights ? 4 : 0);
+  const int key =
+      (lighting.room_lights ? 1 : 0) | (lighting.front_frame_lights ? 2 : 0) | (lighting.back_frame_lights ? 4 : 0);
   BaseCache& cache = base_[key];
   if (cache.version == scene.version() && !cache.irradiance.empty()) return cache.irradiance;
   const int w = camera_.width, h = camera_.height;
@@ -576,8 +582,10 @@ const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Li
   // pass for the next pose.
   cache.unblurred.assign(n, 0.f);
   tbb::parallel_for(0, h, [&](int y) { light(y, 0, w - 1); });
-  if (blurs) blur_image(cache.unblurred, cache.across, cache.irradiance, w, h, k);
-  else cache.irradiance = cache.unblurred;
+  if (blurs)
+    blur_image(cache.unblurred, cache.across, cache.irradiance, w, h, k);
+  else
+    cache.irradiance = cache.unblurred;
   if (!scene.moves()) {
     cache.unblurred = {};
     cache.across = {};
@@ -616,8 +624,10 @@ const std::vector<Renderer::CachedHit>& Renderer::hits(const Scene& scene) const
       for (int x = 0; x < w; ++x) {
         const CachedHit& c = hits_[static_cast<size_t>(y) * w + x];
         if (c.surface != Surface::kSubject) continue;
-        if (!row.empty() && row.back().second == x - 1) row.back().second = x;
-        else row.emplace_back(x, x);
+        if (!row.empty() && row.back().second == x - 1)
+          row.back().second = x;
+        else
+          row.emplace_back(x, x);
         nearest_in[static_cast<size_t>(y)] =
             std::min(nearest_in[static_cast<size_t>(y)], (c.position.cast<double>() - model_.centre()).norm());
       }

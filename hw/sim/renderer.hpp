@@ -24,7 +24,7 @@ struct Lighting {
   bool room_lights = false;
   bool front_frame_lights = false;  // the front poles' lights (Z > 0)
   bool back_frame_lights = false;
-  std::vector<Vec3d> dead_lights;  // frame lights (centres) that stay dark when switched on
+  std::vector<Vec3d> dead_lights;   // frame lights (centres) that stay dark when switched on
   std::vector<ActiveLaser> lasers;  // the lasers that are on, at their steps
 };
 

@@ -41,8 +41,8 @@ RTCGeometry attach_mesh(RTCDevice device, RTCScene scene, const std::vector<Vec3
       rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices.size()));
   for (size_t i = 0; i < vertices.size(); ++i)
     for (int k = 0; k < 3; ++k) vb[3 * i + k] = vertices[i][k];
-  auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                            3 * sizeof(uint32_t), triangles.size()));
+  auto* ib = static_cast<uint32_t*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangles.size()));
   for (size_t i = 0; i < triangles.size(); ++i)
     for (int k = 0; k < 3; ++k) ib[3 * i + k] = triangles[i][k];
   rtcCommitGeometry(g);
@@ -65,7 +65,9 @@ StatusOr<std::unique_ptr<Scene>> Scene::create(const RigDescription& rig, const 
   s->rt_ = std::make_unique<Embree>();
   Embree& e = *s->rt_;
   e.device = rtcNewDevice(nullptr);
-  if (!e.device) return internal_error("the ray tracer (Embree) could not start: error " + std::to_string(rtcGetDeviceError(nullptr)));
+  if (!e.device)
+    return internal_error("the ray tracer (Embree) could not start: error " +
+                          std::to_string(rtcGetDeviceError(nullptr)));
   e.scene = rtcNewScene(e.device);
   rtcSetSceneFlags(e.scene, RTC_SCENE_FLAG_DYNAMIC);
 
@@ -112,8 +114,10 @@ StatusOr<std::unique_ptr<Scene>> Scene::create(const RigDescription& rig, const 
   const FrameGeometry& f = rig.frame;
   const double a = 0.5 * f.tube, hw = 0.5 * f.width, hd = 0.5 * f.depth;
   for (double y : {0.0, f.top_height}) {
-    for (double z : {-hd, hd}) add_box(Vec3d(-hw - a, y - a, z - a), Vec3d(hw + a, y + a, z + a), s->frame_vertices_, s->frame_triangles_);
-    for (double x : {-hw, hw}) add_box(Vec3d(x - a, y - a, -hd + a), Vec3d(x + a, y + a, hd - a), s->frame_vertices_, s->frame_triangles_);
+    for (double z : {-hd, hd})
+      add_box(Vec3d(-hw - a, y - a, z - a), Vec3d(hw + a, y + a, z + a), s->frame_vertices_, s->frame_triangles_);
+    for (double x : {-hw, hw})
+      add_box(Vec3d(x - a, y - a, -hd + a), Vec3d(x + a, y + a, hd - a), s->frame_vertices_, s->frame_triangles_);
   }
   attach_mesh(e.device, e.scene, s->frame_vertices_, s->frame_triangles_, RTC_BUILD_QUALITY_HIGH);
   e.surface_of.push_back(Surface::kFrame);

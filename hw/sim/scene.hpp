@@ -16,7 +16,7 @@ enum class Surface : uint8_t { kNone, kSubject, kFrame, kFloor };
 
 struct Hit {
   Surface surface = Surface::kNone;
-  double t = 0;          // distance along the (unit) ray
+  double t = 0;  // distance along the (unit) ray
   Vec3d position = Vec3d::Zero();
   Vec3d normal = Vec3d::Zero();  // unit, facing the ray's origin
 };
@@ -59,8 +59,8 @@ class Scene {
   struct Embree;
   std::unique_ptr<Embree> rt_;
   RigDescription rig_;
-  TriangleMesh rest_;   // the subject at time 0
-  TriangleMesh posed_;  // the subject now
+  TriangleMesh rest_;                    // the subject at time 0
+  TriangleMesh posed_;                   // the subject now
   std::vector<float> breathing_weight_;  // per vertex, 0..1
   Vec3d body_axis_ = Vec3d::Zero();      // a point on the subject's vertical axis
   double time_ = 0;

@@ -56,7 +56,8 @@ class SimulatedRig::SimController : public Controller {
   }
   StatusOr<int> current_step(int motor) const override {
     RETURN_IF_ERROR(check(motor));
-    if (!homed_[static_cast<size_t>(motor)]) return failed_precondition("motor " + std::to_string(motor) + " is not homed");
+    if (!homed_[static_cast<size_t>(motor)])
+      return failed_precondition("motor " + std::to_string(motor) + " is not homed");
     return step_[static_cast<size_t>(motor)];
   }
 
@@ -68,7 +69,8 @@ class SimulatedRig::SimController : public Controller {
  private:
   Status check(int i) const {
     if (i < 0 || i >= num_lasers()) {
-      return invalid_argument("no laser or motor " + std::to_string(i) + " (the rig has " + std::to_string(num_lasers()) + ")");
+      return invalid_argument("no laser or motor " + std::to_string(i) + " (the rig has " +
+                              std::to_string(num_lasers()) + ")");
     }
     return {};
   }
@@ -116,7 +118,8 @@ class SimulatedRig::SimCamera : public Camera {
   StatusOr<Frame> grab(std::chrono::milliseconds timeout) override {
     if (fail_after_ && answered_ >= *fail_after_) {
       if (fail_code_ == StatusCode::kUnavailable) return unavailable("camera '" + info_.id + "' is disconnected");
-      return deadline_exceeded("camera '" + info_.id + "' sent no frame within " + std::to_string(timeout.count()) + " ms");
+      return deadline_exceeded("camera '" + info_.id + "' sent no frame within " + std::to_string(timeout.count()) +
+                               " ms");
     }
     ++answered_;
     const uint64_t id = ++frame_id_;
@@ -176,7 +179,8 @@ StatusOr<std::unique_ptr<SimulatedRig>> SimulatedRig::create(const RigDescriptio
   } else {
     ASSIGN_OR_RETURN(r->scene_, Scene::create(r->rig_, subject));
   }
-  for (const CameraDescription& c : r->rig_.cameras) r->renderers_.push_back(std::make_unique<Renderer>(c, r->rig_.simulation));
+  for (const CameraDescription& c : r->rig_.cameras)
+    r->renderers_.push_back(std::make_unique<Renderer>(c, r->rig_.simulation));
   r->controller_ = std::make_unique<SimController>(r->rig_);
   for (size_t i = 0; i < r->rig_.cameras.size(); ++i) {
     r->cameras_.push_back(std::make_unique<SimCamera>(*r, i));
@@ -191,7 +195,9 @@ Camera& SimulatedRig::camera(size_t i) { return *cameras_.at(i); }
 
 void SimulatedRig::hold_dot_grid(size_t i, bool held) { dot_grid_held_.at(i) = held; }
 
-void SimulatedRig::fail_camera_after(size_t i, uint64_t frames, StatusCode code) { cameras_.at(i)->fail_after(frames, code); }
+void SimulatedRig::fail_camera_after(size_t i, uint64_t frames, StatusCode code) {
+  cameras_.at(i)->fail_after(frames, code);
+}
 
 void SimulatedRig::break_frame_light(const Vec3d& centre) {
   std::lock_guard<std::mutex> lock(scene_mutex_);

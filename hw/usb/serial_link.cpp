@@ -112,12 +112,13 @@ Status SerialLink::read(uint8_t* data, size_t size, std::chrono::milliseconds ti
     const int left = remaining_ms(deadline);
     const int r = left > 0 ? ::poll(&p, 1, left) : 0;
     if (r == 0) {
-      return deadline_exceeded("the controller on " + path_ + " did not answer within " +
-                               std::to_string(timeout.count()) + " ms" +
-                               (done ? " (" + std::to_string(done) + " of " + std::to_string(size) + " bytes came)" : ""));
+      return deadline_exceeded(
+          "the controller on " + path_ + " did not answer within " + std::to_string(timeout.count()) + " ms" +
+          (done ? " (" + std::to_string(done) + " of " + std::to_string(size) + " bytes came)" : ""));
     }
     if (r < 0 && errno != EINTR) return gone("poll", errno);
-    if ((p.revents & (POLLERR | POLLNVAL)) || ((p.revents & POLLHUP) && !(p.revents & POLLIN))) return gone("read", EIO);
+    if ((p.revents & (POLLERR | POLLNVAL)) || ((p.revents & POLLHUP) && !(p.revents & POLLIN)))
+      return gone("read", EIO);
   }
   return Status::Ok();
 }

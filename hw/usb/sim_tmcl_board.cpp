@@ -89,24 +89,18 @@ void SimTmclBoard::run_program_step() {
     case kCALC:
       if (r.type == kCalcLoad) accumulator_ = r.value;
       break;
-    case kCOMP:
-      compare_equal_ = accumulator_ == r.value;
-      break;
+    case kCOMP: compare_equal_ = accumulator_ == r.value; break;
     case kJC:
       if (r.type == kJcNotEqual && !compare_equal_) pc_ = static_cast<size_t>(r.value);
       break;
-    case kJA:
-      pc_ = static_cast<size_t>(r.value);
-      break;
+    case kJA: pc_ = static_cast<size_t>(r.value); break;
     case kSIO:
       if (r.bank == kBankOutputs && r.type < kOutputs) {
         if (outputs_[r.type] && r.value == 0) ++watchdog_trips_;
         outputs_[r.type] = r.value != 0;
       }
       break;
-    case kSTOP:
-      running_program_ = false;
-      break;
+    case kSTOP: running_program_ = false; break;
     default:  // what this board does not run stops the application, as a real one does
       running_program_ = false;
       break;
@@ -125,9 +119,12 @@ Reply SimTmclBoard::execute(const Request& r) {
     case kMVP: {
       if (!axis_ok(r.bank)) return rep.status = kInvalidValue, rep;
       Axis& a = axes_[r.bank];
-      if (r.type == kMvpAbsolute) a.target = r.value;
-      else if (r.type == kMvpRelative) a.target += r.value;
-      else return rep.status = kWrongType, rep;
+      if (r.type == kMvpAbsolute)
+        a.target = r.value;
+      else if (r.type == kMvpRelative)
+        a.target += r.value;
+      else
+        return rep.status = kWrongType, rep;
       a.moving = true;
       rep.value = a.target;
       return rep;
@@ -140,19 +137,27 @@ Reply SimTmclBoard::execute(const Request& r) {
       return rep;
     case kRFS:
       if (!axis_ok(r.bank)) return rep.status = kInvalidValue, rep;
-      if (r.type == kRfsStart) axes_[r.bank].homing = true, axes_[r.bank].moving = false;
-      else if (r.type == kRfsStop) axes_[r.bank].homing = false;
-      else if (r.type == kRfsStatus) rep.value = axes_[r.bank].homing ? 1 : 0;
-      else rep.status = kWrongType;
+      if (r.type == kRfsStart)
+        axes_[r.bank].homing = true, axes_[r.bank].moving = false;
+      else if (r.type == kRfsStop)
+        axes_[r.bank].homing = false;
+      else if (r.type == kRfsStatus)
+        rep.value = axes_[r.bank].homing ? 1 : 0;
+      else
+        rep.status = kWrongType;
       return rep;
-    case kGAP: case kSAP: {
+    case kGAP:
+    case kSAP: {
       if (!axis_ok(r.bank)) return rep.status = kInvalidValue, rep;
       Axis& a = axes_[r.bank];
       const auto pos = static_cast<int32_t>(std::lround(a.position - a.origin));
       if (r.command == kSAP) {
-        if (r.type == kApActualPosition) a.origin = static_cast<int32_t>(std::lround(a.position)) - r.value;
-        else if (r.type == kApTargetPosition) a.target = r.value, a.moving = true;
-        else if (r.type != kApMaxVelocity && r.type != kApMaxAcceleration && r.type < 130) rep.status = kWrongType;
+        if (r.type == kApActualPosition)
+          a.origin = static_cast<int32_t>(std::lround(a.position)) - r.value;
+        else if (r.type == kApTargetPosition)
+          a.target = r.value, a.moving = true;
+        else if (r.type != kApMaxVelocity && r.type != kApMaxAcceleration && r.type < 130)
+          rep.status = kWrongType;
         return rep;
       }
       switch (r.type) {
@@ -160,7 +165,8 @@ Reply SimTmclBoard::execute(const Request& r) {
         case kApActualPosition: rep.value = pos; break;
         case kApPositionReached: rep.value = (!a.moving && !a.homing) ? 1 : 0; break;
         case kApReferenceSwitch: rep.value = std::lround(a.position) == a.switch_at ? 1 : 0; break;
-        case kApMaxVelocity: case kApMaxAcceleration: rep.value = static_cast<int32_t>(speed_); break;
+        case kApMaxVelocity:
+        case kApMaxAcceleration: rep.value = static_cast<int32_t>(speed_); break;
         default: rep.status = kWrongType;
       }
       return rep;
@@ -171,41 +177,39 @@ Reply SimTmclBoard::execute(const Request& r) {
       outputs_[r.type] = r.value != 0;
       return rep;
     case kGIO:
-      if (r.bank == kBankOutputs && r.type < kOutputs) rep.value = outputs_[r.type] ? 1 : 0;
-      else if (r.bank == kBankInputs && r.type < 8) rep.value = 0;
-      else rep.status = kInvalidValue;
+      if (r.bank == kBankOutputs && r.type < kOutputs)
+        rep.value = outputs_[r.type] ? 1 : 0;
+      else if (r.bank == kBankInputs && r.type < 8)
+        rep.value = 0;
+      else
+        rep.status = kInvalidValue;
       return rep;
-    case kSGP: case kGGP:
+    case kSGP:
+    case kGGP:
       if (r.bank != kBankUserVariables) return rep.status = kWrongType, rep;
-      if (r.command == kSGP) user_vars_[r.type] = r.value;
-      else rep.value = user_vars_[r.type];
+      if (r.command == kSGP)
+        user_vars_[r.type] = r.value;
+      else
+        rep.value = user_vars_[r.type];
       return rep;
     case kStartDownload:
       program_.clear();
       running_program_ = false;
       downloading_ = true;
       return rep;
-    case kQuitDownload:
-      downloading_ = false;
-      return rep;
+    case kQuitDownload: downloading_ = false; return rep;
     case kRunApplication:
       pc_ = static_cast<size_t>(r.type == 1 ? r.value : 0);
       running_program_ = !program_.empty();
       wait_left_s_ = 0;
       return rep;
-    case kStopApplication:
-      running_program_ = false;
-      return rep;
+    case kStopApplication: running_program_ = false; return rep;
     case kResetApplication:
       running_program_ = false;
       pc_ = 0;
       return rep;
-    case kGetApplicationStatus:
-      rep.value = running_program_ ? 1 : 0;
-      return rep;
-    default:
-      rep.status = kInvalidCommand;
-      return rep;
+    case kGetApplicationStatus: rep.value = running_program_ ? 1 : 0; return rep;
+    default: rep.status = kInvalidCommand; return rep;
   }
 }
 

@@ -75,8 +75,8 @@ class SimTmclBoard {
     int32_t origin = 0;     // power-on coordinate of the board's 0
   };
   void tick_loop();
-  void advance(double dt);           // under mutex
-  void run_program_step();           // under mutex
+  void advance(double dt);                      // under mutex
+  void run_program_step();                      // under mutex
   tmcl::Reply execute(const tmcl::Request& r);  // under mutex
 
   const uint8_t address_;

@@ -25,8 +25,15 @@ uint8_t checksum(const uint8_t* b) {
 namespace {
 Frame pack(uint8_t a, uint8_t b, uint8_t c, uint8_t d, int32_t value) {
   const auto v = static_cast<uint32_t>(value);
-  Frame f{a, b, c, d, static_cast<uint8_t>(v >> 24), static_cast<uint8_t>(v >> 16), static_cast<uint8_t>(v >> 8),
-          static_cast<uint8_t>(v), 0};
+  Frame f{a,
+          b,
+          c,
+          d,
+          static_cast<uint8_t>(v >> 24),
+          static_cast<uint8_t>(v >> 16),
+          static_cast<uint8_t>(v >> 8),
+          static_cast<uint8_t>(v),
+          0};
   f[8] = checksum(f.data());
   return f;
 }
@@ -58,17 +65,19 @@ StatusOr<Frame> Client::transact(const Frame& out, const std::function<Status(co
 
 StatusOr<Reply> Client::exchange(const Request& r) {
   ASSIGN_OR_RETURN(const Frame in, transact(encode(r), [&](const Frame& f) -> Status {
-    if (!checksum_ok(f)) return internal_error("the controller on " + link_.name() + " sent a reply with a bad checksum");
-    const Reply rep = decode_reply(f);
-    if (rep.address != address_ || rep.command != r.command) {
-      return internal_error("the controller on " + link_.name() + " answered another request (command " +
-                            std::to_string(rep.command) + " from module " + std::to_string(rep.address) + ")");
-    }
-    if (rep.status == kWrongChecksum) {  // our frame was damaged on the way
-      return internal_error("the controller on " + link_.name() + " received a damaged command");
-    }
-    return Status::Ok();
-  }));
+                     if (!checksum_ok(f))
+                       return internal_error("the controller on " + link_.name() + " sent a reply with a bad checksum");
+                     const Reply rep = decode_reply(f);
+                     if (rep.address != address_ || rep.command != r.command) {
+                       return internal_error("the controller on " + link_.name() +
+                                             " answered another request (command " + std::to_string(rep.command) +
+                                             " from module " + std::to_string(rep.address) + ")");
+                     }
+                     if (rep.status == kWrongChecksum) {  // our frame was damaged on the way
+                       return internal_error("the controller on " + link_.name() + " received a damaged command");
+                     }
+                     return Status::Ok();
+                   }));
   return decode_reply(in);
 }
 
@@ -94,14 +103,14 @@ Status Client::store(uint8_t command, uint8_t type, uint8_t bank, int32_t value)
 StatusOr<std::string> Client::firmware_version() {
   // Type 0 answers with the host address and then eight ASCII characters in place of
   // the rest of the reply (no checksum).
-  ASSIGN_OR_RETURN(const Frame in, transact(encode(Request{address_, kGetFirmwareVersion, 0, 0, 0}),
-                                            [&](const Frame& f) -> Status {
-                                              for (size_t i = 1; i < 9; ++i)
-                                                if (f[i] < 0x20 || f[i] >= 0x7f)
-                                                  return internal_error("the controller on " + link_.name() +
-                                                                        " answered the version request with binary data");
-                                              return Status::Ok();
-                                            }));
+  ASSIGN_OR_RETURN(const Frame in,
+                   transact(encode(Request{address_, kGetFirmwareVersion, 0, 0, 0}), [&](const Frame& f) -> Status {
+                     for (size_t i = 1; i < 9; ++i)
+                       if (f[i] < 0x20 || f[i] >= 0x7f)
+                         return internal_error("the controller on " + link_.name() +
+                                               " answered the version request with binary data");
+                     return Status::Ok();
+                   }));
   return std::string(reinterpret_cast<const char*>(in.data()) + 1, 8);
 }
 

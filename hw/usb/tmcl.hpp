@@ -23,30 +23,68 @@ namespace bodyscan::hw::usb::tmcl {
 
 // Command numbers (TMCL reference).
 enum Command : uint8_t {
-  kROR = 1, kROL = 2, kMST = 3, kMVP = 4, kSAP = 5, kGAP = 6, kSTAP = 7, kRSAP = 8, kSGP = 9, kGGP = 10,
-  kRFS = 13, kSIO = 14, kGIO = 15, kCALC = 19, kCOMP = 20, kJC = 21, kJA = 22, kWAIT = 27, kSTOP = 28,
-  kAAP = 34, kAGP = 35,
-  kStopApplication = 128, kRunApplication = 129, kResetApplication = 131, kStartDownload = 132,
-  kQuitDownload = 133, kGetApplicationStatus = 135, kGetFirmwareVersion = 136,
+  kROR = 1,
+  kROL = 2,
+  kMST = 3,
+  kMVP = 4,
+  kSAP = 5,
+  kGAP = 6,
+  kSTAP = 7,
+  kRSAP = 8,
+  kSGP = 9,
+  kGGP = 10,
+  kRFS = 13,
+  kSIO = 14,
+  kGIO = 15,
+  kCALC = 19,
+  kCOMP = 20,
+  kJC = 21,
+  kJA = 22,
+  kWAIT = 27,
+  kSTOP = 28,
+  kAAP = 34,
+  kAGP = 35,
+  kStopApplication = 128,
+  kRunApplication = 129,
+  kResetApplication = 131,
+  kStartDownload = 132,
+  kQuitDownload = 133,
+  kGetApplicationStatus = 135,
+  kGetFirmwareVersion = 136,
 };
 
 // Types of the commands above that take one.
 enum : uint8_t {
-  kMvpAbsolute = 0, kMvpRelative = 1,
-  kRfsStart = 0, kRfsStop = 1, kRfsStatus = 2,
-  kWaitTicks = 0,                     // WAIT: value in 10 ms ticks
-  kCalcLoad = 9,                      // CALC: accumulator = value
-  kJcNotEqual = 3,                    // JC: jump if the last COMP found them unequal
+  kMvpAbsolute = 0,
+  kMvpRelative = 1,
+  kRfsStart = 0,
+  kRfsStop = 1,
+  kRfsStatus = 2,
+  kWaitTicks = 0,   // WAIT: value in 10 ms ticks
+  kCalcLoad = 9,    // CALC: accumulator = value
+  kJcNotEqual = 3,  // JC: jump if the last COMP found them unequal
 };
 // Banks for SIO/GIO and SGP/GGP.
 enum : uint8_t { kBankInputs = 0, kBankAnalog = 1, kBankOutputs = 2, kBankUserVariables = 2 };
 // Axis parameters.
-enum : uint8_t { kApTargetPosition = 0, kApActualPosition = 1, kApMaxVelocity = 4, kApMaxAcceleration = 5,
-                 kApPositionReached = 8, kApReferenceSwitch = 9 };
+enum : uint8_t {
+  kApTargetPosition = 0,
+  kApActualPosition = 1,
+  kApMaxVelocity = 4,
+  kApMaxAcceleration = 5,
+  kApPositionReached = 8,
+  kApReferenceSwitch = 9
+};
 
 enum ReplyStatus : uint8_t {
-  kSuccess = 100, kLoaded = 101, kWrongChecksum = 1, kInvalidCommand = 2, kWrongType = 3, kInvalidValue = 4,
-  kEepromLocked = 5, kNotAvailable = 6,
+  kSuccess = 100,
+  kLoaded = 101,
+  kWrongChecksum = 1,
+  kInvalidCommand = 2,
+  kWrongType = 3,
+  kInvalidValue = 4,
+  kEepromLocked = 5,
+  kNotAvailable = 6,
 };
 const char* status_text(uint8_t status);
 

@@ -47,8 +47,8 @@ TmclController::TmclController(const RigDescription& rig, std::unique_ptr<ByteLi
       homed_(rig.lasers.size(), false) {
   emergency_bytes_.assign(std::tuple_size_v<Frame>, 0);
   for (const auto& w : wiring_.lasers) {
-    const Frame f = encode(Request{static_cast<uint8_t>(wiring_.module_address), kSIO, static_cast<uint8_t>(w.output),
-                                   kBankOutputs, 0});
+    const Frame f = encode(
+        Request{static_cast<uint8_t>(wiring_.module_address), kSIO, static_cast<uint8_t>(w.output), kBankOutputs, 0});
     emergency_bytes_.insert(emergency_bytes_.end(), f.begin(), f.end());
   }
 }
@@ -59,13 +59,16 @@ StatusOr<std::unique_ptr<TmclController>> TmclController::open(const RigDescript
   if (!rig.controller.port.empty()) {
     ASSIGN_OR_RETURN(link, SerialLink::open(rig.controller.port));
   } else {
-    ASSIGN_OR_RETURN(link, UsbLink::open(rig.controller.usb_vendor, rig.controller.usb_product, rig.controller.usb_serial));
+    ASSIGN_OR_RETURN(link,
+                     UsbLink::open(rig.controller.usb_vendor, rig.controller.usb_product, rig.controller.usb_serial));
   }
   return open(rig, std::move(link));
 }
 
-StatusOr<std::unique_ptr<TmclController>> TmclController::open(const RigDescription& rig, std::unique_ptr<ByteLink> link) {
-  if (rig.controller.lasers.size() != rig.lasers.size()) return invalid_argument("the controller's wiring does not match the lasers");
+StatusOr<std::unique_ptr<TmclController>> TmclController::open(const RigDescription& rig,
+                                                               std::unique_ptr<ByteLink> link) {
+  if (rig.controller.lasers.size() != rig.lasers.size())
+    return invalid_argument("the controller's wiring does not match the lasers");
   std::unique_ptr<TmclController> c(new TmclController(rig, std::move(link)));
   RETURN_IF_ERROR(c->start());
   return c;
@@ -161,7 +164,8 @@ void TmclController::emergency_stop(void* self) noexcept {
 
 Status TmclController::check_laser(int i) const {
   if (i < 0 || i >= num_lasers()) {
-    return invalid_argument("no laser or motor " + std::to_string(i) + " (the rig has " + std::to_string(num_lasers()) + ")");
+    return invalid_argument("no laser or motor " + std::to_string(i) + " (the rig has " + std::to_string(num_lasers()) +
+                            ")");
   }
   return Status::Ok();
 }
@@ -205,8 +209,10 @@ Status TmclController::all_lasers_off() {
   std::lock_guard lock(mutex_);
   for (size_t i = 0; i < wiring_.lasers.size(); ++i) {
     Status st = output(wiring_.lasers[i].output, false);
-    if (st.ok()) laser_on_[i] = false;
-    else if (first.ok()) first = Status(st.code(), "switching laser '" + lasers_[i].id + "' off: " + st.message());
+    if (st.ok())
+      laser_on_[i] = false;
+    else if (first.ok())
+      first = Status(st.code(), "switching laser '" + lasers_[i].id + "' off: " + st.message());
   }
   return first;
 }
@@ -245,7 +251,8 @@ Status TmclController::home(int motor) {
 Status TmclController::move_to(int motor, int step) {
   RETURN_IF_ERROR(check_laser(motor));
   const LaserDescription& l = lasers_[static_cast<size_t>(motor)];
-  if (!homed_[static_cast<size_t>(motor)]) return failed_precondition("motor of laser '" + l.id + "' is not homed: call home() first");
+  if (!homed_[static_cast<size_t>(motor)])
+    return failed_precondition("motor of laser '" + l.id + "' is not homed: call home() first");
   if (step < l.min_step || step > l.max_step) {
     return out_of_range("laser '" + l.id + "': step " + std::to_string(step) + " is outside its sweep [" +
                         std::to_string(l.min_step) + ", " + std::to_string(l.max_step) + "]");
@@ -263,8 +270,7 @@ Status TmclController::move_to(int motor, int step) {
 
 Status TmclController::wait_for_axis(uint8_t axis, uint8_t command, uint8_t type, int32_t done_when,
                                      uint8_t stop_command, uint8_t stop_type, int timeout_ms,
-                                     std::chrono::milliseconds every, const std::string& who,
-                                     const std::string& late) {
+                                     std::chrono::milliseconds every, const std::string& who, const std::string& late) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
   for (;;) {
     int32_t answer = 0;
@@ -281,7 +287,8 @@ Status TmclController::wait_for_axis(uint8_t axis, uint8_t command, uint8_t type
 
 StatusOr<int> TmclController::current_step(int motor) const {
   RETURN_IF_ERROR(check_laser(motor));
-  if (!homed_[static_cast<size_t>(motor)]) return failed_precondition("motor " + std::to_string(motor) + " is not homed");
+  if (!homed_[static_cast<size_t>(motor)])
+    return failed_precondition("motor " + std::to_string(motor) + " is not homed");
   const auto& w = wiring_.lasers[static_cast<size_t>(motor)];
   StatusOr<int32_t> pos = [&] {
     std::lock_guard lock(mutex_);

@@ -54,13 +54,14 @@ class TmclController : public Controller {
   // The user variable the watchdog program reads (bank 2), and the program itself:
   // what open() stores in the module. Public for tests and docs/hardware.md.
   static constexpr uint8_t kHeartbeatVariable = 55;
-  static std::vector<tmcl::Request> watchdog_program(uint8_t address, const std::vector<int>& laser_outputs, int period_ms);
+  static std::vector<tmcl::Request> watchdog_program(uint8_t address, const std::vector<int>& laser_outputs,
+                                                     int period_ms);
 
  private:
   TmclController(const RigDescription& rig, std::unique_ptr<ByteLink> link);
   Status start();
   Status check_laser(int i) const;
-  Status output(int port, bool on);           // under mutex_
+  Status output(int port, bool on);  // under mutex_
   Status call_or_lasers_off(uint8_t command, uint8_t type, uint8_t bank, int32_t value, int32_t* result);
   // Asks (command, type) of `axis` every `every` until the answer is `done_when`;
   // past `timeout_ms` it sends `stop_command` (with `stop_type`), switches the

@@ -20,8 +20,10 @@ std::string hex4(uint16_t v) {
 }
 
 std::string known_board(uint16_t vendor, uint16_t product) {
-  if (vendor == 0x2a3c && (product == 0x0100 || product == 0x0200 || product == 0x0700)) return "TMCL module (Trinamic)";
-  if (vendor == 0x16d0 && (product == 0x0461 || product == 0x05a1 || product == 0x07e4)) return "TMCL module (Trinamic)";
+  if (vendor == 0x2a3c && (product == 0x0100 || product == 0x0200 || product == 0x0700))
+    return "TMCL module (Trinamic)";
+  if (vendor == 0x16d0 && (product == 0x0461 || product == 0x05a1 || product == 0x07e4))
+    return "TMCL module (Trinamic)";
   return "";
 }
 
@@ -46,7 +48,8 @@ StatusOr<std::vector<UsbDeviceInfo>> list_usb_devices() {
   if (int rc = libusb_init(&c.ctx); rc != 0) return unavailable(std::string("libusb: ") + libusb_strerror(rc));
   libusb_device** list = nullptr;
   const ssize_t n = libusb_get_device_list(c.ctx, &list);
-  if (n < 0) return unavailable(std::string("libusb: cannot list USB devices: ") + libusb_strerror(static_cast<int>(n)));
+  if (n < 0)
+    return unavailable(std::string("libusb: cannot list USB devices: ") + libusb_strerror(static_cast<int>(n)));
   std::vector<UsbDeviceInfo> out;
   for (ssize_t i = 0; i < n; ++i) {
     libusb_device_descriptor d{};
@@ -75,7 +78,8 @@ Status UsbLink::error(const char* what, int code) const {
     return unavailable("the controller " + name_ + " is gone (" + what + ": " + libusb_strerror(code) +
                        "): is it still plugged in and powered?");
   }
-  if (code == LIBUSB_ERROR_TIMEOUT) return deadline_exceeded("the controller " + name_ + " did not answer (" + what + ")");
+  if (code == LIBUSB_ERROR_TIMEOUT)
+    return deadline_exceeded("the controller " + name_ + " did not answer (" + what + ")");
   return io_error("the controller " + name_ + ": " + what + ": " + libusb_strerror(code));
 }
 
@@ -123,7 +127,8 @@ StatusOr<std::unique_ptr<UsbLink>> UsbLink::open(uint16_t vendor, uint16_t produ
   }
   for (uint8_t i = 0; i < cfg->bNumInterfaces; ++i) {
     const libusb_interface_descriptor& alt = cfg->interface[i].altsetting[0];
-    if (alt.bInterfaceClass == LIBUSB_CLASS_COMM && link->comm_interface_ < 0) link->comm_interface_ = alt.bInterfaceNumber;
+    if (alt.bInterfaceClass == LIBUSB_CLASS_COMM && link->comm_interface_ < 0)
+      link->comm_interface_ = alt.bInterfaceNumber;
     // CDC-ACM only: vendor bridges (FTDI, CP210x) frame their data differently and
     // are driven through their kernel serial driver ("port" in the description).
     if (alt.bInterfaceClass != LIBUSB_CLASS_DATA) continue;
@@ -132,8 +137,10 @@ StatusOr<std::unique_ptr<UsbLink>> UsbLink::open(uint16_t vendor, uint16_t produ
     for (uint8_t e = 0; e < alt.bNumEndpoints; ++e) {
       const libusb_endpoint_descriptor& ep = alt.endpoint[e];
       if ((ep.bmAttributes & 0x3) != LIBUSB_TRANSFER_TYPE_BULK) continue;
-      if (ep.bEndpointAddress & LIBUSB_ENDPOINT_IN) in = ep.bEndpointAddress, in_size = ep.wMaxPacketSize;
-      else out = ep.bEndpointAddress;
+      if (ep.bEndpointAddress & LIBUSB_ENDPOINT_IN)
+        in = ep.bEndpointAddress, in_size = ep.wMaxPacketSize;
+      else
+        out = ep.bEndpointAddress;
     }
     if (in && out && link->data_interface_ < 0) {
       link->data_interface_ = alt.bInterfaceNumber;
@@ -143,12 +150,16 @@ StatusOr<std::unique_ptr<UsbLink>> UsbLink::open(uint16_t vendor, uint16_t produ
     }
   }
   libusb_free_config_descriptor(cfg);
-  if (link->data_interface_ < 0) return io_error(link->name_ + " is not a USB CDC-ACM board; give its serial port (\"port\": \"/dev/ttyUSB0\") in the rig description instead");
+  if (link->data_interface_ < 0)
+    return io_error(link->name_ +
+                    " is not a USB CDC-ACM board; give its serial port (\"port\": \"/dev/ttyUSB0\") in the rig "
+                    "description instead");
   libusb_set_auto_detach_kernel_driver(link->handle_, 1);  // cdc_acm lets go of it
   for (int iface : {link->comm_interface_, link->data_interface_}) {
     if (iface < 0) continue;
     if (int rc = libusb_claim_interface(link->handle_, iface); rc != 0) {
-      return rc == LIBUSB_ERROR_BUSY ? unavailable(link->name_ + " is in use by another program") : link->error("claim", rc);
+      return rc == LIBUSB_ERROR_BUSY ? unavailable(link->name_ + " is in use by another program")
+                                     : link->error("claim", rc);
     }
   }
   if (link->comm_interface_ >= 0) {
@@ -186,7 +197,8 @@ Status UsbLink::write(const uint8_t* data, size_t size, std::chrono::millisecond
     if (sent > 0) send.sent(data, static_cast<size_t>(sent));
   }
   if (rc != 0) return error("write", rc);
-  if (static_cast<size_t>(sent) != size) return deadline_exceeded("the controller " + name_ + " took only part of a command");
+  if (static_cast<size_t>(sent) != size)
+    return deadline_exceeded("the controller " + name_ + " took only part of a command");
   return Status::Ok();
 }
 
@@ -194,9 +206,11 @@ Status UsbLink::read(uint8_t* data, size_t size, std::chrono::milliseconds timeo
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   std::vector<uint8_t> packet(static_cast<size_t>(std::max(in_packet_, 64)));
   while (rx_.size() < size) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) {
-      return deadline_exceeded("the controller " + name_ + " did not answer within " + std::to_string(timeout.count()) + " ms");
+      return deadline_exceeded("the controller " + name_ + " did not answer within " + std::to_string(timeout.count()) +
+                               " ms");
     }
     int got = 0;
     const int rc = libusb_bulk_transfer(handle_, in_ep_, packet.data(), static_cast<int>(packet.size()), &got,
@@ -214,7 +228,8 @@ void UsbLink::discard_input() {
   std::vector<uint8_t> packet(static_cast<size_t>(std::max(in_packet_, 64)));
   int got = 0;
   for (int i = 0; i < 16; ++i) {
-    if (libusb_bulk_transfer(handle_, in_ep_, packet.data(), static_cast<int>(packet.size()), &got, 5) != 0 || got == 0) break;
+    if (libusb_bulk_transfer(handle_, in_ep_, packet.data(), static_cast<int>(packet.size()), &got, 5) != 0 || got == 0)
+      break;
   }
 }
 

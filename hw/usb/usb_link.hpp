@@ -21,7 +21,7 @@ struct UsbDeviceInfo {
   uint16_t vendor = 0, product = 0;
   int bus = 0, address = 0;
   std::string manufacturer, product_name, serial;  // empty when the device cannot be opened
-  std::string known_as;  // "TMCL module (Trinamic)" for the boards this project drives
+  std::string known_as;                            // "TMCL module (Trinamic)" for the boards this project drives
 };
 
 // Every USB device on the machine, with the ones bodyscan drives named.

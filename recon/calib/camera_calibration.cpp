@@ -52,7 +52,8 @@ std::array<std::array<Eigen::Vector2d, 2>, 4> name_markers(const FrameMarkers& m
     // The pairs are in image x order; world X runs the other way for a back camera.
     const bool flip = side == FrameSide::kBack;
     auto put = [&](Pole p, const std::array<int, 2>& pair) {
-      out[static_cast<size_t>(p)] = {m[static_cast<size_t>(pair[flip ? 1 : 0])], m[static_cast<size_t>(pair[flip ? 0 : 1])]};
+      out[static_cast<size_t>(p)] = {m[static_cast<size_t>(pair[flip ? 1 : 0])],
+                                     m[static_cast<size_t>(pair[flip ? 0 : 1])]};
     };
     put(top ? Pole::kNearTop : Pole::kNearBottom, near);
     put(top ? Pole::kFarTop : Pole::kFarBottom, far);
@@ -101,8 +102,7 @@ StatusOr<CameraCalibration> calibrate_camera(const std::string& camera_id, const
 }
 
 StatusOr<CameraCalibration> camera_from_markers(const std::string& camera_id, int width, int height,
-                                                const ReferenceFrame& frame, const LensCorrection& lens,
-                                                FrameSide side,
+                                                const ReferenceFrame& frame, const LensCorrection& lens, FrameSide side,
                                                 const std::array<std::array<Eigen::Vector2d, 2>, 4>& markers) {
   auto fail = [&](const std::string& step, const Status& s) {
     return Status(s.code(), "camera '" + camera_id + "': " + step + ": " + s.message());

@@ -71,8 +71,7 @@ StatusOr<CameraCalibration> calibrate_camera(const std::string& camera_id, const
 // plane transforms, the centre, the view. calibrate_camera ends here; a scan's raw
 // record (docs/archive.md) rebuilds its cameras with it, exactly.
 StatusOr<CameraCalibration> camera_from_markers(const std::string& camera_id, int width, int height,
-                                                const ReferenceFrame& frame, const LensCorrection& lens,
-                                                FrameSide side,
+                                                const ReferenceFrame& frame, const LensCorrection& lens, FrameSide side,
                                                 const std::array<std::array<Eigen::Vector2d, 2>, 4>& markers);
 
 }  // namespace bodyscan

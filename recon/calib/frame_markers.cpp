@@ -18,7 +18,8 @@ StatusOr<std::vector<Marker>> find_markers(const ImageView& on, const ImageView&
     return d > 0 ? d : 0;
   };
   int count = 0;
-  const std::vector<int> label = label_components(w, h, [&](int x, int y) { return diff(x, y) >= o.threshold; }, &count);
+  const std::vector<int> label = label_components(
+      w, h, [&](int x, int y) { return diff(x, y) >= o.threshold; }, &count);
   std::vector<Marker> blobs(static_cast<size_t>(count));
   std::vector<Eigen::Vector2d> moment(static_cast<size_t>(count), Eigen::Vector2d::Zero());
   std::vector<Eigen::Vector4i> box(static_cast<size_t>(count), Eigen::Vector4i(w, h, -1, -1));  // x0, y0, x1, y1
@@ -54,7 +55,8 @@ StatusOr<std::vector<Marker>> find_markers(const ImageView& on, const ImageView&
         mass += d;
         m += d * Eigen::Vector2d(x, y);
       }
-    blobs[i].centre = mass > 0.5 * blobs[i].mass ? Eigen::Vector2d(m / mass) : Eigen::Vector2d(moment[i] / blobs[i].mass);
+    blobs[i].centre =
+        mass > 0.5 * blobs[i].mass ? Eigen::Vector2d(m / mass) : Eigen::Vector2d(moment[i] / blobs[i].mass);
     out.push_back(blobs[i]);
   }
   std::sort(out.begin(), out.end(), [](const Marker& a, const Marker& b) { return a.mass > b.mass; });

@@ -16,14 +16,14 @@ namespace bodyscan {
 
 struct Marker {
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // intensity-weighted, pixels
-  int area = 0;          // pixels above the threshold
-  double mass = 0;       // summed intensity above the off image
+  int area = 0;                                      // pixels above the threshold
+  double mass = 0;                                   // summed intensity above the off image
 };
 
 struct MarkerOptions {
-  int threshold = 40;   // on - off, pixel values
-  int min_area = 3;     // smaller blobs are noise
-  int max_area = 20000; // larger ones are not a light (a lamp, a reflection)
+  int threshold = 40;    // on - off, pixel values
+  int min_area = 3;      // smaller blobs are noise
+  int max_area = 20000;  // larger ones are not a light (a lamp, a reflection)
 };
 
 // Every blob of the difference image, largest mass first.

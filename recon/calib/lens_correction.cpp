@@ -11,12 +11,12 @@
 #include <numeric>
 #include <optional>
 
-#include "recon/calib/components.hpp"
 #include <string>
 #include <tuple>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
+#include "recon/calib/components.hpp"
 
 #include "recon/calib/plane_projection.hpp"  // fit_homography
 
@@ -278,8 +278,8 @@ StatusOr<std::vector<Dot>> find_dots(const ImageView& image, const DotOptions& o
   });
 
   int count = 0;
-  const std::vector<int> label =
-      label_components(w, h, [&](int x, int y) { return dark[static_cast<size_t>(y) * w + x] != 0; }, &count);
+  const std::vector<int> label = label_components(
+      w, h, [&](int x, int y) { return dark[static_cast<size_t>(y) * w + x] != 0; }, &count);
   struct Blob {
     int area = 0, x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
     double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
@@ -578,8 +578,8 @@ StatusOr<LensCorrection> LensCorrection::fit(const std::vector<GridDot>& dots, i
   lens.held_out_rms_ = held_out > 0 ? std::sqrt(held_out_ss / held_out) : 0.0;
 
   const double step = o.table_step, margin = 2 * step;
-  state->forward_table = Table(state->forward, Vector2d::Constant(-margin),
-                               Vector2d(width - 1 + margin, height - 1 + margin), step);
+  state->forward_table =
+      Table(state->forward, Vector2d::Constant(-margin), Vector2d(width - 1 + margin, height - 1 + margin), step);
   const auto [lo, hi] = state->forward_table.value_range();
   state->inverse_table = Table(state->inverse, lo, hi, step);
   lens.state_ = state;

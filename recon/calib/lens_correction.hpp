@@ -22,8 +22,8 @@ namespace bodyscan {
 
 struct Dot {
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // darkness-weighted centroid, pixels
-  int area = 0;     // pixels below the threshold
-  double mass = 0;  // summed darkness (local background - value)
+  int area = 0;                                      // pixels below the threshold
+  double mass = 0;                                   // summed darkness (local background - value)
 };
 
 struct DotOptions {
@@ -34,9 +34,9 @@ struct DotOptions {
   // parts such as the room beside the board, by this fraction of a quarter of the
   // image's white).
   double contrast = 0.25;
-  int min_area = 12;           // smaller blobs are noise
-  int max_area = 0;            // larger ones are not dots; 0: half the window's area
-  double max_elongation = 3;   // ratio of a blob's principal axes; longer ones are edges
+  int min_area = 12;          // smaller blobs are noise
+  int max_area = 0;           // larger ones are not dots; 0: half the window's area
+  double max_elongation = 3;  // ratio of a blob's principal axes; longer ones are edges
 };
 
 // The dots of a dot-grid image, in raster order of their first pixel. Blobs within

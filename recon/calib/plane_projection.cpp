@@ -46,7 +46,8 @@ StatusOr<Eigen::Matrix3d> fit_homography(const std::vector<Eigen::Vector2d>& fro
         for (size_t c = b + 1; c < n; ++c) {
           const Eigen::Vector2d u = from[b] - from[a], v = from[c] - from[a];
           if (std::abs(u.x() * v.y() - u.y() * v.x()) < 1e-6 * u.norm() * v.norm()) {
-            return invalid_argument("three of the four points lie on one line: the projective transform is undetermined");
+            return invalid_argument(
+                "three of the four points lie on one line: the projective transform is undetermined");
           }
         }
   }

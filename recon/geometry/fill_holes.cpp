@@ -1,9 +1,9 @@
 #include "recon/geometry/fill_holes.hpp"
 
-#include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
@@ -316,13 +316,15 @@ class HolePatch {
     if (solver.info() != Eigen::Success) return;
     const Eigen::MatrixXd x = solver.solve(a.transpose() * b);
     if (solver.info() != Eigen::Success || !x.allFinite()) return;
-    for (uint32_t i = 0; i < k; ++i) mesh_.vertices[first_new_vertex_ + i] = x.row(static_cast<int>(i)).transpose().cast<float>();
+    for (uint32_t i = 0; i < k; ++i)
+      mesh_.vertices[first_new_vertex_ + i] = x.row(static_cast<int>(i)).transpose().cast<float>();
   }
 
   const std::vector<Triangle>& triangles() const { return tris_; }
   double area() const {
     double sum = 0.0;
-    for (const Triangle& t : tris_) sum += 0.5 * static_cast<double>((pos(t[1]) - pos(t[0])).cross(pos(t[2]) - pos(t[0])).norm());
+    for (const Triangle& t : tris_)
+      sum += 0.5 * static_cast<double>((pos(t[1]) - pos(t[0])).cross(pos(t[2]) - pos(t[0])).norm());
     return sum;
   }
   // Forgets the patch and any vertex it added.
@@ -339,9 +341,8 @@ class HolePatch {
   // An edge the patch may not create: it exists in the mesh, in another patch, or
   // in this one.
   bool edge_taken(uint32_t a, uint32_t b) const {
-    return (a < first_new_vertex_ && b < first_new_vertex_ && he_.connected(a, b)) ||
-           added_.contains(a, b) || diagonals_.count(undirected_key(a, b)) > 0 || edges_.count(key(a, b)) > 0 ||
-           edges_.count(key(b, a)) > 0;
+    return (a < first_new_vertex_ && b < first_new_vertex_ && he_.connected(a, b)) || added_.contains(a, b) ||
+           diagonals_.count(undirected_key(a, b)) > 0 || edges_.count(key(a, b)) > 0 || edges_.count(key(b, a)) > 0;
   }
 
   // edge_taken for every pair of the polygon's vertices (n x n, symmetric), found
@@ -575,8 +576,8 @@ class HolePatch {
   const uint32_t first_new_vertex_;
   std::vector<Triangle> tris_;
   tsl::robin_map<uint64_t, uint32_t, EdgeHash> edges_;  // directed patch edge -> patch triangle
-  std::unordered_set<uint64_t> diagonals_;        // the splits' diagonals (undirected)
-  std::unordered_map<uint32_t, float> scale_;     // local edge length per vertex
+  std::unordered_set<uint64_t> diagonals_;              // the splits' diagonals (undirected)
+  std::unordered_map<uint32_t, float> scale_;           // local edge length per vertex
 };
 
 }  // namespace

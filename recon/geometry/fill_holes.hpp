@@ -52,12 +52,12 @@ struct HoleFillOptions {
 };
 
 struct HoleFillStats {
-  size_t holes = 0;               // boundary loops found
+  size_t holes = 0;  // boundary loops found
   size_t holes_filled = 0;
   size_t largest_hole_edges = 0;  // boundary edges of the longest loop
   size_t triangles_added = 0;
   size_t vertices_added = 0;
-  double area_added = 0.0;        // square units of the mesh
+  double area_added = 0.0;  // square units of the mesh
 };
 
 // Fills the mesh's boundary loops in place. Needs an edge-manifold, consistently

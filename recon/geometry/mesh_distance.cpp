@@ -52,12 +52,10 @@ S segment_parameter(const Vec3<S>& offset, const Vec3<S>& dir) {
 // Closest point to p on the three edges of triangle (a, a + ab, a + ac): what a
 // zero-area triangle is.
 template <typename S>
-Vec3<S> closest_on_edges(const Vec3<S>& p, const Vec3<S>& a, const Vec3<S>& ab, const Vec3<S>& ac,
-                         int* feature) {
+Vec3<S> closest_on_edges(const Vec3<S>& p, const Vec3<S>& a, const Vec3<S>& ab, const Vec3<S>& ac, int* feature) {
   const Vec3<S> ap = p - a;
   const Vec3<S> bc = ac - ab;
-  const Vec3<S> candidates[3] = {a + segment_parameter(ap, ab) * ab,
-                                 a + ab + segment_parameter<S>(ap - ab, bc) * bc,
+  const Vec3<S> candidates[3] = {a + segment_parameter(ap, ab) * ab, a + ab + segment_parameter<S>(ap - ab, bc) * bc,
                                  a + segment_parameter(ap, ac) * ac};
   const int features[3] = {kEdge0, kEdge0 + 1, kEdge0 + 2};
   int best = 0;
@@ -78,8 +76,7 @@ Vec3<S> closest_on_edges(const Vec3<S>& p, const Vec3<S>& a, const Vec3<S>& ab, 
 // triangle is (a, b = a + ab, c = a + ac) and must have non-zero area; divisions are
 // guarded anyway so that a sliver never produces NaN.
 template <typename S>
-Vec3<S> closest_on_triangle(const Vec3<S>& p, const Vec3<S>& a, const Vec3<S>& ab,
-                            const Vec3<S>& ac, int* feature) {
+Vec3<S> closest_on_triangle(const Vec3<S>& p, const Vec3<S>& a, const Vec3<S>& ab, const Vec3<S>& ac, int* feature) {
   const Vec3<S> ap = p - a;
   const S d1 = ab.dot(ap);
   const S d2 = ac.dot(ap);
@@ -193,8 +190,7 @@ Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen:
   return closest_on_triangle<double>(p, a, b - a, c - a, &feature);
 }
 
-MeshDistance::MeshDistance(const TriangleMesh& mesh)
-    : vertices_(mesh.vertices), triangles_(mesh.triangles) {
+MeshDistance::MeshDistance(const TriangleMesh& mesh) : vertices_(mesh.vertices), triangles_(mesh.triangles) {
   const size_t num = triangles_.size();
   assert(num < kDegenerateBit);
   degenerate_.assign(num, 0);
@@ -215,8 +211,8 @@ MeshDistance::MeshDistance(const TriangleMesh& mesh)
                         vertices_[tri[2]].cast<double>()};
     centroids[t] = ((p[0] + p[1] + p[2]) / 3.0).cast<float>();
     const Vec3d cross = (p[1] - p[0]).cross(p[2] - p[0]);
-    const double longest2 = std::max(
-        {(p[1] - p[0]).squaredNorm(), (p[2] - p[1]).squaredNorm(), (p[0] - p[2]).squaredNorm()});
+    const double longest2 =
+        std::max({(p[1] - p[0]).squaredNorm(), (p[2] - p[1]).squaredNorm(), (p[0] - p[2]).squaredNorm()});
     // Thinner than 1e-7 of its length: the edges are then within that of the true
     // answer, and the face formulas would divide by (almost) zero.
     if (!(cross.norm() > 1e-7 * longest2)) {
@@ -235,8 +231,7 @@ MeshDistance::MeshDistance(const TriangleMesh& mesh)
     }
   }
   for (size_t v = 0; v < vertices_.size(); ++v) {
-    if (vertex_sum[v].squaredNorm() > 0)
-      vertex_normals_[v] = vertex_sum[v].normalized().cast<float>();
+    if (vertex_sum[v].squaredNorm() > 0) vertex_normals_[v] = vertex_sum[v].normalized().cast<float>();
   }
   for (size_t t = 0; t < num; ++t) {
     for (int k = 0; k < 3; ++k) {
@@ -342,9 +337,8 @@ void MeshDistance::build(const std::vector<Vec3f>& centroids, std::vector<uint32
     }
     if (mid == nullptr) {
       mid = first + count / 2;
-      std::nth_element(first, mid, last, [&](uint32_t x, uint32_t y) {
-        return centroids[x][axis] < centroids[y][axis];
-      });
+      std::nth_element(first, mid, last,
+                       [&](uint32_t x, uint32_t y) { return centroids[x][axis] < centroids[y][axis]; });
     }
 
     const auto children = static_cast<uint32_t>(nodes_.size());
@@ -373,9 +367,8 @@ ClosestPoint MeshDistance::closest_point(const Vec3f& q) const {
     if (node.count > 0) {
       for (uint32_t i = node.first; i < node.first + node.count; ++i) {
         const SearchTriangle& tri = tris_[i];
-        const Vec3f p = (tri.id & kDegenerateBit)
-                            ? closest_on_edges<float>(q, tri.a, tri.ab, tri.ac, nullptr)
-                            : closest_on_triangle<float>(q, tri.a, tri.ab, tri.ac, nullptr);
+        const Vec3f p = (tri.id & kDegenerateBit) ? closest_on_edges<float>(q, tri.a, tri.ab, tri.ac, nullptr)
+                                                  : closest_on_triangle<float>(q, tri.a, tri.ab, tri.ac, nullptr);
         const float d2 = (q - p).squaredNorm();
         if (d2 < best) {
           best = d2;
@@ -417,8 +410,8 @@ ClosestPoint MeshDistance::finish(const Vec3f& q, uint32_t t) const {
   const Vec3d ac = vertices_[tri[2]].cast<double>() - a;
   const Vec3d p = q.cast<double>();
   int feature = kFace;
-  const Vec3d c = degenerate_[t] ? closest_on_edges(p, a, ab, ac, &feature)
-                                 : closest_on_triangle(p, a, ab, ac, &feature);
+  const Vec3d c =
+      degenerate_[t] ? closest_on_edges(p, a, ab, ac, &feature) : closest_on_triangle(p, a, ab, ac, &feature);
   const double distance = (p - c).norm();
 
   Vec3f pseudonormal;
@@ -448,21 +441,18 @@ std::vector<float> MeshDistance::distances(const std::vector<Vec3f>& queries) co
   for (const Vec3f& q : queries) bounds.grow(q);
   const Vec3f extent = (bounds.hi - bounds.lo).cwiseMax(Vec3f::Constant(1e-30f));
   std::vector<std::pair<uint64_t, uint32_t>> order(queries.size());
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, queries.size(), 4096),
-      [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t i = range.begin(); i != range.end(); ++i) {
-          order[i] = {morton_code(queries[i], bounds.lo, extent), static_cast<uint32_t>(i)};
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, queries.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      order[i] = {morton_code(queries[i], bounds.lo, extent), static_cast<uint32_t>(i)};
+    }
+  });
   tbb::parallel_sort(order.begin(), order.end());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, queries.size(), 256),
-                    [&](const tbb::blocked_range<size_t>& range) {
-                      for (size_t i = range.begin(); i != range.end(); ++i) {
-                        const uint32_t k = order[i].second;
-                        out[k] = closest_point(queries[k]).distance;
-                      }
-                    });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, queries.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const uint32_t k = order[i].second;
+      out[k] = closest_point(queries[k]).distance;
+    }
+  });
   return out;
 }
 
@@ -497,14 +487,11 @@ DistanceStats summarize_distances(std::vector<float> distances) {
   return stats;
 }
 
-MeshComparison compare_meshes(const TriangleMesh& output, const TriangleMesh& truth, size_t samples,
-                              uint64_t seed) {
+MeshComparison compare_meshes(const TriangleMesh& output, const TriangleMesh& truth, size_t samples, uint64_t seed) {
   // Two different streams: comparing a mesh with itself must not sample the very same
   // points on both sides.
-  const PointCloud on_output =
-      sample_mesh_uniform(output, samples, splitmix64(seed), /*with_normals=*/false);
-  const PointCloud on_truth =
-      sample_mesh_uniform(truth, samples, splitmix64(seed ^ 0x5bd1e9955bd1e995ull), false);
+  const PointCloud on_output = sample_mesh_uniform(output, samples, splitmix64(seed), /*with_normals=*/false);
+  const PointCloud on_truth = sample_mesh_uniform(truth, samples, splitmix64(seed ^ 0x5bd1e9955bd1e995ull), false);
   MeshComparison result;
   result.output_to_truth = summarize_distances(MeshDistance(truth).distances(on_output.positions));
   result.truth_to_output = summarize_distances(MeshDistance(output).distances(on_truth.positions));

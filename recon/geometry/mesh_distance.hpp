@@ -119,7 +119,6 @@ struct MeshComparison {
   DistanceStats truth_to_output;
 };
 
-MeshComparison compare_meshes(const TriangleMesh& output, const TriangleMesh& truth, size_t samples,
-                              uint64_t seed);
+MeshComparison compare_meshes(const TriangleMesh& output, const TriangleMesh& truth, size_t samples, uint64_t seed);
 
 }  // namespace bodyscan

@@ -22,9 +22,8 @@ void keep_unmarked(std::vector<T>& v, const std::vector<uint8_t>& drop) {
 
 bool PointCloud::is_consistent() const {
   const size_t n = positions.size();
-  if (!absent_or_per_point(normals, n) || !absent_or_per_point(intensity, n) ||
-      !absent_or_per_point(confidence, n) || !absent_or_per_point(camera, n) ||
-      !absent_or_per_point(laser, n) || !absent_or_per_point(frame, n)) {
+  if (!absent_or_per_point(normals, n) || !absent_or_per_point(intensity, n) || !absent_or_per_point(confidence, n) ||
+      !absent_or_per_point(camera, n) || !absent_or_per_point(laser, n) || !absent_or_per_point(frame, n)) {
     return false;
   }
   // Camera ids may come without centres (has_cameras() is then false and nothing

@@ -50,15 +50,13 @@ void add_sphere_point(PointCloud& cloud, double radius, double y_unit, double ph
 
 }  // namespace
 
-PointCloud sample_mesh_uniform(const TriangleMesh& mesh, size_t n, uint64_t seed,
-                               bool with_normals) {
+PointCloud sample_mesh_uniform(const TriangleMesh& mesh, size_t n, uint64_t seed, bool with_normals) {
   // Cumulative areas in double: 10^5 float additions would lose the small triangles.
   std::vector<double> cumulative(mesh.triangles.size());
   double total = 0;
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const Triangle& tri = mesh.triangles[t];
-    assert(tri[0] < mesh.vertices.size() && tri[1] < mesh.vertices.size() &&
-           tri[2] < mesh.vertices.size());
+    assert(tri[0] < mesh.vertices.size() && tri[1] < mesh.vertices.size() && tri[2] < mesh.vertices.size());
     const Vec3d a = mesh.vertices[tri[0]].cast<double>();
     const Vec3d b = mesh.vertices[tri[1]].cast<double>();
     const Vec3d c = mesh.vertices[tri[2]].cast<double>();
@@ -78,9 +76,8 @@ PointCloud sample_mesh_uniform(const TriangleMesh& mesh, size_t n, uint64_t seed
     // upper_bound never returns a zero-area triangle: its cumulative value equals its
     // predecessor's, so no u in [0, total) lands on it.
     const double u = uniform01(rng) * total;
-    const size_t t = std::min<size_t>(
-        std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin(),
-        cumulative.size() - 1);
+    const size_t t = std::min<size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin(),
+                                      cumulative.size() - 1);
     const Triangle& tri = mesh.triangles[t];
     const Vec3d a = mesh.vertices[tri[0]].cast<double>();
     const Vec3d b = mesh.vertices[tri[1]].cast<double>();

@@ -22,8 +22,7 @@ namespace bodyscan {
 // counter-clockwise winding), else normals stay empty. Units and frame are the mesh's.
 //
 // The mesh's indices must be in range. A mesh without area gives an empty cloud.
-PointCloud sample_mesh_uniform(const TriangleMesh& mesh, size_t n, uint64_t seed,
-                               bool with_normals);
+PointCloud sample_mesh_uniform(const TriangleMesh& mesh, size_t n, uint64_t seed, bool with_normals);
 
 // n nearly evenly spaced points on a sphere of `radius` (mm) about the origin: the
 // spherical Fibonacci lattice (González, "Measurement of areas on a sphere using

@@ -24,9 +24,7 @@ bool is_degenerate(const Triangle& t) { return t[0] == t[1] || t[1] == t[2] || t
 // Union-find with path halving and union by size; triangles are the nodes.
 class DisjointSets {
  public:
-  explicit DisjointSets(size_t n) : parent_(n), size_(n, 1) {
-    std::iota(parent_.begin(), parent_.end(), uint32_t{0});
-  }
+  explicit DisjointSets(size_t n) : parent_(n), size_(n, 1) { std::iota(parent_.begin(), parent_.end(), uint32_t{0}); }
   uint32_t find(uint32_t x) {
     while (parent_[x] != x) {
       parent_[x] = parent_[parent_[x]];
@@ -124,11 +122,10 @@ MeshTopology analyze_topology(const TriangleMesh& mesh) {
       ++topo.components;
     }
   }
-  const size_t num_referenced =
-      static_cast<size_t>(std::count(referenced.begin(), referenced.end(), uint8_t{1}));
+  const size_t num_referenced = static_cast<size_t>(std::count(referenced.begin(), referenced.end(), uint8_t{1}));
   topo.unreferenced_vertices = num_vertices - num_referenced;
-  topo.euler_characteristic = static_cast<long>(num_referenced) - static_cast<long>(num_edges) +
-                              static_cast<long>(proper_triangles);
+  topo.euler_characteristic =
+      static_cast<long>(num_referenced) - static_cast<long>(num_edges) + static_cast<long>(proper_triangles);
   return topo;
 }
 

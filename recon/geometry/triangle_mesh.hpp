@@ -34,13 +34,13 @@ struct TriangleMesh {
 
 // Topology summary used by tests and reports.
 struct MeshTopology {
-  size_t boundary_edges = 0;      // edges used by exactly one triangle
-  size_t non_manifold_edges = 0;  // edges used by more than two triangles
-  size_t inconsistent_edges = 0;  // interior edges whose two triangles disagree on winding
+  size_t boundary_edges = 0;        // edges used by exactly one triangle
+  size_t non_manifold_edges = 0;    // edges used by more than two triangles
+  size_t inconsistent_edges = 0;    // interior edges whose two triangles disagree on winding
   size_t degenerate_triangles = 0;  // repeated index
   size_t unreferenced_vertices = 0;
-  size_t components = 0;            // connected by shared edges
-  long euler_characteristic = 0;    // V - E + F over referenced vertices
+  size_t components = 0;          // connected by shared edges
+  long euler_characteristic = 0;  // V - E + F over referenced vertices
   bool closed() const { return boundary_edges == 0 && non_manifold_edges == 0; }
 };
 

@@ -35,8 +35,8 @@ Status write_file_atomically(const std::string& path, std::string_view bytes, Fi
   // A reader (or a crash) must never see half a file: write beside the target,
   // make it durable, then rename over the target in one step.
   const std::string temp = path + ".tmp-" + std::to_string(::getpid());
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC,
-                        access == FileAccess::kPrivate ? 0600 : 0666);
+  const int fd =
+      ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, access == FileAccess::kPrivate ? 0600 : 0666);
   std::FILE* f = fd < 0 ? nullptr : ::fdopen(fd, "wb");
   if (f == nullptr) {
     const int error = errno;
@@ -78,8 +78,7 @@ Status write_file_atomically(const std::string& path, std::string_view bytes, Fi
   // Make the rename itself durable. Best effort: the data is already in place, and
   // some file systems refuse fsync on directories.
   const size_t slash = path.find_last_of('/');
-  const std::string dir =
-      slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
   const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir_fd >= 0) {
     ::fsync(dir_fd);

@@ -16,8 +16,7 @@ enum class FileAccess {
 // Writes beside the target, fsyncs, renames over the target, then syncs the folder
 // (best effort). On any failure the target is untouched and the message says what
 // the system refused.
-Status write_file_atomically(const std::string& path, std::string_view bytes,
-                             FileAccess access = FileAccess::kUmask);
+Status write_file_atomically(const std::string& path, std::string_view bytes, FileAccess access = FileAccess::kUmask);
 
 // A whole file's bytes; not found when it cannot be opened, an I/O error when it
 // cannot be read to its end.

@@ -89,8 +89,7 @@ T load(const char* p, bool swap) {
   if constexpr (sizeof(T) == 1) {
     std::memcpy(&value, p, 1);
   } else {
-    using U = std::conditional_t<sizeof(T) == 2, uint16_t,
-                                 std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>>;
+    using U = std::conditional_t<sizeof(T) == 2, uint16_t, std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>>;
     U bits;
     std::memcpy(&bits, p, sizeof(U));
     if (swap) bits = byte_swap(bits);
@@ -102,22 +101,14 @@ T load(const char* p, bool swap) {
 // Every PLY scalar fits a double exactly (the widest integer is 32 bits).
 double load_scalar(const char* p, Scalar type, bool swap) {
   switch (type) {
-    case Scalar::kInt8:
-      return load<int8_t>(p, swap);
-    case Scalar::kUint8:
-      return load<uint8_t>(p, swap);
-    case Scalar::kInt16:
-      return load<int16_t>(p, swap);
-    case Scalar::kUint16:
-      return load<uint16_t>(p, swap);
-    case Scalar::kInt32:
-      return load<int32_t>(p, swap);
-    case Scalar::kUint32:
-      return load<uint32_t>(p, swap);
-    case Scalar::kFloat32:
-      return load<float>(p, swap);
-    case Scalar::kFloat64:
-      return load<double>(p, swap);
+    case Scalar::kInt8: return load<int8_t>(p, swap);
+    case Scalar::kUint8: return load<uint8_t>(p, swap);
+    case Scalar::kInt16: return load<int16_t>(p, swap);
+    case Scalar::kUint16: return load<uint16_t>(p, swap);
+    case Scalar::kInt32: return load<int32_t>(p, swap);
+    case Scalar::kUint32: return load<uint32_t>(p, swap);
+    case Scalar::kFloat32: return load<float>(p, swap);
+    case Scalar::kFloat64: return load<double>(p, swap);
   }
   return 0.0;
 }
@@ -199,9 +190,7 @@ struct PlyHeader {
 void split_tokens(std::string_view line, std::vector<std::string_view>* tokens) {
   tokens->clear();
   size_t i = 0;
-  auto is_space = [](char c) {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-  };
+  auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; };
   while (i < line.size()) {
     while (i < line.size() && is_space(line[i])) ++i;
     const size_t start = i;
@@ -240,8 +229,8 @@ StatusOr<PlyHeader> parse_header(std::string_view bytes) {
   };
   while (true) {
     if (pos >= bytes.size()) {
-      return invalid_argument("the header has no end_header line (the file ends after line " +
-                              std::to_string(line_no) + ")");
+      return invalid_argument("the header has no end_header line (the file ends after line " + std::to_string(line_no) +
+                              ")");
     }
     size_t end = bytes.find('\n', pos);
     const bool last_line = end == std::string_view::npos;
@@ -263,8 +252,8 @@ StatusOr<PlyHeader> parse_header(std::string_view bytes) {
       break;
     }
     if (last_line) {
-      return invalid_argument("the header has no end_header line (the file ends after line " +
-                              std::to_string(line_no) + ")");
+      return invalid_argument("the header has no end_header line (the file ends after line " + std::to_string(line_no) +
+                              ")");
     }
     if (keyword == "format") {
       if (have_format) return at_line("a second format line");
@@ -291,8 +280,7 @@ StatusOr<PlyHeader> parse_header(std::string_view bytes) {
       const std::string_view count = tokens[2];
       auto r = std::from_chars(count.data(), count.data() + count.size(), element.count);
       if (r.ec != std::errc() || r.ptr != count.data() + count.size()) {
-        return at_line("element " + quoted(tokens[1]) + " count " + quoted(count) +
-                       " is not a non-negative integer");
+        return at_line("element " + quoted(tokens[1]) + " count " + quoted(count) + " is not a non-negative integer");
       }
       const auto [first, added] = element_lines.emplace(tokens[1], line_no);
       if (!added) {
@@ -328,8 +316,7 @@ StatusOr<PlyHeader> parse_header(std::string_view bytes) {
       }
       PlyElement& element = header.elements.back();
       if (!property_names.insert(tokens.back()).second) {
-        return at_line("element " + quoted(element.name) + " has two properties named " +
-                       quoted(property.name));
+        return at_line("element " + quoted(element.name) + " has two properties named " + quoted(property.name));
       }
       element.properties.push_back(std::move(property));
     } else {
@@ -385,9 +372,9 @@ class BinaryCursor {
     *count = static_cast<uint64_t>(n);
     const size_t item = info(p.type).size;
     if (*count > remaining() / item) {
-      error_ = "truncated: a list of " + std::to_string(*count) + " " + info(p.type).name +
-               " needs " + std::to_string(*count * item) + " bytes at offset " +
-               std::to_string(pos_) + ", file has " + std::to_string(size_) + " bytes";
+      error_ = "truncated: a list of " + std::to_string(*count) + " " + info(p.type).name + " needs " +
+               std::to_string(*count * item) + " bytes at offset " + std::to_string(pos_) + ", file has " +
+               std::to_string(size_) + " bytes";
       return false;
     }
     return true;
@@ -400,8 +387,8 @@ class BinaryCursor {
 
  private:
   bool truncated(size_t needed) {
-    error_ = "truncated: needs " + std::to_string(needed) + " bytes at offset " +
-             std::to_string(pos_) + ", file has " + std::to_string(size_) + " bytes";
+    error_ = "truncated: needs " + std::to_string(needed) + " bytes at offset " + std::to_string(pos_) + ", file has " +
+             std::to_string(size_) + " bytes";
     return false;
   }
 
@@ -439,8 +426,7 @@ class AsciiCursor {
   bool end_record() {
     skip_blanks();
     if (pos_ == text_.size() || text_[pos_] == '\n') return true;
-    error_ = "unexpected extra value " + quoted(peek_token()) + " " + where() +
-             " after the last property";
+    error_ = "unexpected extra value " + quoted(peek_token()) + " " + where() + " after the last property";
     return false;
   }
 
@@ -460,8 +446,8 @@ class AsciiCursor {
     *count = static_cast<uint64_t>(n);
     // Each item needs a separator and at least one character.
     if (*count > remaining() / 2) {
-      error_ = "truncated: a list of " + std::to_string(*count) + " values " + where() +
-               " cannot fit in the " + std::to_string(remaining()) + " bytes left in the file";
+      error_ = "truncated: a list of " + std::to_string(*count) + " values " + where() + " cannot fit in the " +
+               std::to_string(remaining()) + " bytes left in the file";
       return false;
     }
     return true;
@@ -476,9 +462,7 @@ class AsciiCursor {
   }
 
  private:
-  static bool is_blank(char c) {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-  }
+  static bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
   void skip_blanks() {
     while (pos_ < text_.size() && is_blank(text_[pos_])) ++pos_;
   }
@@ -581,8 +565,7 @@ std::string record_label(const PlyElement& e, uint64_t i) {
   return e.name + " " + std::to_string(i) + " of " + std::to_string(e.count);
 }
 
-Status record_error(const PlyElement& e, uint64_t i, const PlyProperty& p,
-                    const std::string& what) {
+Status record_error(const PlyElement& e, uint64_t i, const PlyProperty& p, const std::string& what) {
   return invalid_argument(record_label(e, i) + ", property " + quoted(p.name) + ": " + what);
 }
 
@@ -597,8 +580,7 @@ bool store(const Slot& slot, uint64_t i, double v, std::string* why) {
         return false;
       }
       if (!(std::fabs(v) <= std::numeric_limits<float>::max())) {
-        *why = std::isinf(v) ? "infinite value"
-                             : "value " + number_text(v) + " is outside float range";
+        *why = std::isinf(v) ? "infinite value" : "value " + number_text(v) + " is outside float range";
         return false;
       }
       slot.f[i * slot.stride] = static_cast<float>(v);
@@ -611,15 +593,13 @@ bool store(const Slot& slot, uint64_t i, double v, std::string* why) {
       slot.n[i * slot.stride] = static_cast<int32_t>(v);
       return true;
     case Slot::kSkip:
-    case Slot::kCorners:
-      return true;
+    case Slot::kCorners: return true;
   }
   return true;
 }
 
 template <typename Cursor>
-Status read_records(Cursor& cursor, const PlyElement& e, const std::vector<Slot>& slots,
-                    FaceSink* faces) {
+Status read_records(Cursor& cursor, const PlyElement& e, const std::vector<Slot>& slots, FaceSink* faces) {
   std::string why;
   for (uint64_t i = 0; i < e.count; ++i) {
     cursor.begin_record();
@@ -639,9 +619,9 @@ Status read_records(Cursor& cursor, const PlyElement& e, const std::vector<Slot>
         continue;
       }
       if (count < 3) {
-        return record_error(e, i, p,
-                            "a face needs at least 3 corners, this one has " +
-                                std::to_string(count) + " (" + cursor.where() + ")");
+        return record_error(
+            e, i, p,
+            "a face needs at least 3 corners, this one has " + std::to_string(count) + " (" + cursor.where() + ")");
       }
       faces->corners.resize(count);  // list_count bounded it by the bytes left
       for (uint64_t j = 0; j < count; ++j) {
@@ -652,8 +632,8 @@ Status read_records(Cursor& cursor, const PlyElement& e, const std::vector<Slot>
         if (!(v >= 0.0 && v < static_cast<double>(faces->num_vertices))) {
           return record_error(e, i, p,
                               "vertex index " + number_text(v) + " " + cursor.where() +
-                                  " is out of range: the file has " +
-                                  std::to_string(faces->num_vertices) + " vertices");
+                                  " is out of range: the file has " + std::to_string(faces->num_vertices) +
+                                  " vertices");
         }
         faces->corners[j] = static_cast<uint32_t>(v);
       }
@@ -671,8 +651,7 @@ Status read_records(Cursor& cursor, const PlyElement& e, const std::vector<Slot>
 // records that stay in cache, with its type and byte order fixed at compile time.
 // Returns the index of the first value the slot refuses (see store), or count.
 template <typename T, bool kSwap>
-uint64_t convert_column(const char* src, size_t record_size, uint64_t first, uint64_t count,
-                        const Slot& slot) {
+uint64_t convert_column(const char* src, size_t record_size, uint64_t first, uint64_t count, const Slot& slot) {
   if (slot.kind == Slot::kFloat) {
     float* dst = slot.f + first * slot.stride;
     for (uint64_t i = 0; i < count; ++i) {
@@ -704,29 +683,20 @@ using ColumnFn = uint64_t (*)(const char*, size_t, uint64_t, uint64_t, const Slo
 template <bool kSwap>
 ColumnFn column_fn(Scalar type) {
   switch (type) {
-    case Scalar::kInt8:
-      return &convert_column<int8_t, kSwap>;
-    case Scalar::kUint8:
-      return &convert_column<uint8_t, kSwap>;
-    case Scalar::kInt16:
-      return &convert_column<int16_t, kSwap>;
-    case Scalar::kUint16:
-      return &convert_column<uint16_t, kSwap>;
-    case Scalar::kInt32:
-      return &convert_column<int32_t, kSwap>;
-    case Scalar::kUint32:
-      return &convert_column<uint32_t, kSwap>;
-    case Scalar::kFloat32:
-      return &convert_column<float, kSwap>;
-    case Scalar::kFloat64:
-      return &convert_column<double, kSwap>;
+    case Scalar::kInt8: return &convert_column<int8_t, kSwap>;
+    case Scalar::kUint8: return &convert_column<uint8_t, kSwap>;
+    case Scalar::kInt16: return &convert_column<int16_t, kSwap>;
+    case Scalar::kUint16: return &convert_column<uint16_t, kSwap>;
+    case Scalar::kInt32: return &convert_column<int32_t, kSwap>;
+    case Scalar::kUint32: return &convert_column<uint32_t, kSwap>;
+    case Scalar::kFloat32: return &convert_column<float, kSwap>;
+    case Scalar::kFloat64: return &convert_column<double, kSwap>;
   }
   return nullptr;
 }
 
 // Reads a fixed-size element whose count check_count_fits has already checked.
-Status read_fixed_binary(BinaryCursor& cursor, const PlyElement& e,
-                         const std::vector<Slot>& slots) {
+Status read_fixed_binary(BinaryCursor& cursor, const PlyElement& e, const std::vector<Slot>& slots) {
   struct Column {
     size_t property;
     size_t offset;  // within the record
@@ -737,8 +707,7 @@ Status read_fixed_binary(BinaryCursor& cursor, const PlyElement& e,
   for (size_t k = 0; k < e.properties.size(); ++k) {
     const Scalar type = e.properties[k].type;
     if (slots[k].kind != Slot::kSkip) {
-      columns.push_back(
-          {k, record_size, cursor.swap() ? column_fn<true>(type) : column_fn<false>(type)});
+      columns.push_back({k, record_size, cursor.swap() ? column_fn<true>(type) : column_fn<false>(type)});
     }
     record_size += info(type).size;
   }
@@ -762,8 +731,7 @@ Status read_fixed_binary(BinaryCursor& cursor, const PlyElement& e,
       const PlyProperty& p = e.properties[bad_column->property];
       const size_t offset = cursor.offset() + (first + bad) * record_size + bad_column->offset;
       std::string why;
-      store(slots[bad_column->property], first + bad,
-            load_scalar(cursor.data() + offset, p.type, cursor.swap()), &why);
+      store(slots[bad_column->property], first + bad, load_scalar(cursor.data() + offset, p.type, cursor.swap()), &why);
       return record_error(e, first + bad, p, why + " at offset " + std::to_string(offset));
     }
   }
@@ -793,8 +761,7 @@ size_t min_record_bytes(const PlyElement& e, bool ascii, const PlyProperty* corn
 }
 
 template <typename Cursor>
-Status check_count_fits(const Cursor& cursor, const PlyElement& e, size_t min_bytes, bool binary,
-                        bool fixed_size) {
+Status check_count_fits(const Cursor& cursor, const PlyElement& e, size_t min_bytes, bool binary, bool fixed_size) {
   if (e.count == 0 || min_bytes == 0 || e.count <= cursor.remaining() / min_bytes) {
     return Status::Ok();
   }
@@ -802,35 +769,20 @@ Status check_count_fits(const Cursor& cursor, const PlyElement& e, size_t min_by
   if (binary && fixed_size) {
     // Every record has the same size: name the first one that is cut off.
     const uint64_t first_missing = cursor.remaining() / min_bytes;
-    return invalid_argument("truncated: " + record_label(e, first_missing) + " needs " +
-                            std::to_string(min_bytes) + " bytes at offset " +
-                            std::to_string(cursor.offset() + first_missing * min_bytes) +
+    return invalid_argument("truncated: " + record_label(e, first_missing) + " needs " + std::to_string(min_bytes) +
+                            " bytes at offset " + std::to_string(cursor.offset() + first_missing * min_bytes) +
                             ", file has " + std::to_string(file_size) + " bytes");
   }
-  return invalid_argument("truncated: the header declares " + std::to_string(e.count) + " " +
-                          e.name + " records of at least " + std::to_string(min_bytes) +
-                          " bytes each, but only " + std::to_string(cursor.remaining()) +
-                          " bytes are left at offset " + std::to_string(cursor.offset()) +
-                          " (file has " + std::to_string(file_size) + " bytes)");
+  return invalid_argument("truncated: the header declares " + std::to_string(e.count) + " " + e.name +
+                          " records of at least " + std::to_string(min_bytes) + " bytes each, but only " +
+                          std::to_string(cursor.remaining()) + " bytes are left at offset " +
+                          std::to_string(cursor.offset()) + " (file has " + std::to_string(file_size) + " bytes)");
 }
 
 // ---------------------------------------------------------------------------
 // What the reader takes from the vertex, face and camera elements.
 
-enum class VertexField {
-  kOther,
-  kX,
-  kY,
-  kZ,
-  kNx,
-  kNy,
-  kNz,
-  kIntensity,
-  kConfidence,
-  kCamera,
-  kLaser,
-  kFrame
-};
+enum class VertexField { kOther, kX, kY, kZ, kNx, kNy, kNz, kIntensity, kConfidence, kCamera, kLaser, kFrame };
 
 VertexField vertex_field(std::string_view name) {
   static constexpr std::pair<std::string_view, VertexField> kFields[] = {
@@ -855,18 +807,16 @@ VertexField vertex_field(std::string_view name) {
 Status check_vertex_element(const PlyElement& v) {
   for (const char* name : {"x", "y", "z"}) {
     if (v.find(name) == nullptr) {
-      return invalid_argument("element 'vertex' (header line " + std::to_string(v.line) +
-                              ") has no property '" + name + "'");
+      return invalid_argument("element 'vertex' (header line " + std::to_string(v.line) + ") has no property '" + name +
+                              "'");
     }
   }
   for (const PlyProperty& p : v.properties) {
     if (p.is_list && vertex_field(p.name) != VertexField::kOther) {
-      return invalid_argument("vertex property " + quoted(p.name) +
-                              " is a list; it must be a single value per vertex");
+      return invalid_argument("vertex property " + quoted(p.name) + " is a list; it must be a single value per vertex");
     }
   }
-  const int normals =
-      (v.find("nx") != nullptr) + (v.find("ny") != nullptr) + (v.find("nz") != nullptr);
+  const int normals = (v.find("nx") != nullptr) + (v.find("ny") != nullptr) + (v.find("nz") != nullptr);
   if (normals != 0 && normals != 3) {
     return invalid_argument("element 'vertex' has only some of the normal properties nx, ny, nz");
   }
@@ -883,16 +833,15 @@ Status check_face_element(const PlyElement& f) {
   const PlyProperty* corners = face_corners(f);
   if (corners == nullptr) {
     if (f.count == 0) return Status::Ok();
-    return invalid_argument("element 'face' (header line " + std::to_string(f.line) +
-                            ") has no 'vertex_indices' list");
+    return invalid_argument("element 'face' (header line " + std::to_string(f.line) + ") has no 'vertex_indices' list");
   }
   if (!corners->is_list) {
     return invalid_argument("face property " + quoted(corners->name) +
                             " must be a list of vertex indices, not a single value");
   }
   if (!info(corners->type).integer) {
-    return invalid_argument("face property " + quoted(corners->name) + " has item type " +
-                            info(corners->type).name + "; vertex indices must be integers");
+    return invalid_argument("face property " + quoted(corners->name) + " has item type " + info(corners->type).name +
+                            "; vertex indices must be integers");
   }
   return Status::Ok();
 }
@@ -941,11 +890,8 @@ Status read_body(Cursor& cursor, const PlyHeader& header, PlyData* out) {
     if (is_vertex || is_camera || (binary && !e.has_lists())) {
       RETURN_IF_ERROR(check_count_fits(cursor, e, min_bytes, binary, !e.has_lists()));
     }
-    const size_t n =
-        static_cast<size_t>(std::min<uint64_t>(e.count, cursor.remaining() / min_bytes));
-    auto float_slot = [](float* base, size_t stride) {
-      return Slot{Slot::kFloat, base, nullptr, stride};
-    };
+    const size_t n = static_cast<size_t>(std::min<uint64_t>(e.count, cursor.remaining() / min_bytes));
+    auto float_slot = [](float* base, size_t stride) { return Slot{Slot::kFloat, base, nullptr, stride}; };
     auto int_slot = [](int32_t* base) { return Slot{Slot::kInt, nullptr, base, 1}; };
     if (is_vertex) {
       cloud.positions.resize(n);
@@ -960,41 +906,18 @@ Status read_body(Cursor& cursor, const PlyHeader& header, PlyData* out) {
       static_assert(sizeof(Vec3f) == 3 * sizeof(float));
       for (size_t k = 0; k < e.properties.size(); ++k) {
         switch (vertex_field(e.properties[k].name)) {
-          case VertexField::kX:
-            slots[k] = float_slot(xyz + 0, 3);
-            break;
-          case VertexField::kY:
-            slots[k] = float_slot(xyz + 1, 3);
-            break;
-          case VertexField::kZ:
-            slots[k] = float_slot(xyz + 2, 3);
-            break;
-          case VertexField::kNx:
-            slots[k] = float_slot(nxyz + 0, 3);
-            break;
-          case VertexField::kNy:
-            slots[k] = float_slot(nxyz + 1, 3);
-            break;
-          case VertexField::kNz:
-            slots[k] = float_slot(nxyz + 2, 3);
-            break;
-          case VertexField::kIntensity:
-            slots[k] = float_slot(cloud.intensity.data(), 1);
-            break;
-          case VertexField::kConfidence:
-            slots[k] = float_slot(cloud.confidence.data(), 1);
-            break;
-          case VertexField::kCamera:
-            slots[k] = int_slot(cloud.camera.data());
-            break;
-          case VertexField::kLaser:
-            slots[k] = int_slot(cloud.laser.data());
-            break;
-          case VertexField::kFrame:
-            slots[k] = int_slot(cloud.frame.data());
-            break;
-          case VertexField::kOther:
-            break;
+          case VertexField::kX: slots[k] = float_slot(xyz + 0, 3); break;
+          case VertexField::kY: slots[k] = float_slot(xyz + 1, 3); break;
+          case VertexField::kZ: slots[k] = float_slot(xyz + 2, 3); break;
+          case VertexField::kNx: slots[k] = float_slot(nxyz + 0, 3); break;
+          case VertexField::kNy: slots[k] = float_slot(nxyz + 1, 3); break;
+          case VertexField::kNz: slots[k] = float_slot(nxyz + 2, 3); break;
+          case VertexField::kIntensity: slots[k] = float_slot(cloud.intensity.data(), 1); break;
+          case VertexField::kConfidence: slots[k] = float_slot(cloud.confidence.data(), 1); break;
+          case VertexField::kCamera: slots[k] = int_slot(cloud.camera.data()); break;
+          case VertexField::kLaser: slots[k] = int_slot(cloud.laser.data()); break;
+          case VertexField::kFrame: slots[k] = int_slot(cloud.frame.data()); break;
+          case VertexField::kOther: break;
         }
       }
     } else if (is_camera) {
@@ -1026,9 +949,8 @@ Status read_body(Cursor& cursor, const PlyHeader& header, PlyData* out) {
     const int32_t id = cloud.camera[i];
     if (id == kUnknownSource) continue;
     if (id < 0 || (num_centres > 0 && id >= num_centres)) {
-      return invalid_argument("vertex " + std::to_string(i) + " has camera id " +
-                              std::to_string(id) + ", but the file has " +
-                              std::to_string(num_centres) +
+      return invalid_argument("vertex " + std::to_string(i) + " has camera id " + std::to_string(id) +
+                              ", but the file has " + std::to_string(num_centres) +
                               " camera centres (ids must be -1 for unknown or index them)");
     }
   }
@@ -1043,8 +965,7 @@ constexpr bool kNativeLittleEndian = std::endian::native == std::endian::little;
 template <typename T>
 void put(char*& p, T v) {
   if constexpr (!kNativeLittleEndian && sizeof(T) > 1) {
-    using U = std::conditional_t<sizeof(T) == 2, uint16_t,
-                                 std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>>;
+    using U = std::conditional_t<sizeof(T) == 2, uint16_t, std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>>;
     U bits;
     std::memcpy(&bits, &v, sizeof(U));
     bits = byte_swap(bits);
@@ -1201,8 +1122,7 @@ std::string encode_ply(const PointCloud& cloud, PlyFormat format) {
   s += "end_header\n";
 
   if (format == PlyFormat::kBinaryLittleEndian) {
-    const size_t record =
-        12 + (normals ? 12 : 0) + 4 * (intensity + confidence + camera + laser + frame);
+    const size_t record = 12 + (normals ? 12 : 0) + 4 * (intensity + confidence + camera + laser + frame);
     const size_t header_size = s.size();
     s.resize(header_size + n * record + num_centres * 12);
     char* p = s.data() + header_size;

@@ -27,7 +27,7 @@ namespace bodyscan {
 enum class PlyFormat { kBinaryLittleEndian, kAscii };
 
 struct PlyData {
-  PointCloud cloud;                // vertex positions and whatever attributes the file has
+  PointCloud cloud;                 // vertex positions and whatever attributes the file has
   std::vector<Triangle> triangles;  // empty for a point cloud
 };
 
@@ -43,12 +43,10 @@ StatusOr<TriangleMesh> read_ply_mesh(const std::string& path);
 // Writes every present attribute of the cloud (and a `camera` element when the
 // cloud has camera centres). Writes to a temporary file beside `path`, flushes and
 // fsyncs it, then renames it over `path`, so a reader never sees half a file.
-Status write_ply(const std::string& path, const PointCloud& cloud,
-                 PlyFormat format = PlyFormat::kBinaryLittleEndian);
+Status write_ply(const std::string& path, const PointCloud& cloud, PlyFormat format = PlyFormat::kBinaryLittleEndian);
 
 // Writes vertices (with normals when present) and triangles; same atomicity.
-Status write_ply(const std::string& path, const TriangleMesh& mesh,
-                 PlyFormat format = PlyFormat::kBinaryLittleEndian);
+Status write_ply(const std::string& path, const TriangleMesh& mesh, PlyFormat format = PlyFormat::kBinaryLittleEndian);
 
 // The bytes write_ply would write (for tests and in-memory use).
 std::string encode_ply(const PointCloud& cloud, PlyFormat format);

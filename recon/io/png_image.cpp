@@ -51,8 +51,9 @@ bool encode_rows(png_structp png, png_infop info, const GrayImage& image, int co
   if (setjmp(png_jmpbuf(png))) return false;
   png_set_write_fn(png, bytes, append_bytes, no_flush);
   png_set_compression_level(png, compression);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height), image.bit_depth,
-               PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height),
+               image.bit_depth, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
   uint8_t* out = row->data();
   for (int y = 0; y < image.height; ++y) {
@@ -92,7 +93,8 @@ bool decode_rows(png_structp png, png_infop info, Reader* reader, GrayImage* ima
     png_read_row(png, row->data(), nullptr);
     uint16_t* dst = image->pixels.data() + static_cast<size_t>(y) * image->width;
     const uint8_t* in = row->data();
-    for (int x = 0; x < image->width; ++x) dst[x] = depth == 8 ? in[x] : static_cast<uint16_t>(in[2 * x] << 8 | in[2 * x + 1]);
+    for (int x = 0; x < image->width; ++x)
+      dst[x] = depth == 8 ? in[x] : static_cast<uint16_t>(in[2 * x] << 8 | in[2 * x + 1]);
   }
   png_read_end(png, nullptr);
   return true;

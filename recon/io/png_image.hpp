@@ -12,8 +12,8 @@ namespace bodyscan {
 
 struct GrayImage {
   int width = 0, height = 0;
-  int bit_depth = 8;              // 8 or 16
-  std::vector<uint16_t> pixels;   // row-major; values < 2^bit_depth
+  int bit_depth = 8;             // 8 or 16
+  std::vector<uint16_t> pixels;  // row-major; values < 2^bit_depth
 };
 
 // zlib level 1-9 (speed against size); 1 suits the mostly dark frames of a scan.

@@ -111,7 +111,8 @@ TriangleMesh transformed(const TriangleMesh& mesh, const Eigen::Isometry3d& tran
 StatusOr<BodyFrame> find_body_frame(const TriangleMesh& mesh, const BodyFrameOptions& options) {
   if (mesh.triangles.empty()) return invalid_argument("measure: the mesh has no triangles");
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const Vec3f& v : mesh.vertices) lo = std::min(lo, static_cast<double>(v.y())), hi = std::max(hi, static_cast<double>(v.y()));
+  for (const Vec3f& v : mesh.vertices)
+    lo = std::min(lo, static_cast<double>(v.y())), hi = std::max(hi, static_cast<double>(v.y()));
   BodyFrame frame;
   frame.floor_y = options.floor_y.value_or(lo);
   frame.height = hi - frame.floor_y;
@@ -128,7 +129,8 @@ StatusOr<BodyFrame> find_body_frame(const TriangleMesh& mesh, const BodyFrameOpt
       if (r.points.size() >= 8 && (!trunk || r.girth > trunk->girth)) trunk = &r;
     if (trunk) cuts.push_back({resampled(trunk->points, kLoopPoints), {trunk->centroid.x(), trunk->centroid.z()}});
   }
-  if (cuts.size() < 10) return not_found("measure: no trunk between half and 70 % of the height; is the body standing?");
+  if (cuts.size() < 10)
+    return not_found("measure: no trunk between half and 70 % of the height; is the body standing?");
 
   // The sagittal plane: the mirror that fits the trunk's cuts best, searched over
   // every direction, then refined.

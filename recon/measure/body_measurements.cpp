@@ -28,8 +28,8 @@ const BodyLandmark* BodyMeasurements::landmark(const std::string& name) const {
 }
 
 double iso20685_allowance_mm(const BodyMeasurement& m) {
-  static const char* const kTorso[] = {"chest_girth", "bust_girth",     "underbust_girth",
-                                       "waist_girth", "hip_girth", "max_hip_girth"};
+  static const char* const kTorso[] = {"chest_girth", "bust_girth", "underbust_girth",
+                                       "waist_girth", "hip_girth",  "max_hip_girth"};
   if (m.kind == "girth") return std::find(std::begin(kTorso), std::end(kTorso), m.name) != std::end(kTorso) ? 9 : 4;
   return m.kind == "height" ? 4 : 5;
 }
@@ -83,8 +83,8 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
     sheet.height("stature", "Stature", "5.1.1", {"top_of_head"}, cuts.crown(), "top of the head above the floor");
     sheet.height("cervical_height", "Cervical height", "", {"back_neck_point"}, sheet.position("back_neck_point"),
                  "back neck point above the floor");
-    sheet.height("crotch_height", "Inside leg length (crotch height)", "5.1.15", {"crotch"},
-                 sheet.position("crotch"), "crotch above the floor");
+    sheet.height("crotch_height", "Inside leg length (crotch height)", "5.1.15", {"crotch"}, sheet.position("crotch"),
+                 "crotch above the floor");
     rules::measure_neck(cuts, sheet, neck);
     rules::measure_trunk(cuts, sheet, crotch_y, arms, levels);
     rules::PerSide<std::optional<rules::Knee>> knees;

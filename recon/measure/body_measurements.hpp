@@ -51,7 +51,7 @@ inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-16";
 inline constexpr float kMeasuredConfidence = 0.5f;
 
 struct BodyLandmark {
-  std::string name;  // e.g. "crotch", "armpit_left", "back_neck_point"
+  std::string name;                                    // e.g. "crotch", "armpit_left", "back_neck_point"
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // mm, on (or in) the body
   // The mesh's confidence at its nearest vertex (1: measured, 0: invented by hole
   // filling); the measurements built on it inherit the lowest.
@@ -68,8 +68,8 @@ struct BodyMeasurement {
   // length's path, a height's vertical from the floor.
   std::vector<Eigen::Vector3d> path;
   bool closed = false;
-  std::vector<Eigen::Vector3d> loop;  // girths: the section loop round the skin
-  std::optional<Plane> plane;         // girths
+  std::vector<Eigen::Vector3d> loop;   // girths: the section loop round the skin
+  std::optional<Plane> plane;          // girths
   std::vector<std::string> landmarks;  // names used
   std::string definition;              // how it was taken, one sentence
   float min_confidence = 1;            // lowest mesh confidence along it and at its landmarks

@@ -86,15 +86,16 @@ std::vector<std::string> posture_parts(const std::string& m) {
     if (m == "outer_arm_length_" + s || m == "upper_arm_girth_" + s) return {"arm_" + s};
   }
   // The stance moves the hips and thighs, and with the legs' slant every height.
-  if (m == "hip_girth" || m == "max_hip_girth" || starts_with(m, "thigh_girth_") || starts_with(m, "mid_thigh_girth_") ||
-      starts_with(m, "knee_girth_") || m == "stature" || starts_with(m, "crotch_height") || m == "hip_height" ||
-      starts_with(m, "knee_height_"))
+  if (m == "hip_girth" || m == "max_hip_girth" || starts_with(m, "thigh_girth_") ||
+      starts_with(m, "mid_thigh_girth_") || starts_with(m, "knee_girth_") || m == "stature" ||
+      starts_with(m, "crotch_height") || m == "hip_height" || starts_with(m, "knee_height_"))
     return {"feet"};
   // The back neck point is read at the side neck points' level. The under-bust is
   // sought below the bust, which is sought below the armpits; the waist between the
   // hip (above the crotch) and the under-bust: on a scan, where hole filling moves
   // an armpit or the crotch, their levels move with it.
-  if (m == "cervical_height" || m == "waist_height" || m == "underbust_girth" || m == "waist_girth" || m == "back_neck_to_waist")
+  if (m == "cervical_height" || m == "waist_height" || m == "underbust_girth" || m == "waist_girth" ||
+      m == "back_neck_to_waist")
     return {"feet", "arm_left", "arm_right"};
   return {};
 }

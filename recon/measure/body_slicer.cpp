@@ -88,10 +88,13 @@ std::vector<Ring> BodySlicer::rings(double y) const {
       r.x_min = std::min(r.x_min, a.x()), r.x_max = std::max(r.x_max, a.x());
       r.z_min = std::min(r.z_min, a.z()), r.z_max = std::max(r.z_max, a.z());
     }
-    if (std::abs(area) > 1e-9) r.centroid = Eigen::Vector3d(cx / (3 * area), y, cz / (3 * area));
-    else r.centroid = Eigen::Vector3d(0.5 * (r.x_min + r.x_max), y, 0.5 * (r.z_min + r.z_max));
+    if (std::abs(area) > 1e-9)
+      r.centroid = Eigen::Vector3d(cx / (3 * area), y, cz / (3 * area));
+    else
+      r.centroid = Eigen::Vector3d(0.5 * (r.x_min + r.x_max), y, 0.5 * (r.z_min + r.z_max));
     r.girth = closed_length(convex_hull(std::move(flat)));
-    r.min_confidence = loop.confidence.empty() ? 1.f : *std::min_element(loop.confidence.begin(), loop.confidence.end());
+    r.min_confidence =
+        loop.confidence.empty() ? 1.f : *std::min_element(loop.confidence.begin(), loop.confidence.end());
     r.points = std::move(loop.points);
     r.confidence = std::move(loop.confidence);
     out.push_back(std::move(r));

@@ -155,7 +155,8 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
   const size_t cut = loops.size();
   loops.erase(std::remove_if(loops.begin(), loops.end(), [](const SectionLoop& l) { return !l.closed; }), loops.end());
   if (cut == 0) return not_found("girth: the plane does not cut the body");
-  if (loops.empty()) return not_found("girth: the plane cuts only the body's open border, no closed loop to measure around");
+  if (loops.empty())
+    return not_found("girth: the plane cuts only the body's open border, no closed loop to measure around");
   std::vector<SectionLoop> closed;  // nested ones too: one may cross the loop meant
   if (loops.size() > 1) closed = loops;
   drop_nested_loops(&loops, plane);
@@ -236,7 +237,8 @@ StatusOr<Girth> cloud_girth(const PointCloud& cloud, const Plane& plane_in, cons
     const double d = plane.signed_distance(q);
     if (std::abs(d) <= slab_mm) slab.push_back(q - d * plane.normal);
   }
-  if (slab.size() < 3) return not_found("girth: fewer than 3 points lie within " + std::to_string(slab_mm) + " mm of the plane");
+  if (slab.size() < 3)
+    return not_found("girth: fewer than 3 points lie within " + std::to_string(slab_mm) + " mm of the plane");
   // Parts: single-linkage groups at gap_mm (union-find over a sort by one axis).
   std::vector<size_t> parent(slab.size());
   std::iota(parent.begin(), parent.end(), 0);

@@ -23,7 +23,7 @@ double closed_length(const std::vector<Eigen::Vector2d>& polygon);
 double closed_length(const std::vector<Eigen::Vector3d>& polygon);
 
 struct Girth {
-  double value_mm = 0;                // the tape: the hull's perimeter
+  double value_mm = 0;  // the tape: the hull's perimeter
   Plane plane;
   std::vector<Eigen::Vector3d> loop;  // the section loop measured around, in order
   std::vector<Eigen::Vector3d> tape;  // the hull's corners in order: the tape's path

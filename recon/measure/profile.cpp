@@ -60,8 +60,8 @@ LocalParabola local_parabola(const std::vector<double>& x, const std::vector<dou
   return p;
 }
 
-std::optional<double> parabola_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k,
-                                      double half, bool lowest) {
+std::optional<double> parabola_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
+                                      bool lowest) {
   const LocalParabola p = local_parabola(x, v, x[k], half, false);
   if (p.samples < 7) return std::nullopt;
   const Eigen::Vector3d& c = p.coef;

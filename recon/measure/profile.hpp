@@ -50,8 +50,8 @@ LocalParabola local_parabola(const std::vector<double>& x, const std::vector<dou
 // `half` of x[k]: where a shallow, noisy profile bottoms out (`lowest`) or tops out.
 // Nothing when fewer than 7 samples lie there, the fit opens the other way (or is
 // flat), or its vertex falls outside the window.
-std::optional<double> parabola_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k,
-                                      double half, bool lowest);
+std::optional<double> parabola_vertex(const std::vector<double>& x, const std::vector<double>& v, size_t k, double half,
+                                      bool lowest);
 
 // The index of v's largest (or smallest) sample, the first of equals.
 size_t arg_extreme(const std::vector<double>& v, bool largest);

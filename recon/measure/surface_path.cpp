@@ -234,8 +234,7 @@ class SurfacePaths::Impl {
     for (int i = 0; i < 3; ++i) scale = std::max(scale, (vertex(tr[i]) - vertex(tr[(i + 1) % 3])).norm());
     const double eps = 1e-6 * scale + 1e-9;
     for (uint32_t v : tr)
-      if ((vertex(v) - p).norm() <= eps)
-        return {incident_.begin() + offset_[v], incident_.begin() + offset_[v + 1]};
+      if ((vertex(v) - p).norm() <= eps) return {incident_.begin() + offset_[v], incident_.begin() + offset_[v + 1]};
     std::vector<uint32_t> out{t};
     for (int i = 0; i < 3; ++i) {
       const Eigen::Vector3d a = vertex(tr[i]), e = vertex(tr[(i + 1) % 3]) - a;
@@ -310,7 +309,6 @@ class SurfacePaths::Impl {
     return strip;
   }
 
-
   // Lays the strip flat, each triangle hinged on the edge it shares with the last.
   std::vector<Flat> unfold(const std::vector<uint32_t>& strip) const {
     std::vector<Flat> flat(strip.size());
@@ -319,8 +317,9 @@ class SurfacePaths::Impl {
       const Eigen::Vector3d a = vertex(t[0]), b = vertex(t[1]), c = vertex(t[2]);
       const double ab = (b - a).norm(), ac = (c - a).norm();
       const double x = ab > 0 ? (b - a).dot(c - a) / ab : 0.0;
-      flat[0] = {strip[0], {Eigen::Vector2d(0, 0), Eigen::Vector2d(ab, 0),
-                            Eigen::Vector2d(x, std::sqrt(std::max(0.0, ac * ac - x * x)))}};
+      flat[0] = {strip[0],
+                 {Eigen::Vector2d(0, 0), Eigen::Vector2d(ab, 0),
+                  Eigen::Vector2d(x, std::sqrt(std::max(0.0, ac * ac - x * x)))}};
     }
     for (size_t j = 1; j < strip.size(); ++j) {
       const Triangle& pt = mesh_.triangles[strip[j - 1]];
@@ -332,8 +331,10 @@ class SurfacePaths::Impl {
         int k = -1;
         for (int q = 0; q < 3; ++q)
           if (pt[q] == t[i]) k = q;
-        if (k >= 0) flat[j].p[i] = flat[j - 1].p[k];
-        else w = i;
+        if (k >= 0)
+          flat[j].p[i] = flat[j - 1].p[k];
+        else
+          w = i;
       }
       for (int q = 0; q < 3; ++q)
         if (!has_vertex(strip[j], pt[q])) r2 = flat[j - 1].p[q];
@@ -383,8 +384,10 @@ class SurfacePaths::Impl {
       std::array<int, 2> shared{};
       int n = 0;
       for (int q = 0; q < 3; ++q) {
-        if (has_vertex(strip[j], pt[q]) && n < 2) shared[static_cast<size_t>(n++)] = q;
-        else r = q;
+        if (has_vertex(strip[j], pt[q]) && n < 2)
+          shared[static_cast<size_t>(n++)] = q;
+        else
+          r = q;
       }
       const Eigen::Vector2d u2 = flat[j - 1].p[shared[0]], v2 = flat[j - 1].p[shared[1]];
       const Eigen::Vector2d r2 = flat[j - 1].p[r];

@@ -36,8 +36,8 @@ struct SurfacePath {
   double straight_mm = 0;             // the chord between the two ends
   std::vector<Eigen::Vector3d> path;  // on the surface, from the first end to the second
   Eigen::Vector3d from = Eigen::Vector3d::Zero(), to = Eigen::Vector3d::Zero();  // the ends as snapped
-  float min_confidence = 1;           // lowest mesh confidence along the path (1: all measured)
-  size_t reroutes = 0;                // vertex re-routings step 4 made (both searches)
+  float min_confidence = 1;  // lowest mesh confidence along the path (1: all measured)
+  size_t reroutes = 0;       // vertex re-routings step 4 made (both searches)
 };
 
 struct SurfacePathOptions {

@@ -58,7 +58,8 @@ float difference_at(const ImageView& f, const ImageView& b, const Eigen::Vector2
     const int v = static_cast<int>(f.row(yy)[xx]) - static_cast<int>(b.row(yy)[xx]);
     return static_cast<float>(std::max(v, 0));
   };
-  return (1 - fy) * ((1 - fx) * d(x0, y0) + fx * d(x0 + 1, y0)) + fy * ((1 - fx) * d(x0, y0 + 1) + fx * d(x0 + 1, y0 + 1));
+  return (1 - fy) * ((1 - fx) * d(x0, y0) + fx * d(x0 + 1, y0)) +
+         fy * ((1 - fx) * d(x0, y0 + 1) + fx * d(x0 + 1, y0 + 1));
 }
 
 // The plane through three points, as (unit normal, offset).
@@ -123,8 +124,8 @@ StatusOr<LaserPlane> LaserPlaneFinder::find(const ImageView& frame, const ImageV
     for (Pole p : kPoles)
       if (!at(p).found) missing += std::string(missing.empty() ? "" : ", ") + to_string(p);
     return failed_precondition("camera '" + cal_.camera_id + "': the laser stripe crosses only " +
-                               std::to_string(primary.size()) + " of the frame's 4 poles (none seen on the " +
-                               missing + " pole) - is a laser off, or aimed past the frame?");
+                               std::to_string(primary.size()) + " of the frame's 4 poles (none seen on the " + missing +
+                               " pole) - is a laser off, or aimed past the frame?");
   }
   auto [n, d] = plane_through(at(primary[0]).world, at(primary[1]).world, at(primary[2]).world);
   for (Pole p : primary) at(p).used = true;
@@ -178,8 +179,10 @@ Status complete_plane(const CameraCalibration& cal, const Eigen::Vector3d& norma
   }
   auto h = fit_homography(image, on_plane);
   if (!h.ok()) {
-    return failed_precondition("camera '" + cal.camera_id + "': the laser's pole points do not fix the image-to-plane "
-                               "transform: " + h.status().message());
+    return failed_precondition("camera '" + cal.camera_id +
+                               "': the laser's pole points do not fix the image-to-plane "
+                               "transform: " +
+                               h.status().message());
   }
   plane->image_to_plane = *h;
   return {};

@@ -31,12 +31,12 @@ enum class TriangulationMethod { kTwoPlaneRay, kLaserHomography };
 const char* to_string(TriangulationMethod m);
 
 struct PoleStripe {
-  bool found = false;      // the stripe crosses the pole's line in the image
-  bool used = false;       // it fixes the plane
-  bool estimated = false;  // hidden or disagreeing: put where the plane cuts the pole
+  bool found = false;                               // the stripe crosses the pole's line in the image
+  bool used = false;                                // it fixes the plane
+  bool estimated = false;                           // hidden or disagreeing: put where the plane cuts the pole
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // lens-corrected
   Eigen::Vector3d world = Eigen::Vector3d::Zero();
-  double peak = 0;         // frame - base at the crossing, pixel values
+  double peak = 0;  // frame - base at the crossing, pixel values
 };
 
 struct LaserPlane {
@@ -48,7 +48,8 @@ struct LaserPlane {
   double fourth_point_mm = -1;
   // Eq. 3.6: lens-corrected pixel -> (a, b), the point origin + a * axis_a + b * axis_b.
   Eigen::Matrix3d image_to_plane = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero(), axis_a = Eigen::Vector3d::UnitY(), axis_b = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero(), axis_a = Eigen::Vector3d::UnitY(),
+                  axis_b = Eigen::Vector3d::UnitZ();
 
   Eigen::Vector3d triangulate(const CameraCalibration& cal, const Eigen::Vector2d& corrected,
                               TriangulationMethod method) const;
@@ -84,8 +85,8 @@ class LaserPlaneFinder {
 
  private:
   struct Line {
-    Eigen::Vector2d a, b;                       // lens-corrected ends (the pole's ends)
-    std::vector<Eigen::Vector2f> raw;           // samples x band offsets, raw pixels
+    Eigen::Vector2d a, b;              // lens-corrected ends (the pole's ends)
+    std::vector<Eigen::Vector2f> raw;  // samples x band offsets, raw pixels
     int samples = 0, band = 0;
   };
   const CameraCalibration& cal_;

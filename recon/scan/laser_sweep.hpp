@@ -21,7 +21,7 @@ struct SweepPoint {
 
 struct SweepPlane {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  // unit
-  double offset = 0;                                   // normal . x = offset
+  double offset = 0;                                  // normal . x = offset
 };
 
 class LaserSweep {
@@ -29,14 +29,14 @@ class LaserSweep {
   // Fits the sweep to points of at least three distinct steps; `initial` are per-step
   // planes (any sense) to start from, at least two distinct steps. Points farther
   // than `reject_mm` (or 4 robust sigmas, if more) from the first fit are left out.
-  static StatusOr<LaserSweep> fit(const std::vector<SweepPoint>& points, const std::vector<std::pair<int, SweepPlane>>& initial,
-                                  double reject_mm = 1.5);
+  static StatusOr<LaserSweep> fit(const std::vector<SweepPoint>& points,
+                                  const std::vector<std::pair<int, SweepPlane>>& initial, double reject_mm = 1.5);
 
   SweepPlane plane(int step) const;
   const Eigen::Vector3d& axis_point() const { return a_; }
   const Eigen::Vector3d& axis_direction() const { return u_; }
   double degrees_per_step() const;
-  double rms_mm() const { return rms_; }      // of the points kept
+  double rms_mm() const { return rms_; }  // of the points kept
   size_t points_used() const { return used_; }
   size_t points_rejected() const { return rejected_; }
 

@@ -20,7 +20,8 @@ size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio, float
     if (need > 1.f) return;  // nothing can be that much better
     for (const auto& [j, d2] : index.within_radius(cloud.positions[i], radius)) {
       if (j == i || cloud.confidence[j] < need) continue;
-      const bool other = (frames && cloud.frame[j] != cloud.frame[i]) || (cameras && cloud.camera[j] != cloud.camera[i]);
+      const bool other =
+          (frames && cloud.frame[j] != cloud.frame[i]) || (cameras && cloud.camera[j] != cloud.camera[i]);
       if (other) {
         drop[i] = 1;
         return;

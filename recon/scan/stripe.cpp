@@ -26,8 +26,8 @@ __attribute__((always_inline)) inline uint16_t chunk_peak(const uint16_t* __rest
 // first chunk holding it, so that the brightest pixel is then looked for there only.
 constexpr int kChunk = 64;
 __attribute__((target_clones("arch=haswell", "default"))) uint16_t row_peak(const uint16_t* __restrict f,
-                                                                           const uint16_t* __restrict b, int n,
-                                                                           int* chunk) {
+                                                                            const uint16_t* __restrict b, int n,
+                                                                            int* chunk) {
   uint16_t peak = 0;
   *chunk = 0;
   int c = 0;

@@ -27,8 +27,8 @@ struct StripeOptions {
 
 struct StripeSample {
   int row = 0;
-  float column = 0;     // sub-pixel, image x (pixel centres at integers)
-  uint16_t peak = 0;    // frame - base at the brightest pixel
+  float column = 0;        // sub-pixel, image x (pixel centres at integers)
+  uint16_t peak = 0;       // frame - base at the brightest pixel
   bool saturated = false;  // the frame itself hit full scale inside the window
 };
 

@@ -1,5 +1,6 @@
 #include "recon/scan/subject_sway.hpp"
 
+#include <tbb/parallel_for.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -8,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
-#include <tbb/parallel_for.h>
 
 #include "recon/spatial/knn_index.hpp"
 
@@ -22,9 +22,9 @@ namespace {
 // weights.
 struct Pair {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  double r0 = 0;      // the distance as measured, mm
-  double weight = 1;  // confidence
-  int fold = 0;       // the block of space the anchor lies in, for cross-validation
+  double r0 = 0;                              // the distance as measured, mm
+  double weight = 1;                          // confidence
+  int fold = 0;                               // the block of space the anchor lies in, for cross-validation
   std::vector<std::pair<int, double>> knots;  // (knot, weight): +point, -plane
 };
 
@@ -44,8 +44,10 @@ void merge(std::vector<std::pair<int, double>>& v) {
   std::sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   size_t w = 0;
   for (size_t r = 0; r < v.size(); ++r) {
-    if (w > 0 && v[w - 1].first == v[r].first) v[w - 1].second += v[r].second;
-    else v[w++] = v[r];
+    if (w > 0 && v[w - 1].first == v[r].first)
+      v[w - 1].second += v[r].second;
+    else
+      v[w++] = v[r];
   }
   v.resize(w);
 }
@@ -185,9 +187,10 @@ int fold_of(const Vec3f& p, const SwayOptions& o) {
 
 // The pairs at the current sway: each anchor against the other sweeps' points among
 // `candidates` (every point, or an even share of a dense cloud).
-std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& moved, const std::vector<size_t>& anchors,
-                             const std::vector<uint32_t>& candidates, const Knots& knots, const SwayOptions& o,
-                             float radius, const std::vector<Eigen::Vector3d>& x) {
+std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& moved,
+                             const std::vector<size_t>& anchors, const std::vector<uint32_t>& candidates,
+                             const Knots& knots, const SwayOptions& o, float radius,
+                             const std::vector<Eigen::Vector3d>& x) {
   std::vector<Vec3f> at(candidates.size());
   for (size_t c = 0; c < candidates.size(); ++c) at[c] = moved[candidates[c]];
   const KnnIndex index(at);
@@ -250,7 +253,8 @@ Eigen::MatrixXd slow_part(size_t m, const SwayOptions& o) {
   const int half = std::max(1, o.slow_frames / o.knot_frames / 2);
   Eigen::MatrixXd box = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
   for (size_t k = 0; k < m; ++k) {
-    const int b = std::max(0, static_cast<int>(k) - half), e = std::min(static_cast<int>(m) - 1, static_cast<int>(k) + half);
+    const int b = std::max(0, static_cast<int>(k) - half),
+              e = std::min(static_cast<int>(m) - 1, static_cast<int>(k) + half);
     for (int j = b; j <= e; ++j) box(static_cast<Eigen::Index>(k), j) = 1.0 / (e - b + 1);
   }
   return box.transpose() * box;
@@ -281,7 +285,8 @@ StatusOr<std::vector<Eigen::Vector3d>> solve_path(const System& s, const SwayReg
     // see (and knots nothing constrains) near zero instead of letting them drift.
     for (size_t a = 0; a < m; ++a) {
       for (size_t b = 0; b < m; ++b)
-        ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(b * dims + d)) += per_knot / static_cast<double>(m);
+        ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(b * dims + d)) +=
+            per_knot / static_cast<double>(m);
       ata(static_cast<Eigen::Index>(a * dims + d), static_cast<Eigen::Index>(a * dims + d)) +=
           o.ridge * reg.ridge_scale * scale;
     }
@@ -323,7 +328,8 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
     return invalid_argument("sway: bad options (no hold to try, or no cubes to fold by)");
   for (const SwayRegularization& r : o.regularizations)
     if (!(r.ridge_scale >= 0) || !(r.slow_scale >= 0)) return invalid_argument("sway: a hold's weights must be >= 0");
-  if (std::all_of(o.regularizations.begin(), o.regularizations.end(), [](const SwayRegularization& r) { return r.still; }))
+  if (std::all_of(o.regularizations.begin(), o.regularizations.end(),
+                  [](const SwayRegularization& r) { return r.still; }))
     return invalid_argument("sway: every hold stands still; offer one that moves");
   SwayEstimate est;
   est.knot_frames = o.knot_frames;
@@ -352,8 +358,8 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
   }
   if (est.stripe_spacing_mm > o.max_stripe_spacing_mm) {
     char why[160];
-    std::snprintf(why, sizeof why, "the stripes are %.0f mm apart, more than %.0f: scan more steps", est.stripe_spacing_mm,
-                  o.max_stripe_spacing_mm);
+    std::snprintf(why, sizeof why, "the stripes are %.0f mm apart, more than %.0f: scan more steps",
+                  est.stripe_spacing_mm, o.max_stripe_spacing_mm);
     est.not_estimated = why;
     return est;
   }
@@ -493,7 +499,8 @@ StatusOr<SwayEstimate> estimate_sway(const PointCloud& cloud, const SwayOptions&
 void undo_sway(PointCloud& cloud, const SwayEstimate& sway) {
   if (sway.empty() || cloud.frame.size() != cloud.size()) return;
   for (size_t i = 0; i < cloud.size(); ++i)
-    if (cloud.frame[i] >= 0) cloud.positions[i] = (cloud.positions[i].cast<double>() - sway.at(cloud.frame[i])).cast<float>();
+    if (cloud.frame[i] >= 0)
+      cloud.positions[i] = (cloud.positions[i].cast<double>() - sway.at(cloud.frame[i])).cast<float>();
 }
 
 }  // namespace bodyscan

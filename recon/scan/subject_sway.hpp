@@ -58,15 +58,15 @@ struct SwayRegularization {
 };
 
 struct SwayOptions {
-  int knot_frames = 20;         // knot spacing of the sway's path, frames (1/3 s at 60 Hz)
+  int knot_frames = 20;  // knot spacing of the sway's path, frames (1/3 s at 60 Hz)
   // Neighbourhood in which a point meets another sweep's skin: at least this, and at
   // least 2.5 stripe spacings (measured from the cloud: a scan of every Nth step has
   // its stripes N times farther apart), so that it holds two stripes of each sweep.
   float radius_mm = 8.f;
-  int min_frame_gap = 30;       // moments closer than this (frames) are taken as one
-  size_t max_anchors = 30000;   // points whose neighbourhoods are examined, spread over the scan
+  int min_frame_gap = 30;          // moments closer than this (frames) are taken as one
+  size_t max_anchors = 30000;      // points whose neighbourhoods are examined, spread over the scan
   size_t max_candidates = 500000;  // points their neighbourhoods are drawn from (an even share of a denser cloud)
-  size_t min_group = 6;         // points of the other sweep needed for its local surface
+  size_t min_group = 6;            // points of the other sweep needed for its local surface
   // Re-pairings, at most: each finds the pairs again where the last path put the
   // sweeps, and fits the path to them; they stop once no knot moved more than
   // converged_mm. The first pairing is at no sway, and the path comes up to the
@@ -76,11 +76,11 @@ struct SwayOptions {
   // after 9, 0.49; no closer after 16).
   int iterations = 12;
   double converged_mm = 0.05;
-  double smoothness = 0.01;     // weight of the path's second differences, relative to the data
-  double ridge = 0.003;         // weight of the sway itself, relative: holds what the pairs cannot see near zero
-  double huber_mm = 0.75;       // residuals beyond this count linearly
-  double max_residual_mm = 6;   // pairs farther apart than this are not the same skin
-  bool vertical = false;        // also estimate a vertical sway (off: posture moves sideways)
+  double smoothness = 0.01;    // weight of the path's second differences, relative to the data
+  double ridge = 0.003;        // weight of the sway itself, relative: holds what the pairs cannot see near zero
+  double huber_mm = 0.75;      // residuals beyond this count linearly
+  double max_residual_mm = 6;  // pairs farther apart than this are not the same skin
+  bool vertical = false;       // also estimate a vertical sway (off: posture moves sideways)
   // Stripes farther apart than this (a scan of every 5th step or coarser on the
   // thesis rig) leave too little overlap to tell sway from shape: not estimated.
   double max_stripe_spacing_mm = 16;
@@ -94,9 +94,9 @@ struct SwayOptions {
   // over to other skin, while a sway does.
   std::vector<SwayRegularization> regularizations = {
       {0, false, 0, true},  // no sway
-      {1, false, 0},   // every pair's weight
-      {1, true, 30},   // per axis, the slow part held
-      {0.3, true, 30}, // and the size's weight a third
+      {1, false, 0},        // every pair's weight
+      {1, true, 30},        // per axis, the slow part held
+      {0.3, true, 30},      // and the size's weight a third
   };
   int cv_folds = 5;
   float cv_block_mm = 150;  // the cubes of space dealt out to the folds
@@ -104,19 +104,19 @@ struct SwayOptions {
 };
 
 struct SwayEstimate {
-  int first_frame = 0;                   // frame of knot 0
+  int first_frame = 0;  // frame of knot 0
   int knot_frames = 1;
-  std::vector<Eigen::Vector3d> knots;    // the sway at each knot, mm (mean zero)
-  size_t pairs = 0;                      // point-to-sweep pairs in the last solve
-  int iterations = 0;                    // re-pairings made
-  double last_move_mm = 0;               // the most any knot moved in the last one
-  double radius_mm = 0;                  // the neighbourhood used
-  double stripe_spacing_mm = 0;          // median distance between a sweep's neighbouring stripes
+  std::vector<Eigen::Vector3d> knots;          // the sway at each knot, mm (mean zero)
+  size_t pairs = 0;                            // point-to-sweep pairs in the last solve
+  int iterations = 0;                          // re-pairings made
+  double last_move_mm = 0;                     // the most any knot moved in the last one
+  double radius_mm = 0;                        // the neighbourhood used
+  double stripe_spacing_mm = 0;                // median distance between a sweep's neighbouring stripes
   double rms_before_mm = 0, rms_after_mm = 0;  // of those pairs' distances (robust RMS)
-  double peak_mm = 0;                    // largest |sway| over the knots
-  SwayRegularization regularization;     // the hold taken
-  std::vector<double> held_out_rms_mm;   // each candidate's RMS over the held-out pairs (empty: no choice made)
-  std::string not_estimated;             // when empty(): why (nothing to compare, stripes too far apart)
+  double peak_mm = 0;                          // largest |sway| over the knots
+  SwayRegularization regularization;           // the hold taken
+  std::vector<double> held_out_rms_mm;         // each candidate's RMS over the held-out pairs (empty: no choice made)
+  std::string not_estimated;                   // when empty(): why (nothing to compare, stripes too far apart)
 
   // The sway at `frame` (linear between knots, constant beyond the ends).
   Eigen::Vector3d at(double frame) const;

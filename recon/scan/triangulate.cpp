@@ -32,7 +32,8 @@ std::vector<ColumnRange> stripe_windows(const CameraCalibration& cal, const Lase
       const double db = plane.normal.dot(corners[static_cast<size_t>(b)]) - plane.offset;
       if ((da < 0) == (db < 0) || da == db) continue;
       const double t = da / (da - db);
-      poly.push_back(corners[static_cast<size_t>(a)] + t * (corners[static_cast<size_t>(b)] - corners[static_cast<size_t>(a)]));
+      poly.push_back(corners[static_cast<size_t>(a)] +
+                     t * (corners[static_cast<size_t>(b)] - corners[static_cast<size_t>(a)]));
     }
   std::vector<ColumnRange> rows(static_cast<size_t>(cal.height), ColumnRange{0, 0});
   if (poly.size() < 3) return rows;
@@ -68,8 +69,9 @@ std::vector<ColumnRange> stripe_windows(const CameraCalibration& cal, const Lase
   }
   for (int y = 0; y < cal.height; ++y) {
     if (hi[static_cast<size_t>(y)] < lo[static_cast<size_t>(y)]) continue;
-    rows[static_cast<size_t>(y)] = {std::max(0, static_cast<int>(std::floor(lo[static_cast<size_t>(y)])) - pad),
-                                    std::min(cal.width, static_cast<int>(std::ceil(hi[static_cast<size_t>(y)])) + pad + 1)};
+    rows[static_cast<size_t>(y)] = {
+        std::max(0, static_cast<int>(std::floor(lo[static_cast<size_t>(y)])) - pad),
+        std::min(cal.width, static_cast<int>(std::ceil(hi[static_cast<size_t>(y)])) + pad + 1)};
   }
   return rows;
 }
@@ -87,12 +89,14 @@ StatusOr<std::vector<StripeSample>> extract_plane_stripe(const CameraCalibration
 }
 
 float angle_confidence(double angle_deg, double full_angle_deg) {
-  return static_cast<float>(std::clamp(std::sin(angle_deg * M_PI / 180) / std::sin(full_angle_deg * M_PI / 180), 0.0, 1.0));
+  return static_cast<float>(
+      std::clamp(std::sin(angle_deg * M_PI / 180) / std::sin(full_angle_deg * M_PI / 180), 0.0, 1.0));
 }
 
 size_t triangulate_samples(const CameraCalibration& cal, const LaserPlane& plane,
                            const std::vector<StripeSample>& samples, int full_scale, const PointSource& source,
-                           const TriangulateOptions& options, const std::vector<SweepPlane>& others, PointCloud* cloud) {
+                           const TriangulateOptions& options, const std::vector<SweepPlane>& others,
+                           PointCloud* cloud) {
   const ScanVolume volume = scan_volume(cal.frame);
   const double floor_y = -0.5 * cal.frame.tube;
   size_t added = 0;
@@ -109,7 +113,8 @@ size_t triangulate_samples(const CameraCalibration& cal, const LaserPlane& plane
       if (r.direction.y() < 0) {
         const Eigen::Vector3d q = r.origin + (floor_y - r.origin.y()) / r.direction.y() * r.direction;
         bool ghost = false;
-        for (const SweepPlane& o : others) ghost = ghost || std::abs(o.normal.dot(q) - o.offset) < options.floor_line_mm;
+        for (const SweepPlane& o : others)
+          ghost = ghost || std::abs(o.normal.dot(q) - o.offset) < options.floor_line_mm;
         if (ghost) continue;
       }
     }

@@ -36,7 +36,7 @@ struct TriangulateOptions {
   StripeOptions stripe;
   TriangulationMethod method = TriangulationMethod::kLaserHomography;
   int window_pad_px = 8;
-  int smooth_rows = 5;  // smooth_stripe's half window (0: off)
+  int smooth_rows = 5;   // smooth_stripe's half window (0: off)
   int min_run_rows = 2;  // drop_short_runs before smoothing (1: keep every sample)
   double floor_line_mm = 3;
   // The angle between a pixel's ray and the laser plane: the depth error is the

@@ -16,9 +16,9 @@
 namespace bodyscan {
 
 struct ViewAngleOptions {
-  size_t k = 16;               // neighbours in each point's normal (PCA)
-  double max_view_deg = 70;    // points seen more obliquely than this are dropped
-  double full_view_deg = 45;   // confidence falls with cos(view) beyond this
+  size_t k = 16;              // neighbours in each point's normal (PCA)
+  double max_view_deg = 70;   // points seen more obliquely than this are dropped
+  double full_view_deg = 45;  // confidence falls with cos(view) beyond this
 };
 
 struct ViewAngleResult {

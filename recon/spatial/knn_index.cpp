@@ -1,8 +1,8 @@
 #include "recon/spatial/knn_index.hpp"
 
-#include <nanoflann.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <nanoflann.hpp>
 
 #include <algorithm>
 
@@ -18,8 +18,8 @@ struct PointAdaptor {
     return false;
   }
 };
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointAdaptor>,
-                                                 PointAdaptor, 3, uint32_t>;
+using Tree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointAdaptor>, PointAdaptor, 3, uint32_t>;
 }  // namespace
 
 struct KnnIndex::Impl {
@@ -45,8 +45,7 @@ size_t KnnIndex::knn(const Vec3f& q, size_t k, uint32_t* indices, float* sq_dist
   return rs.size();
 }
 
-std::vector<std::pair<uint32_t, float>> KnnIndex::within_radius(const Vec3f& q,
-                                                                float radius) const {
+std::vector<std::pair<uint32_t, float>> KnnIndex::within_radius(const Vec3f& q, float radius) const {
   std::vector<std::pair<uint32_t, float>> out;
   nanoflann::SearchParams params;
   params.sorted = true;

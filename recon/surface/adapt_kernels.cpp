@@ -22,10 +22,8 @@ std::vector<float> density_sigma(const NeighborGraph& graph, size_t k) {
 }
 
 std::vector<Kernel> adapt_kernels(const std::vector<Vec3f>& points, const LocalFrames& frames,
-                                  const std::vector<float>& sigma_density,
-                                  const CurvatureResult* curvature,
-                                  const std::vector<ShapeOperator>& shape,
-                                  const std::vector<float>& confidence,
+                                  const std::vector<float>& sigma_density, const CurvatureResult* curvature,
+                                  const std::vector<ShapeOperator>& shape, const std::vector<float>& confidence,
                                   const AdaptKernelsOptions& options) {
   const size_t n = points.size();
   std::vector<Kernel> kernels(n);

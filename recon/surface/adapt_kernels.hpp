@@ -28,9 +28,9 @@
 namespace bodyscan {
 
 struct AdaptKernelsOptions {
-  float sigma_user = 1.f;        // tangential size in units of sigma_density
-  float normal_scale = 0.5f;     // sigma_n in units of sigma_density
-  float sharpening = 0.f;        // s; 0 = no curvature adaptation
+  float sigma_user = 1.f;     // tangential size in units of sigma_density
+  float normal_scale = 0.5f;  // sigma_n in units of sigma_density
+  float sharpening = 0.f;     // s; 0 = no curvature adaptation
   float min_sigma_fraction = 0.25f;
   // Bend kernels by the surface's normal curvatures along their axes
   // (implicit_field.hpp), each clamped so that |bend| sigma_t <= max_bend. A round
@@ -55,10 +55,8 @@ std::vector<float> density_sigma(const NeighborGraph& graph, size_t k);
 // tangents), or empty when options.curvature_compensation is off. confidence: empty (all 1) or one per point;
 // points with confidence <= 0 are dropped.
 std::vector<Kernel> adapt_kernels(const std::vector<Vec3f>& points, const LocalFrames& frames,
-                                  const std::vector<float>& sigma_density,
-                                  const CurvatureResult* curvature,
-                                  const std::vector<ShapeOperator>& shape,
-                                  const std::vector<float>& confidence,
+                                  const std::vector<float>& sigma_density, const CurvatureResult* curvature,
+                                  const std::vector<ShapeOperator>& shape, const std::vector<float>& confidence,
                                   const AdaptKernelsOptions& options);
 
 }  // namespace bodyscan

@@ -9,9 +9,9 @@
 // Chernov & Lesort 2005), exact and smooth through kappa = 0.
 #include "recon/surface/estimate_curvature.hpp"
 
-#include <Eigen/Dense>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <Eigen/Dense>
 
 #include <algorithm>
 #include <atomic>
@@ -115,8 +115,7 @@ float fit_circle_curvature(const float* u, const float* h, size_t count, int max
 }
 
 float angle_curvature(const Vec3f& p, const Vec3f& n, const std::vector<Vec3f>& points,
-                      const std::vector<Vec3f>& normals, const uint32_t* neighbours,
-                      size_t count) {
+                      const std::vector<Vec3f>& normals, const uint32_t* neighbours, size_t count) {
   double sum = 0.0;
   size_t used = 0;
   for (size_t i = 0; i < count; ++i) {
@@ -132,8 +131,8 @@ float angle_curvature(const Vec3f& p, const Vec3f& n, const std::vector<Vec3f>& 
   return used ? static_cast<float>(sum / static_cast<double>(used)) : 0.f;
 }
 
-LocalQuadric fit_local_quadric(const std::vector<Vec3f>& points, size_t i, const uint32_t* neighbours,
-                               size_t count, const LocalFrames& frames) {
+LocalQuadric fit_local_quadric(const std::vector<Vec3f>& points, size_t i, const uint32_t* neighbours, size_t count,
+                               const LocalFrames& frames) {
   LocalQuadric q;
   if (count + 1 < 7) return q;
   const Vec3f& p = points[i];
@@ -238,9 +237,8 @@ std::vector<ShapeOperator> estimate_shape_operators(const std::vector<Vec3f>& po
   const size_t n = points.size();
   std::vector<ShapeOperator> s(n);
   if (options.k <= graph.k) {
-    tbb::parallel_for(size_t{0}, n, [&](size_t i) {
-      s[i] = fit_shape_operator(points, i, graph.row(i), options.k, frames);
-    });
+    tbb::parallel_for(size_t{0}, n,
+                      [&](size_t i) { s[i] = fit_shape_operator(points, i, graph.row(i), options.k, frames); });
   } else {
     const size_t k = std::min(options.k, n - 1);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
@@ -284,8 +282,7 @@ std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, con
 }
 
 CurvatureResult estimate_curvature(const std::vector<Vec3f>& points, const NeighborGraph& graph,
-                                   const LocalFrames& frames,
-                                   const EstimateCurvatureOptions& options) {
+                                   const LocalFrames& frames, const EstimateCurvatureOptions& options) {
   const size_t n = points.size();
   const size_t k = std::min(options.k, graph.k);
   CurvatureResult result;
@@ -316,14 +313,11 @@ CurvatureResult estimate_curvature(const std::vector<Vec3f>& points, const Neigh
           h.push_back(d.dot(nrm));
           in_plane.push_back(nb[j]);
         }
-        const float c_angle =
-            angle_curvature(p, nrm, points, frames.normals, in_plane.data(), in_plane.size());
-        const float c_circle = std::abs(fit_circle_curvature(u.data(), h.data(), u.size(),
-                                                             options.max_iterations));
+        const float c_angle = angle_curvature(p, nrm, points, frames.normals, in_plane.data(), in_plane.size());
+        const float c_circle = std::abs(fit_circle_curvature(u.data(), h.data(), u.size(), options.max_iterations));
         const bool unstable =
-            !std::isfinite(c_circle) ||
-            c_circle > options.instability_ratio * c_angle +
-                           1.f / (options.instability_ratio * std::max(radius, 1e-30f));
+            !std::isfinite(c_circle) || c_circle > options.instability_ratio * c_angle +
+                                                       1.f / (options.instability_ratio * std::max(radius, 1e-30f));
         if (unstable && !in_plane.empty()) {
           result.curvature[i][a] = c_angle;
           ++local_fallbacks;

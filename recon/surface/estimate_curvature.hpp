@@ -32,8 +32,8 @@ struct EstimateCurvatureOptions {
 struct CurvatureResult {
   // |curvature| (1 / length unit) of the normal section along tangent1 and tangent2.
   std::vector<Eigen::Vector2f> curvature;
-  size_t circle_fits_used = 0;   // sections where the circle fit was kept
-  size_t angle_fallbacks = 0;    // sections where the angle estimate replaced it
+  size_t circle_fits_used = 0;  // sections where the circle fit was kept
+  size_t angle_fallbacks = 0;   // sections where the angle estimate replaced it
 };
 
 // Circle fit for one section. u: positions along the tangent, h: heights along the
@@ -46,22 +46,21 @@ float fit_circle_curvature(const float* u, const float* h, size_t count, int max
 // The normal-angle curvature estimate (eq. 3.23 divided by the distances, i.e. the
 // mean of eq. 3.22 over the neighbours given), unsigned.
 float angle_curvature(const Vec3f& p, const Vec3f& n, const std::vector<Vec3f>& points,
-                      const std::vector<Vec3f>& normals, const uint32_t* neighbours,
-                      size_t count);
+                      const std::vector<Vec3f>& normals, const uint32_t* neighbours, size_t count);
 
 // A quadric height field h = a u^2 + b uv + c v^2 + d u + e v + f fitted by least
 // squares to a point (at the origin) and its neighbours in its frame (u along
 // tangent1, v along tangent2, h along the normal).
 struct LocalQuadric {
   Eigen::Matrix<double, 6, 1> coef = Eigen::Matrix<double, 6, 1>::Zero();  // a b c d e f
-  double residual_rms = 0.0;  // corrected for the six fitted parameters
+  double residual_rms = 0.0;                                               // corrected for the six fitted parameters
   bool ok = false;
   // Mean curvature, positive where the surface bends away from the normal (convex
   // with outward normals): -(a + c) for a near-level fit.
   double mean_curvature() const { return -(coef[0] + coef[2]); }
 };
-LocalQuadric fit_local_quadric(const std::vector<Vec3f>& points, size_t i, const uint32_t* neighbours,
-                               size_t count, const LocalFrames& frames);
+LocalQuadric fit_local_quadric(const std::vector<Vec3f>& points, size_t i, const uint32_t* neighbours, size_t count,
+                               const LocalFrames& frames);
 
 // A point's shape operator in its own frame: the normal turns by dn = S d for a
 // small step d in the tangent plane, S = [[s11, s12], [s12, s22]] in (tangent1,
@@ -77,7 +76,7 @@ struct MeanCurvatureOptions {
   // Neighbours per quadric fit. Up to graph.k they come from the graph; more are
   // queried from the index (a noisy cloud needs fits as wide as its kernels).
   size_t k = 20;
-  int smoothing_passes = 2;   // neighbour averages of the result
+  int smoothing_passes = 2;  // neighbour averages of the result
   size_t smoothing_k = 10;
 };
 
@@ -112,7 +111,6 @@ std::vector<float> estimate_mean_curvature(const std::vector<Vec3f>& points, con
                                            const MeanCurvatureOptions& options = {});
 
 CurvatureResult estimate_curvature(const std::vector<Vec3f>& points, const NeighborGraph& graph,
-                                   const LocalFrames& frames,
-                                   const EstimateCurvatureOptions& options = {});
+                                   const LocalFrames& frames, const EstimateCurvatureOptions& options = {});
 
 }  // namespace bodyscan

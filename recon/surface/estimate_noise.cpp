@@ -11,17 +11,14 @@
 
 namespace bodyscan {
 
-NoiseEstimate estimate_noise(const std::vector<Vec3f>& points, const KnnIndex& index,
-                             const NeighborGraph& graph, const LocalFrames& frames,
-                             const EstimateNoiseOptions& options) {
+NoiseEstimate estimate_noise(const std::vector<Vec3f>& points, const KnnIndex& index, const NeighborGraph& graph,
+                             const LocalFrames& frames, const EstimateNoiseOptions& options) {
   NoiseEstimate est;
   const size_t n = points.size();
   if (n < 8 || graph.k == 0) return est;
   const size_t samples = std::min(n, options.max_samples);
   const double stride = static_cast<double>(n) / static_cast<double>(samples);
-  auto sample_index = [&](size_t s) {
-    return std::min(n - 1, static_cast<size_t>(static_cast<double>(s) * stride));
-  };
+  auto sample_index = [&](size_t s) { return std::min(n - 1, static_cast<size_t>(static_cast<double>(s) * stride)); };
   std::vector<float> spacing(samples);
   for (size_t s = 0; s < samples; ++s) spacing[s] = graph.row_distances(sample_index(s))[0];
   est.median_spacing = median_in_place(spacing);

@@ -27,13 +27,12 @@ struct EstimateNoiseOptions {
 };
 
 struct NoiseEstimate {
-  float sigma = 0.f;         // per-axis noise standard deviation, the points' unit
+  float sigma = 0.f;           // per-axis noise standard deviation, the points' unit
   float median_spacing = 0.f;  // median distance to the nearest neighbour
   size_t samples = 0;
 };
 
-NoiseEstimate estimate_noise(const std::vector<Vec3f>& points, const KnnIndex& index,
-                             const NeighborGraph& graph,
+NoiseEstimate estimate_noise(const std::vector<Vec3f>& points, const KnnIndex& index, const NeighborGraph& graph,
                              const LocalFrames& frames, const EstimateNoiseOptions& options = {});
 
 }  // namespace bodyscan

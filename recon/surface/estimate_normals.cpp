@@ -3,16 +3,16 @@
 // off-diagonal entry non-negative and tilt every normal. We use the covariance.
 #include "recon/surface/estimate_normals.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 
 namespace bodyscan {
 
-LocalFrames estimate_normals(const std::vector<Vec3f>& points, const KnnIndex& index,
-                             const NeighborGraph& graph, const EstimateNormalsOptions& options) {
+LocalFrames estimate_normals(const std::vector<Vec3f>& points, const KnnIndex& index, const NeighborGraph& graph,
+                             const EstimateNormalsOptions& options) {
   const size_t n = points.size();
   const bool from_graph = options.k <= graph.k;
   const size_t k = from_graph ? options.k : std::min(options.k, n > 0 ? n - 1 : 0);

@@ -39,8 +39,8 @@ struct EstimateNormalsOptions {
 // points: N points, any unit. Neighbours come from `graph` when it has options.k
 // columns, else from `index` (a noisy cloud needs neighbourhoods wider than its
 // noise, more than a graph is worth keeping for). Runs in parallel.
-LocalFrames estimate_normals(const std::vector<Vec3f>& points, const KnnIndex& index,
-                             const NeighborGraph& graph, const EstimateNormalsOptions& options = {});
+LocalFrames estimate_normals(const std::vector<Vec3f>& points, const KnnIndex& index, const NeighborGraph& graph,
+                             const EstimateNormalsOptions& options = {});
 
 // Flips each frame so that (tangent1, tangent2, normal) stays right-handed after the
 // normal's sign was changed.

@@ -30,18 +30,18 @@ constexpr int kMaxCoord = (1 << kCoordBits) - 1;
 //   x  = c1 z1^2 + c2 z2^2                   (bend1^2 t1^2 + bend2^2 t2^2, world)
 //   z3 = z3u + p * 2 / (1 + sqrt(1 - min(1, x)))   (the circle's sag).
 struct Prepared {
-  Eigen::Matrix3f m;   // rows t1/s1, t2/s2, n/sn
+  Eigen::Matrix3f m;  // rows t1/s1, t2/s2, n/sn
   // The visited region lies inside the ellipsoid (x - c)^T A (x - c) <= 2 r^2,
   // A = M^T diag(1, 1, (r / slab)^2) M; per grid layer z its y extent bounds the
   // rows worth looking at (a tilted disk's box is mostly empty).
   float yy = 0.f, yz = 0.f, zz = 0.f;  // y-extent quadratic at fixed z (Schur complement of A)
   Vec3f center;
-  Vec3f half_extent;   // world-axis half size of the visited region
+  Vec3f half_extent;  // world-axis half size of the visited region
   float weight;
   float slab;
   float b1, b2;
   float c1, c2;  // bend_a^2 sigma_t_a^2
-  bool exact;  // the support reaches x > 1/4 (splat_row_body)
+  bool exact;    // the support reaches x > 1/4 (splat_row_body)
 };
 
 // The sag of a sphere of curvature |bend| at tangential distance r (world units),
@@ -127,8 +127,7 @@ template <bool kExact>
 __attribute__((always_inline)) inline void splat_row_body(float* __restrict f, float* __restrict w, int t0, int n,
                                                           float zx, float zy, float zz, float dx, float dy, float dz,
                                                           float b1, float b2, float c1, float c2, float weight,
-                                                          float r2,
-                                                          float slab2) {
+                                                          float r2, float slab2) {
   for (int t = 0; t < n; ++t) {
     const float tf = static_cast<float>(t0 + t);
     const float z1 = zx + tf * dx, z2 = zy + tf * dy, z3u = zz + tf * dz;
@@ -152,14 +151,16 @@ __attribute__((always_inline)) inline void splat_row_body(float* __restrict f, f
 }
 
 __attribute__((target_clones("arch=haswell", "default"))) void splat_row_series(
-    float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx, float dy,
-    float dz, float b1, float b2, float c1, float c2, float weight, float r2, float slab2) {
+    float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx, float dy, float dz,
+    float b1, float b2, float c1, float c2, float weight, float r2, float slab2) {
   splat_row_body<false>(f, w, t0, n, zx, zy, zz, dx, dy, dz, b1, b2, c1, c2, weight, r2, slab2);
 }
 
-__attribute__((target_clones("arch=haswell", "default"))) void splat_row_exact(
-    float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx, float dy,
-    float dz, float b1, float b2, float c1, float c2, float weight, float r2, float slab2) {
+__attribute__((target_clones("arch=haswell", "default"))) void splat_row_exact(float* __restrict f, float* __restrict w,
+                                                                               int t0, int n, float zx, float zy,
+                                                                               float zz, float dx, float dy, float dz,
+                                                                               float b1, float b2, float c1, float c2,
+                                                                               float weight, float r2, float slab2) {
   splat_row_body<true>(f, w, t0, n, zx, zy, zz, dx, dy, dz, b1, b2, c1, c2, weight, r2, slab2);
 }
 
@@ -172,8 +173,8 @@ struct Pair {
 }  // namespace
 
 uint64_t ImplicitField::pack(const Eigen::Vector3i& c) {
-  return (static_cast<uint64_t>(c.z()) << (2 * kCoordBits)) |
-         (static_cast<uint64_t>(c.y()) << kCoordBits) | static_cast<uint64_t>(c.x());
+  return (static_cast<uint64_t>(c.z()) << (2 * kCoordBits)) | (static_cast<uint64_t>(c.y()) << kCoordBits) |
+         static_cast<uint64_t>(c.x());
 }
 
 Eigen::Vector3i ImplicitField::brick_coord(size_t b) const {
@@ -205,11 +206,12 @@ float ImplicitField::weight_at(const Eigen::Vector3i& node) const {
   const long b = find_brick({node.x() >> brick_shift_, node.y() >> brick_shift_, node.z() >> brick_shift_});
   if (b < 0) return 0.f;
   const int m = brick_size_ - 1;
-  return weights(static_cast<size_t>(b))[(node.x() & m) + brick_size_ * ((node.y() & m) + brick_size_ * (node.z() & m))];
+  return weights(
+      static_cast<size_t>(b))[(node.x() & m) + brick_size_ * ((node.y() & m) + brick_size_ * (node.z() & m))];
 }
 
-void ImplicitField::evaluate(const std::vector<Kernel>& kernels, float epsilon, const Vec3d& x,
-                             double* value, double* weight) {
+void ImplicitField::evaluate(const std::vector<Kernel>& kernels, float epsilon, const Vec3d& x, double* value,
+                             double* weight) {
   const double r2 = -2.0 * std::log(static_cast<double>(epsilon));
   const float r = static_cast<float>(std::sqrt(r2));
   double f = 0.0, w = 0.0;
@@ -234,8 +236,7 @@ void ImplicitField::evaluate(const std::vector<Kernel>& kernels, float epsilon, 
   *weight = w;
 }
 
-StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
-                                             const ImplicitFieldOptions& options) {
+StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels, const ImplicitFieldOptions& options) {
   if (!(options.voxel_size > 0.f) || !std::isfinite(options.voxel_size)) {
     return invalid_argument("voxel size must be a positive number");
   }
@@ -275,8 +276,8 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
   field.origin_ = ((lo / h).array().floor() - 1.0).matrix() * h;
   const Vec3d span = (hi - field.origin_) / h;
   if ((span.array() + 2.0 > static_cast<double>(kMaxCoord)).any()) {
-    return out_of_range("the voxel size is too small for the cloud's extent (more than " +
-                        std::to_string(kMaxCoord) + " voxels along an axis)");
+    return out_of_range("the voxel size is too small for the cloud's extent (more than " + std::to_string(kMaxCoord) +
+                        " voxels along an axis)");
   }
 
   // Node range of each kernel's support.
@@ -313,8 +314,7 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
     const Eigen::Vector3i blo = klo[i].array() / bs, bhi = khi[i].array() / bs;
     size_t o = counts[i];
     for (int z = blo.z(); z <= bhi.z(); ++z)
-      for (int y = blo.y(); y <= bhi.y(); ++y)
-        pairs[o++] = {ImplicitField::pack({0, y, z}), static_cast<uint32_t>(i)};
+      for (int y = blo.y(); y <= bhi.y(); ++y) pairs[o++] = {ImplicitField::pack({0, y, z}), static_cast<uint32_t>(i)};
   });
   std::vector<size_t>().swap(counts);
   tbb::parallel_sort(pairs.begin(), pairs.end());
@@ -454,9 +454,10 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
               }
               const size_t b = static_cast<size_t>(brick_of[bx - xmin]);
               const size_t idx = b * per + static_cast<size_t>(row_offset + first);
-              (p.exact ? splat_row_exact : splat_row_series)(field.values_.data() + idx, field.weights_.data() + idx, brick_x + first - lo.x(),
-                        last - first + 1, z0.x(), z0.y(), z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.c1, p.c2, p.weight, r2,
-                        p.slab * p.slab);
+              (p.exact ? splat_row_exact : splat_row_series)(field.values_.data() + idx, field.weights_.data() + idx,
+                                                             brick_x + first - lo.x(), last - first + 1, z0.x(), z0.y(),
+                                                             z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.c1, p.c2,
+                                                             p.weight, r2, p.slab * p.slab);
               gx = seg_end + 1;
             }
           }
@@ -467,7 +468,8 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
     if (options.progress) {
       std::lock_guard<std::mutex> lock(progress_mutex);
       // Under the lock, so that reports never go backwards.
-      last_fraction = std::max(last_fraction, std::min(1.0, 0.1 + 0.9 * static_cast<double>(d) / static_cast<double>(np)));
+      last_fraction =
+          std::max(last_fraction, std::min(1.0, 0.1 + 0.9 * static_cast<double>(d) / static_cast<double>(np)));
       if (!options.progress("field", last_fraction)) stop = true;
     }
   });
@@ -475,8 +477,7 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
   return field;
 }
 
-float median_surface_weight(const ImplicitField& field, const std::vector<Vec3f>& points,
-                            size_t max_samples) {
+float median_surface_weight(const ImplicitField& field, const std::vector<Vec3f>& points, size_t max_samples) {
   if (points.empty()) return 0.f;
   const size_t stride = std::max<size_t>(1, points.size() / std::max<size_t>(1, max_samples));
   std::vector<float> w;

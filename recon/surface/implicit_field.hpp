@@ -66,9 +66,9 @@ struct Kernel {
 };
 
 struct ImplicitFieldOptions {
-  float voxel_size = 1.f;   // grid spacing, the points' unit (> 0)
-  float epsilon = 1e-3f;    // error tolerance of eq. 3.26, in (0, 1)
-  int brick_size = 16;      // nodes per brick side, a power of two in [2, 1024]
+  float voxel_size = 1.f;  // grid spacing, the points' unit (> 0)
+  float epsilon = 1e-3f;   // error tolerance of eq. 3.26, in (0, 1)
+  int brick_size = 16;     // nodes per brick side, a power of two in [2, 1024]
   // Refuse to allocate more than this many bricks (each brick_size^3 * 8 bytes):
   // protects against a voxel size far too small for the cloud.
   size_t max_bricks = 4'000'000;
@@ -102,12 +102,11 @@ class ImplicitField {
   }
 
   // Evaluates the field directly from the kernels at any position (for tests).
-  static void evaluate(const std::vector<Kernel>& kernels, float epsilon, const Vec3d& x,
-                       double* value, double* weight);
+  static void evaluate(const std::vector<Kernel>& kernels, float epsilon, const Vec3d& x, double* value,
+                       double* weight);
 
  private:
-  friend StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>&,
-                                                      const ImplicitFieldOptions&);
+  friend StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>&, const ImplicitFieldOptions&);
   static uint64_t pack(const Eigen::Vector3i& c);
   float voxel_size_ = 1.f;
   int brick_size_ = 8;
@@ -124,11 +123,9 @@ class ImplicitField {
 // points overlaps anywhere on the surface and this median is a scale for the whole
 // field: a zero crossing where W is far below it lies in the tails of a few
 // kernels, where the sum's sign is noise, not surface. 0 when no point has weight.
-float median_surface_weight(const ImplicitField& field, const std::vector<Vec3f>& points,
-                            size_t max_samples = 20000);
+float median_surface_weight(const ImplicitField& field, const std::vector<Vec3f>& points, size_t max_samples = 20000);
 
 // Sums every kernel into a sparse grid. Runs in parallel over bricks.
-StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
-                                             const ImplicitFieldOptions& options);
+StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels, const ImplicitFieldOptions& options);
 
 }  // namespace bodyscan

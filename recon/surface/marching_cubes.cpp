@@ -31,9 +31,7 @@ int edge_faces(int e) {
 }
 
 // True when three cube edges all lie on one face of the cube.
-bool edges_share_face(int e0, int e1, int e2) {
-  return (edge_faces(e0) & edge_faces(e1) & edge_faces(e2)) != 0;
-}
+bool edges_share_face(int e0, int e1, int e2) { return (edge_faces(e0) & edge_faces(e1) & edge_faces(e2)) != 0; }
 
 using CaseTable = std::array<std::vector<std::array<uint8_t, 3>>, 256>;
 
@@ -130,8 +128,7 @@ std::array<long, 8> neighbours(const ImplicitField& field, size_t b) {
   const Eigen::Vector3i c = field.brick_coord(b);
   std::array<long, 8> nb;
   for (int i = 0; i < 8; ++i) {
-    nb[i] = i == 0 ? static_cast<long>(b)
-                   : field.find_brick(c + Eigen::Vector3i(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+    nb[i] = i == 0 ? static_cast<long>(b) : field.find_brick(c + Eigen::Vector3i(i & 1, (i >> 1) & 1, (i >> 2) & 1));
   }
   return nb;
 }
@@ -143,8 +140,7 @@ const std::vector<std::array<uint8_t, 3>>& marching_cubes_case(uint8_t inside_ma
   return table[inside_mask];
 }
 
-StatusOr<TriangleMesh> extract_isosurface(const ImplicitField& field,
-                                          const MarchingCubesOptions& options) {
+StatusOr<TriangleMesh> extract_isosurface(const ImplicitField& field, const MarchingCubesOptions& options) {
   const size_t nb = field.num_bricks();
   const int bs = field.brick_size();
   const float min_w = std::max(options.min_weight, std::numeric_limits<float>::min());

@@ -37,7 +37,6 @@ struct MarchingCubesOptions {
 // a+1, a+2 mod 3). `inside_mask` bit v is set when corner v is inside (field > 0).
 const std::vector<std::array<uint8_t, 3>>& marching_cubes_case(uint8_t inside_mask);
 
-StatusOr<TriangleMesh> extract_isosurface(const ImplicitField& field,
-                                          const MarchingCubesOptions& options = {});
+StatusOr<TriangleMesh> extract_isosurface(const ImplicitField& field, const MarchingCubesOptions& options = {});
 
 }  // namespace bodyscan

@@ -79,8 +79,7 @@ OrientNormalsResult orient_normals_mst(const std::vector<Vec3f>& points, const N
   // highest point of a component not reached yet.
   std::vector<uint32_t> by_height(n);
   std::iota(by_height.begin(), by_height.end(), 0u);
-  std::sort(by_height.begin(), by_height.end(),
-            [&](uint32_t a, uint32_t b) { return points[a].y() > points[b].y(); });
+  std::sort(by_height.begin(), by_height.end(), [&](uint32_t a, uint32_t b) { return points[a].y() > points[b].y(); });
 
   std::vector<uint8_t> visited(n, 0);
   std::vector<uint8_t> flipped(n, 0);

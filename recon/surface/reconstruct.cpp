@@ -30,8 +30,7 @@ const char* to_string(NormalSource s) {
 }
 
 bool parse_normal_source(const std::string& text, NormalSource* out) {
-  for (NormalSource s : {NormalSource::kAuto, NormalSource::kInput, NormalSource::kCameras,
-                         NormalSource::kMst}) {
+  for (NormalSource s : {NormalSource::kAuto, NormalSource::kInput, NormalSource::kCameras, NormalSource::kMst}) {
     if (text == to_string(s)) {
       *out = s;
       return true;
@@ -43,14 +42,11 @@ bool parse_normal_source(const std::string& text, NormalSource* out) {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 }  // namespace
 
-StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
-                                                const ReconstructOptions& options) {
+StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input, const ReconstructOptions& options) {
   if (!input.is_consistent()) {
     return invalid_argument("point cloud attributes do not have one entry per point");
   }
@@ -100,7 +96,7 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
 
   NormalSource source = options.normal_source;
   if (source == NormalSource::kAuto) {
-    source = cloud->has_normals() ? NormalSource::kInput
+    source = cloud->has_normals()   ? NormalSource::kInput
              : cloud->has_cameras() ? NormalSource::kCameras
                                     : NormalSource::kMst;
   }
@@ -175,10 +171,10 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   // the sum a mode finder, and on a curved surface, where more points lie on the
   // convex side, the mode sits outside (16384 points at s = 0.1: bias 0.075 at
   // sigma_n = 1 density sigma, 0.012 at 5).
-  st.sigma_scale = options.sigma_scale > 0.f ? options.sigma_scale
-                                              : std::clamp(1.0f + 1.5f * eta + 1.5f * eta * eta, 1.0f, 1.5f);
+  st.sigma_scale =
+      options.sigma_scale > 0.f ? options.sigma_scale : std::clamp(1.0f + 1.5f * eta + 1.5f * eta * eta, 1.0f, 1.5f);
   st.normal_scale = options.normal_scale > 0.f ? options.normal_scale
-                                                : std::clamp(std::max(0.6f + 0.9f * eta, 3.f * eta), 0.6f, 6.0f);
+                                               : std::clamp(std::max(0.6f + 0.9f * eta, 3.f * eta), 0.6f, 6.0f);
   st.sharpening = options.sharpening;
   CurvatureResult curvature;
   if (options.sharpening != 0.f) curvature = estimate_curvature(pts, graph, frames);
@@ -189,9 +185,8 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
   ko.curvature_compensation = options.curvature_compensation;
   ko.noise_sigma = st.noise_sigma;
   // The voxel must resolve the thinnest kernel across the surface.
-  st.voxel_size = options.voxel_size > 0.f
-                      ? options.voxel_size
-                      : 0.7f * st.median_density_sigma * std::min(1.f, st.normal_scale);
+  st.voxel_size =
+      options.voxel_size > 0.f ? options.voxel_size : 0.7f * st.median_density_sigma * std::min(1.f, st.normal_scale);
   ko.band = options.band_voxels > 0.f ? options.band_voxels * st.voxel_size + 3.f * st.noise_sigma : 0.f;
   std::vector<ShapeOperator> shape;
   if (options.curvature_compensation) {
@@ -261,8 +256,8 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input,
     // The field reaches past its data at creases and thin gaps (its kernels' planes
     // run on beyond them) and stops where the weight runs out, leaving open flaps
     // a few kernel widths long; peel those back to the data, then close every loop.
-    const float reach = options.hole_trim_distance > 0.f ? options.hole_trim_distance
-                                                         : st.median_density_sigma + 3.f * st.noise_sigma;
+    const float reach =
+        options.hole_trim_distance > 0.f ? options.hole_trim_distance : st.median_density_sigma + 3.f * st.noise_sigma;
     const float reach2 = reach * reach;
     st.flap_triangles_trimmed = trim_boundary_flaps(result.mesh, [&](uint32_t v) {
       uint32_t nearest = 0;

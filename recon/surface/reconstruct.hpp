@@ -34,9 +34,9 @@ const char* to_string(NormalSource s);
 bool parse_normal_source(const std::string& text, NormalSource* out);
 
 struct ReconstructOptions {
-  float sigma_scale = 0.f;    // sigma_user, tangential kernel size / density (0 = auto)
-  float normal_scale = 0.f;   // sigma_n / density (0 = auto)
-  float sharpening = 0.f;     // s of eq. 3.24 (0 = none)
+  float sigma_scale = 0.f;   // sigma_user, tangential kernel size / density (0 = auto)
+  float normal_scale = 0.f;  // sigma_n / density (0 = auto)
+  float sharpening = 0.f;    // s of eq. 3.24 (0 = none)
   // Bend kernels by the local mean curvature (removes the thesis kernel's
   // curvature bias; implicit_field.hpp). Off = the thesis's flat kernels.
   bool curvature_compensation = true;
@@ -49,10 +49,10 @@ struct ReconstructOptions {
   // cameras saw), its kernel is bent by the shape operator fitted again to the
   // carried normals. 0 = every kernel keeps the PCA normals' operator.
   float edge_refit_offset = 0.6f;
-  float voxel_size = 0.f;     // grid spacing in the cloud's unit (0 = auto)
-  float epsilon = 1e-2f;      // kernel cut-off tolerance, eq. 3.26
-  size_t density_k = 10;      // neighbours of eq. 3.17
-  size_t normal_k = 0;        // neighbours per PCA normal (0 = auto from the noise)
+  float voxel_size = 0.f;  // grid spacing in the cloud's unit (0 = auto)
+  float epsilon = 1e-2f;   // kernel cut-off tolerance, eq. 3.26
+  size_t density_k = 10;   // neighbours of eq. 3.17
+  size_t normal_k = 0;     // neighbours per PCA normal (0 = auto from the noise)
   NormalSource normal_source = NormalSource::kAuto;
   bool use_confidence = true;  // weight kernels by the cloud's per-point confidence
   // Points whose density sigma (eq. 3.17) exceeds this many times the median are
@@ -89,8 +89,8 @@ struct ReconstructOptions {
 
 struct ReconstructStats {
   size_t input_points = 0;
-  size_t used_points = 0;           // points with positive confidence
-  size_t isolated_points = 0;       // of those, dropped as isolated strays
+  size_t used_points = 0;                      // points with positive confidence
+  size_t isolated_points = 0;                  // of those, dropped as isolated strays
   NormalSource normals = NormalSource::kAuto;  // what was used
   size_t orientation_components = 0;
   float median_density_sigma = 0.f;  // median of eq. 3.17, the cloud's unit
@@ -106,9 +106,7 @@ struct ReconstructStats {
   double hole_area = 0.0;  // area of the fill, the cloud's unit squared
   // Wall-clock seconds per stage.
   double t_neighbours = 0, t_normals = 0, t_orientation = 0, t_kernels = 0, t_field = 0, t_mesh = 0;
-  double total_seconds() const {
-    return t_neighbours + t_normals + t_orientation + t_kernels + t_field + t_mesh;
-  }
+  double total_seconds() const { return t_neighbours + t_normals + t_orientation + t_kernels + t_field + t_mesh; }
 };
 
 struct ReconstructResult {
@@ -116,7 +114,6 @@ struct ReconstructResult {
   ReconstructStats stats;
 };
 
-StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& cloud,
-                                                const ReconstructOptions& options = {});
+StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& cloud, const ReconstructOptions& options = {});
 
 }  // namespace bodyscan

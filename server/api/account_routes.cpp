@@ -12,8 +12,8 @@ nlohmann::json account_json(const Account& a) {
 
 std::string cookie(const std::string& value, int64_t max_age, bool secure) {
   // HttpOnly: scripts never see it; SameSite=Strict: no other site's page sends it.
-  return std::string(kSessionCookie) + "=" + value + "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
-         std::to_string(max_age) + (secure ? "; Secure" : "");
+  return std::string(kSessionCookie) + "=" + value +
+         "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" + std::to_string(max_age) + (secure ? "; Secure" : "");
 }
 
 bool secure(const ApiOptions& o, const HttpRequest& r) { return o.secure_cookies || r.secure; }
@@ -21,32 +21,30 @@ bool secure(const ApiOptions& o, const HttpRequest& r) { return o.secure_cookies
 }  // namespace
 
 void add_account_routes(std::vector<Api::Route>* routes, const ApiOptions& options) {
-  routes->push_back({"POST", "/api/login", kAnyone, [options](Workstation& ws, const Call& call) {
-                       HttpResponse error;
-                       auto body = json_body(call, &error);
-                       if (!body) return error;
-                       if (!(*body)["username"].is_string() || !(*body)["password"].is_string())
-                         return error_response(400, "give 'username' and 'password'");
-                       const LoginResult r = ws.auth().login((*body)["username"], (*body)["password"],
-                                                             call.request.remote_address);
-                       if (r.outcome == LoginResult::kRateLimited) {
-                         HttpResponse out = error_response(429, "too many failed attempts; try again in " +
-                                                                    std::to_string(r.retry_after_s) + " s");
-                         out.set("Retry-After", std::to_string(r.retry_after_s));
-                         return out;
-                       }
-                       if (r.outcome == LoginResult::kError) return error_response(r.error);
-                       if (r.outcome != LoginResult::kOk) return error_response(401, "wrong username or password");
-                       ws.archive().log(r.session.username, "log in", "account", r.session.username,
-                                        call.request.remote_address);
-                       HttpResponse out = json_response(200, {{"username", r.session.username},
-                                                              {"role", to_string(r.session.role)},
-                                                              {"csrf_token", r.session.csrf_token},
-                                                              {"expires_at", r.session.expires_at}});
-                       out.set("Set-Cookie", cookie(r.token, ws.options().auth.session_lifetime_s,
-                                                    secure(options, call.request)));
-                       return out;
-                     }});
+  routes->push_back(
+      {"POST", "/api/login", kAnyone, [options](Workstation& ws, const Call& call) {
+         HttpResponse error;
+         auto body = json_body(call, &error);
+         if (!body) return error;
+         if (!(*body)["username"].is_string() || !(*body)["password"].is_string())
+           return error_response(400, "give 'username' and 'password'");
+         const LoginResult r = ws.auth().login((*body)["username"], (*body)["password"], call.request.remote_address);
+         if (r.outcome == LoginResult::kRateLimited) {
+           HttpResponse out =
+               error_response(429, "too many failed attempts; try again in " + std::to_string(r.retry_after_s) + " s");
+           out.set("Retry-After", std::to_string(r.retry_after_s));
+           return out;
+         }
+         if (r.outcome == LoginResult::kError) return error_response(r.error);
+         if (r.outcome != LoginResult::kOk) return error_response(401, "wrong username or password");
+         ws.archive().log(r.session.username, "log in", "account", r.session.username, call.request.remote_address);
+         HttpResponse out = json_response(200, {{"username", r.session.username},
+                                                {"role", to_string(r.session.role)},
+                                                {"csrf_token", r.session.csrf_token},
+                                                {"expires_at", r.session.expires_at}});
+         out.set("Set-Cookie", cookie(r.token, ws.options().auth.session_lifetime_s, secure(options, call.request)));
+         return out;
+       }});
   routes->push_back({"POST", "/api/logout", kStaff, [options](Workstation& ws, const Call& call) {
                        ws.auth().logout(session_cookie(call.request));
                        HttpResponse out;

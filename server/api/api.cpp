@@ -94,8 +94,7 @@ std::optional<nlohmann::json> json_body(const Call& call, HttpResponse* error) {
     *error = error_response(415, "send the request body as application/json");
     return std::nullopt;
   }
-  nlohmann::json j = call.request.body.empty() ? nlohmann::json::object()
-                                               : parse_json(call.request.body);
+  nlohmann::json j = call.request.body.empty() ? nlohmann::json::object() : parse_json(call.request.body);
   if (j.is_discarded() || !j.is_object()) {
     *error = error_response(400, "the request body is not a JSON object");
     return std::nullopt;
@@ -104,8 +103,7 @@ std::optional<nlohmann::json> json_body(const Call& call, HttpResponse* error) {
 }
 
 Api::Api(Workstation& ws, ApiOptions options) : ws_(ws), options_(std::move(options)) {
-  routes_.push_back({"GET", "/api/health", kAnyone,
-                     [](Workstation&, const Call&) {
+  routes_.push_back({"GET", "/api/health", kAnyone, [](Workstation&, const Call&) {
                        return json_response(200, {{"status", "ok"}, {"service", "bodyscan"}});
                      }});
   routes_.push_back({"GET", "/api/openapi.json", kAnyone, [](Workstation&, const Call&) {

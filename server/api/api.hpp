@@ -39,9 +39,9 @@ struct Call {
 };
 
 struct ApiOptions {
-  std::string web_root;       // the UI's static files
+  std::string web_root;         // the UI's static files
   bool secure_cookies = false;  // Secure on the session cookie (TLS here or at a proxy)
-  std::string public_url;     // share links' base, e.g. "https://scanner.shop.example"; "" from Host
+  std::string public_url;       // share links' base, e.g. "https://scanner.shop.example"; "" from Host
 };
 
 class Api {
@@ -52,7 +52,7 @@ class Api {
     std::string pattern;  // "/api/scans/{id}/mesh.glb"
     unsigned access = 0;  // Access bits
     Handler handler;
-    bool csrf = true;     // state-changing staff requests must carry the CSRF token
+    bool csrf = true;  // state-changing staff requests must carry the CSRF token
   };
 
   Api(Workstation& ws, ApiOptions options);

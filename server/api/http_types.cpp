@@ -136,7 +136,8 @@ bool parse_target(const std::string& target, std::string* path, std::map<std::st
     if (pair.empty()) continue;
     const size_t eq = pair.find('=');
     const auto k = percent_decode(pair.substr(0, eq), true);
-    const auto v = eq == std::string_view::npos ? std::optional<std::string>("") : percent_decode(pair.substr(eq + 1), true);
+    const auto v =
+        eq == std::string_view::npos ? std::optional<std::string>("") : percent_decode(pair.substr(eq + 1), true);
     if (!k || !v) return false;
     (*query)[*k] = *v;
   }

@@ -15,9 +15,9 @@
 namespace bodyscan::server {
 
 struct HttpRequest {
-  std::string method;  // "GET", "POST", ...
-  std::string target;  // as sent: "/api/scans?customer=c_1"
-  std::string path;    // the target's path, percent-decoded: "/api/scans"
+  std::string method;                          // "GET", "POST", ...
+  std::string target;                          // as sent: "/api/scans?customer=c_1"
+  std::string path;                            // the target's path, percent-decoded: "/api/scans"
   std::map<std::string, std::string> query;    // decoded
   std::map<std::string, std::string> headers;  // names in lower case
   std::string body;

@@ -16,8 +16,8 @@ HttpResponse accepted(const JobInfo& j) {
 }  // namespace
 
 void add_rig_routes(std::vector<Api::Route>* routes) {
-  routes->push_back({"GET", "/api/rig", kStaff,
-                     [](Workstation& ws, const Call&) { return json_response(200, ws.rig_status()); }});
+  routes->push_back(
+      {"GET", "/api/rig", kStaff, [](Workstation& ws, const Call&) { return json_response(200, ws.rig_status()); }});
   routes->push_back({"POST", "/api/rig/calibrate", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
                        auto j = ws.start_calibration(call.actor());
                        if (!j.ok()) return error_response(j.status());
@@ -38,7 +38,8 @@ void add_rig_routes(std::vector<Api::Route>* routes) {
                        if (body->contains("customer_id") == body->contains("customer"))
                          return error_response(400, "give either 'customer_id' or a new 'customer' {name, contact}");
                        if (body->contains("customer_id")) {
-                         if (!(*body)["customer_id"].is_string()) return error_response(400, "'customer_id' is a string");
+                         if (!(*body)["customer_id"].is_string())
+                           return error_response(400, "'customer_id' is a string");
                          req.customer_id = (*body)["customer_id"];
                        }
                        // The rig must be free before a customer record is made for the scan.
@@ -47,7 +48,8 @@ void add_rig_routes(std::vector<Api::Route>* routes) {
                                                         " (job " + running->id + ")");
                        if (body->contains("customer")) {
                          const nlohmann::json& c = (*body)["customer"];
-                         if (!c.is_object()) return error_response(400, "'customer' is {\"name\": ..., \"contact\": ...}");
+                         if (!c.is_object())
+                           return error_response(400, "'customer' is {\"name\": ..., \"contact\": ...}");
                          auto text = [&](const char* k) -> std::optional<std::string> {
                            if (!c.contains(k) || c[k].is_null()) return std::nullopt;
                            return c[k].is_string() ? std::optional<std::string>(c[k].get<std::string>()) : std::nullopt;

@@ -17,8 +17,10 @@ namespace bodyscan::server {
 namespace {
 
 nlohmann::json customer_json(const storage::Customer& c) {
-  return {{"id", c.id}, {"name", c.name ? nlohmann::json(*c.name) : nlohmann::json()},
-          {"contact", c.contact ? nlohmann::json(*c.contact) : nlohmann::json()}, {"created_at", c.created_at}};
+  return {{"id", c.id},
+          {"name", c.name ? nlohmann::json(*c.name) : nlohmann::json()},
+          {"contact", c.contact ? nlohmann::json(*c.contact) : nlohmann::json()},
+          {"created_at", c.created_at}};
 }
 
 nlohmann::json scan_json(const storage::ScanRecord& r) {
@@ -47,10 +49,17 @@ nlohmann::json scan_json(const storage::ScanRecord& r) {
 }  // namespace
 
 nlohmann::json measurement_json(const storage::MeasurementRecord& m) {
-  return {{"id", m.id},       {"version", m.version},       {"source", m.source},
-          {"name", m.name},   {"label", m.label},           {"kind", m.kind},
-          {"iso_clause", m.iso_clause}, {"value_mm", m.value_mm}, {"geometry", m.geometry},
-          {"created_by", m.created_by}, {"created_at", m.created_at}};
+  return {{"id", m.id},
+          {"version", m.version},
+          {"source", m.source},
+          {"name", m.name},
+          {"label", m.label},
+          {"kind", m.kind},
+          {"iso_clause", m.iso_clause},
+          {"value_mm", m.value_mm},
+          {"geometry", m.geometry},
+          {"created_by", m.created_by},
+          {"created_at", m.created_at}};
 }
 
 // A scan's result file, served from the archive. The current version revalidates
@@ -75,8 +84,8 @@ HttpResponse scan_file(Workstation& ws, const std::string& scan_id, const std::s
       for (const storage::ArchivedFile& f : v.files)
         if (f.name == name) etag = "\"" + f.blake2b.substr(0, 32) + "\"";
   HttpResponse out;
-  out.set("Content-Type", name.size() > 4 && name.substr(name.size() - 4) == ".glb" ? "model/gltf-binary"
-                                                                                     : "application/octet-stream");
+  out.set("Content-Type",
+          name.size() > 4 && name.substr(name.size() - 4) == ".glb" ? "model/gltf-binary" : "application/octet-stream");
   out.set("ETag", etag);
   out.set("Cache-Control", version ? "private, max-age=31536000, immutable" : "private, no-cache");
   if (!etag.empty() && if_none_match == etag) {
@@ -228,34 +237,34 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                        return r;
                      }});
   for (const char* name : {"mesh.glb", "points.drc"}) {
-    routes->push_back({"GET", std::string("/api/scans/{id}/") + name, kStaff, [name](Workstation& ws, const Call& call) {
-                         return scan_file(ws, call.params.at("id"), name, call.request.param("version"),
-                                          call.request.header("if-none-match"));
-                       }});
+    routes->push_back(
+        {"GET", std::string("/api/scans/{id}/") + name, kStaff, [name](Workstation& ws, const Call& call) {
+           return scan_file(ws, call.params.at("id"), name, call.request.param("version"),
+                            call.request.header("if-none-match"));
+         }});
   }
-  routes->push_back({"GET", "/api/scans/{id}/measurements", kStaff, [](Workstation& ws, const Call& call) {
-                       const std::string& id = call.params.at("id");
-                       auto text = ws.cached_text("measurements/" + id, [&]() -> StatusOr<std::string> {
-                         ASSIGN_OR_RETURN(storage::ScanRecord r, ws.archive().scan(id));
-                         ASSIGN_OR_RETURN(std::vector<storage::MeasurementRecord> ms, ws.archive().measurements(id));
-                         nlohmann::json out = nlohmann::json::array();
-                         for (const auto& m : ms) out.push_back(measurement_json(m));
-                         // How the customer stood, as the measurements read it (scan.json).
-                         nlohmann::json posture = nullptr;
-                         if (auto path = ws.archive().file_path(id, 0, "scan.json"); path.ok())
-                           if (auto scan = read_whole_file(*path); scan.ok()) {
-                             const nlohmann::json j = parse_json(*scan);
-                             if (j.is_object() && j.contains("posture")) posture = j["posture"];
-                           }
-                         return nlohmann::json{{"scan_id", id},
-                                               {"version", r.current_version},
-                                               {"measurements", out},
-                                               {"posture", posture}}
-                             .dump();
-                       });
-                       if (!text.ok()) return error_response(text.status());
-                       return cached_json(**text, call.request);
-                     }});
+  routes->push_back(
+      {"GET", "/api/scans/{id}/measurements", kStaff, [](Workstation& ws, const Call& call) {
+         const std::string& id = call.params.at("id");
+         auto text = ws.cached_text("measurements/" + id, [&]() -> StatusOr<std::string> {
+           ASSIGN_OR_RETURN(storage::ScanRecord r, ws.archive().scan(id));
+           ASSIGN_OR_RETURN(std::vector<storage::MeasurementRecord> ms, ws.archive().measurements(id));
+           nlohmann::json out = nlohmann::json::array();
+           for (const auto& m : ms) out.push_back(measurement_json(m));
+           // How the customer stood, as the measurements read it (scan.json).
+           nlohmann::json posture = nullptr;
+           if (auto path = ws.archive().file_path(id, 0, "scan.json"); path.ok())
+             if (auto scan = read_whole_file(*path); scan.ok()) {
+               const nlohmann::json j = parse_json(*scan);
+               if (j.is_object() && j.contains("posture")) posture = j["posture"];
+             }
+           return nlohmann::json{
+               {"scan_id", id}, {"version", r.current_version}, {"measurements", out}, {"posture", posture}}
+               .dump();
+         });
+         if (!text.ok()) return error_response(text.status());
+         return cached_json(**text, call.request);
+       }});
   routes->push_back({"POST", "/api/scans/{id}/measure", kStaff, [](Workstation& ws, const Call& call) {
                        HttpResponse error;
                        auto body = json_body(call, &error);
@@ -306,16 +315,16 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                        rec.id = *saved;
                        return json_response(201, measurement_json(rec));
                      }});
-  routes->push_back({"DELETE", "/api/scans/{id}/measurements/{mid}", kTailor | kAdmin,
-                     [](Workstation& ws, const Call& call) {
-                       const std::string& mid = call.params.at("mid");
-                       char* end = nullptr;
-                       const long long n = std::strtoll(mid.c_str(), &end, 10);
-                       if (*end != '\0' || n < 1) return error_response(404, "no measurement " + mid);
-                       const Status st = ws.archive().delete_measurement(call.params.at("id"), n, call.actor());
-                       if (!st.ok()) return error_response(st);
-                       return no_content();
-                     }});
+  routes->push_back(
+      {"DELETE", "/api/scans/{id}/measurements/{mid}", kTailor | kAdmin, [](Workstation& ws, const Call& call) {
+         const std::string& mid = call.params.at("mid");
+         char* end = nullptr;
+         const long long n = std::strtoll(mid.c_str(), &end, 10);
+         if (*end != '\0' || n < 1) return error_response(404, "no measurement " + mid);
+         const Status st = ws.archive().delete_measurement(call.params.at("id"), n, call.actor());
+         if (!st.ok()) return error_response(st);
+         return no_content();
+       }});
   for (const char* format : {"csv", "json", "pdf"}) {
     routes->push_back({"GET", std::string("/api/scans/{id}/sheet.") + format, kStaff,
                        [format](Workstation& ws, const Call& call) { return sheet(ws, call, format); }});

@@ -38,7 +38,8 @@ void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options
                        const std::string& id = call.params.at("id");
                        auto r = ws.archive().scan(id);
                        if (!r.ok()) return error_response(r.status());
-                       if (r->current_version == 0) return error_response(409, "scan " + id + " has no results to share");
+                       if (r->current_version == 0)
+                         return error_response(409, "scan " + id + " has no results to share");
                        const nlohmann::json days = body->value("days", nlohmann::json(30));
                        if (!days.is_number() || !(days.get<double>() > 0) || days.get<double>() > 365)
                          return error_response(400, "'days' is how long the link works: more than 0, at most 365");
@@ -76,31 +77,31 @@ void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options
                        return out;
                      }});
   // The customer's side: the token is the only key, and it opens one scan.
-  routes->push_back({"GET", "/api/share/{token}", kShareLink, [](Workstation& ws, const Call& call) {
-                       const ShareLink& link = *call.share;
-                       auto r = ws.archive().scan(link.scan_id);
-                       if (!r.ok()) return error_response(404, "this link is not valid");
-                       auto ms = ws.archive().measurements(link.scan_id);
-                       if (!ms.ok()) return error_response(ms.status());
-                       nlohmann::json shown = nlohmann::json::array();
-                       for (const auto& m : *ms)
-                         if (std::find(link.measurements.begin(), link.measurements.end(), m.name) !=
-                             link.measurements.end()) {
-                           nlohmann::json j = measurement_json(m);
-                           j.erase("created_by");  // staff names stay in the shop
-                           j.erase("id");
-                           shown.push_back(j);
-                         }
-                       HttpResponse out = json_response(200, {{"taken_at", r->started_at},
-                                                              {"expires_at", link.expires_at},
-                                                              {"measurements", shown},
-                                                              {"mesh", "/api/share/" + call.params.at("token") + "/mesh.glb"}});
-                       out.set("Referrer-Policy", "no-referrer");
-                       return out;
-                     }});
+  routes->push_back(
+      {"GET", "/api/share/{token}", kShareLink, [](Workstation& ws, const Call& call) {
+         const ShareLink& link = *call.share;
+         auto r = ws.archive().scan(link.scan_id);
+         if (!r.ok()) return error_response(404, "this link is not valid");
+         auto ms = ws.archive().measurements(link.scan_id);
+         if (!ms.ok()) return error_response(ms.status());
+         nlohmann::json shown = nlohmann::json::array();
+         for (const auto& m : *ms)
+           if (std::find(link.measurements.begin(), link.measurements.end(), m.name) != link.measurements.end()) {
+             nlohmann::json j = measurement_json(m);
+             j.erase("created_by");  // staff names stay in the shop
+             j.erase("id");
+             shown.push_back(j);
+           }
+         HttpResponse out = json_response(200, {{"taken_at", r->started_at},
+                                                {"expires_at", link.expires_at},
+                                                {"measurements", shown},
+                                                {"mesh", "/api/share/" + call.params.at("token") + "/mesh.glb"}});
+         out.set("Referrer-Policy", "no-referrer");
+         return out;
+       }});
   routes->push_back({"GET", "/api/share/{token}/mesh.glb", kShareLink, [](Workstation& ws, const Call& call) {
-                       HttpResponse out = scan_file(ws, call.share->scan_id, "mesh.glb", "",
-                                                    call.request.header("if-none-match"));
+                       HttpResponse out =
+                           scan_file(ws, call.share->scan_id, "mesh.glb", "", call.request.header("if-none-match"));
                        out.set("Referrer-Policy", "no-referrer");
                        return out;
                      }});

@@ -116,7 +116,8 @@ HttpResponse serve_static(const std::string& web_root, const HttpRequest& reques
     file = root / "index.html";
   }
   const fs::path real = fs::canonical(file, ec);
-  if (ec || !under(root, real) || !fs::is_regular_file(real, ec)) return error_response(404, "no such file: " + request.path);
+  if (ec || !under(root, real) || !fs::is_regular_file(real, ec))
+    return error_response(404, "no such file: " + request.path);
   // The UI's build leaves a .gz twin beside each large text or wasm file; a
   // browser that takes gzip gets it, the rest the file itself.
   const fs::path twin = real.string() + ".gz";
@@ -134,8 +135,10 @@ HttpResponse serve_static(const std::string& web_root, const HttpRequest& reques
   r.set("X-Content-Type-Options", "nosniff");
   if (has_twin) r.set("Vary", "Accept-Encoding");
   if (gzip) r.set("Content-Encoding", "gzip");
-  if (rel.rfind("assets/", 0) == 0) r.set("Cache-Control", "public, max-age=31536000, immutable");
-  else r.set("Cache-Control", "no-cache");
+  if (rel.rfind("assets/", 0) == 0)
+    r.set("Cache-Control", "public, max-age=31536000, immutable");
+  else
+    r.set("Cache-Control", "no-cache");
   if (real.extension() == ".html") {
     // The UI's page: its own scripts only (and the Draco decoder's wasm and
     // worker), no framing, and no Referer: a share link's token never leaves in one.

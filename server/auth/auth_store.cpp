@@ -29,12 +29,9 @@ using storage::Transaction;
 
 const char* to_string(Role r) {
   switch (r) {
-    case Role::kOperator:
-      return "operator";
-    case Role::kTailor:
-      return "tailor";
-    case Role::kAdmin:
-      return "admin";
+    case Role::kOperator: return "operator";
+    case Role::kTailor: return "tailor";
+    case Role::kAdmin: return "admin";
   }
   return "?";
 }
@@ -64,12 +61,8 @@ constexpr size_t kMaxMeasurementName = 200;
 constexpr size_t kMaxMeasurements = 1000;
 
 int64_t system_now() {
-  return std::chrono::duration_cast<std::chrono::seconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
-
-
 
 constexpr int kBase64Url = sodium_base64_VARIANT_URLSAFE_NO_PADDING;
 
@@ -89,8 +82,7 @@ std::string random_token(size_t bytes) {
 bool well_formed_token(const std::string& token, size_t bytes) {
   if (token.size() != base64url_chars(bytes)) return false;
   return std::all_of(token.begin(), token.end(), [](char c) {
-    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' ||
-           c == '_';
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
   });
 }
 
@@ -98,8 +90,7 @@ bool well_formed_token(const std::string& token, size_t bytes) {
 // random bits, so a fast unsalted hash is enough: there is nothing to guess.
 std::string token_hash(const std::string& token) {
   unsigned char h[32];
-  crypto_generichash(h, sizeof h, reinterpret_cast<const unsigned char*>(token.data()),
-                     token.size(), nullptr, 0);
+  crypto_generichash(h, sizeof h, reinterpret_cast<const unsigned char*>(token.data()), token.size(), nullptr, 0);
   char hex[65];
   sodium_bin2hex(hex, sizeof hex, h, sizeof h);
   return hex;
@@ -115,29 +106,26 @@ bool same_hash(const std::string& a, const std::string& b) {
 bool valid_username(const std::string& u) {
   if (u.empty() || u.size() > AuthStore::kMaxUsername) return false;
   return std::all_of(u.begin(), u.end(), [](char c) {
-    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' ||
-           c == '_' || c == '-';
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
+           c == '-';
   });
 }
 
 Status check_username(const std::string& u) {
   if (!valid_username(u))
-    return invalid_argument(
-        "username must be 1-64 characters of letters, digits, '.', '_' and '-'");
+    return invalid_argument("username must be 1-64 characters of letters, digits, '.', '_' and '-'");
   return Status::Ok();
 }
 
 // Characters, not bytes, so a passphrase in any script gets the same minimum.
 size_t utf8_chars(const std::string& s) {
-  return static_cast<size_t>(std::count_if(
-      s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+  return static_cast<size_t>(
+      std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
 }
 
 Status check_password(const std::string& p) {
-  if (p.size() > AuthStore::kMaxPasswordBytes)
-    return invalid_argument("password is longer than 1024 bytes");
-  if (utf8_chars(p) < AuthStore::kMinPasswordChars)
-    return invalid_argument("password must be at least 10 characters");
+  if (p.size() > AuthStore::kMaxPasswordBytes) return invalid_argument("password is longer than 1024 bytes");
+  if (utf8_chars(p) < AuthStore::kMinPasswordChars) return invalid_argument("password must be at least 10 characters");
   return Status::Ok();
 }
 
@@ -161,8 +149,7 @@ bool printable_utf8(const std::string& s) {
       cp = (cp << 6) | (cc & 0x3F);
     }
     const uint32_t min = n == 2 ? 0x80 : n == 3 ? 0x800 : 0x10000;
-    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF) || (cp >= 0x80 && cp < 0xA0))
-      return false;
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF) || (cp >= 0x80 && cp < 0xA0)) return false;
     i += n;
   }
   return true;
@@ -211,8 +198,8 @@ class Limiter {
     const bool brake_all = static_cast<int>(total_.size()) >= total_max_;
     const bool brake_account = brake_all || static_cast<int>(account.size()) >= account_max_;
     int64_t wait = 0;
-    for (auto [d, max] : {std::pair{&pair, brake_account ? 1 : pair_max_},
-                          std::pair{&address, brake_all ? 1 : address_max_}}) {
+    for (auto [d, max] :
+         {std::pair{&pair, brake_account ? 1 : pair_max_}, std::pair{&address, brake_all ? 1 : address_max_}}) {
       const auto n = static_cast<int>(d->size());
       // Until enough of this key's failures age out to go under its limit.
       if (n >= max) wait = std::max<int64_t>(wait, (*d)[n - max] + window_ - now);
@@ -281,10 +268,7 @@ struct AuthStore::Impl {
   std::map<int, std::function<void(const SessionChange&)>> watchers;
   int next_watcher = 1;
 
-  Impl(Database d, AuthOptions o)
-      : db(std::move(d)),
-        options(std::move(o)),
-        limiter(options) {}
+  Impl(Database d, AuthOptions o) : db(std::move(d)), options(std::move(o)), limiter(options) {}
 
   int64_t now() const { return options.now ? options.now() : system_now(); }
 
@@ -320,12 +304,9 @@ struct AuthStore::Impl {
         revoked INTEGER NOT NULL DEFAULT 0);
       CREATE INDEX IF NOT EXISTS shares_by_scan ON shares(scan_id);
     )sql"));
-    ASSIGN_OR_RETURN(
-        Statement ins,
-        db.prepare("INSERT OR IGNORE INTO meta(key, value) VALUES ('schema_version', ?)"));
+    ASSIGN_OR_RETURN(Statement ins, db.prepare("INSERT OR IGNORE INTO meta(key, value) VALUES ('schema_version', ?)"));
     RETURN_IF_ERROR(ins.bind(1, std::to_string(kSchemaVersion)).run());
-    ASSIGN_OR_RETURN(Statement st,
-                     db.prepare("SELECT value FROM meta WHERE key = 'schema_version'"));
+    ASSIGN_OR_RETURN(Statement st, db.prepare("SELECT value FROM meta WHERE key = 'schema_version'"));
     ASSIGN_OR_RETURN(bool row, st.step());
     if (!row || std::atoi(st.text(0).c_str()) > kSchemaVersion)
       return failed_precondition("accounts database: made by a newer bodyscan; update this one");
@@ -336,8 +317,7 @@ struct AuthStore::Impl {
     return options.opslimit ? options.opslimit : crypto_pwhash_OPSLIMIT_INTERACTIVE;
   }
   size_t memlimit() const {
-    return static_cast<size_t>(options.memlimit ? options.memlimit
-                                                : crypto_pwhash_MEMLIMIT_INTERACTIVE);
+    return static_cast<size_t>(options.memlimit ? options.memlimit : crypto_pwhash_MEMLIMIT_INTERACTIVE);
   }
 
   StatusOr<std::string> hash_password(const std::string& password) const {
@@ -354,9 +334,7 @@ struct AuthStore::Impl {
     Role role;
   };
   StatusOr<std::optional<Stored>> find_account(const std::string& username) const {
-    ASSIGN_OR_RETURN(
-        Statement st,
-        db.prepare("SELECT username, password_hash, role FROM accounts WHERE username = ?"));
+    ASSIGN_OR_RETURN(Statement st, db.prepare("SELECT username, password_hash, role FROM accounts WHERE username = ?"));
     st.bind(1, username);
     ASSIGN_OR_RETURN(bool row, st.step());
     if (!row) return std::optional<Stored>();
@@ -366,8 +344,7 @@ struct AuthStore::Impl {
   }
 
   StatusOr<int64_t> admin_count() const {
-    ASSIGN_OR_RETURN(Statement st,
-                     db.prepare("SELECT COUNT(*) FROM accounts WHERE role = 'admin'"));
+    ASSIGN_OR_RETURN(Statement st, db.prepare("SELECT COUNT(*) FROM accounts WHERE role = 'admin'"));
     ASSIGN_OR_RETURN(bool row, st.step());
     return row ? st.integer(0) : int64_t{0};
   }
@@ -383,8 +360,7 @@ struct AuthStore::Impl {
     ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(db));
     ASSIGN_OR_RETURN(auto current, find_account(stored.username));
     if (!current || !same_hash(current->hash, stored.hash)) return std::optional<LoginResult>();
-    ASSIGN_OR_RETURN(Statement purge,
-                     db.prepare("DELETE FROM sessions WHERE expires_at <= ? OR last_used <= ?"));
+    ASSIGN_OR_RETURN(Statement purge, db.prepare("DELETE FROM sessions WHERE expires_at <= ? OR last_used <= ?"));
     RETURN_IF_ERROR(purge.bind(1, now).bind(2, now - options.session_idle_s).run());
     LoginResult r;
     r.outcome = LoginResult::kOk;
@@ -394,10 +370,8 @@ struct AuthStore::Impl {
     r.session.csrf_token = random_token(kSessionTokenBytes);
     const int64_t expires = now + options.session_lifetime_s;
     r.session.expires_at = std::min(expires, now + options.session_idle_s);
-    ASSIGN_OR_RETURN(
-        Statement ins,
-        db.prepare("INSERT INTO sessions(token_hash, username, csrf_token, created_at, "
-                   "last_used, expires_at) VALUES (?, ?, ?, ?, ?, ?)"));
+    ASSIGN_OR_RETURN(Statement ins, db.prepare("INSERT INTO sessions(token_hash, username, csrf_token, created_at, "
+                                               "last_used, expires_at) VALUES (?, ?, ?, ?, ?, ?)"));
     ins.bind(1, token_hash(r.token)).bind(2, current->username).bind(3, r.session.csrf_token);
     RETURN_IF_ERROR(ins.bind(4, now).bind(5, now).bind(6, expires).run());
     RETURN_IF_ERROR(tx.commit());
@@ -414,10 +388,9 @@ struct AuthStore::Impl {
   }
 
   StatusOr<std::optional<Session>> find_session(const std::string& hash, int64_t now, bool refresh) {
-    ASSIGN_OR_RETURN(Statement st,
-                     db.prepare("SELECT s.token_hash, s.csrf_token, s.last_used, s.expires_at, "
-                                "a.username, a.role FROM sessions s JOIN accounts a "
-                                "ON a.username = s.username WHERE s.token_hash = ?"));
+    ASSIGN_OR_RETURN(Statement st, db.prepare("SELECT s.token_hash, s.csrf_token, s.last_used, s.expires_at, "
+                                              "a.username, a.role FROM sessions s JOIN accounts a "
+                                              "ON a.username = s.username WHERE s.token_hash = ?"));
     st.bind(1, hash);
     ASSIGN_OR_RETURN(bool row, st.step());
     if (!row || !same_hash(st.text(0), hash)) return std::optional<Session>();
@@ -434,8 +407,7 @@ struct AuthStore::Impl {
     s.csrf_token = st.text(1);
     int64_t used = last_used;
     if (refresh && now - last_used >= kTouchEvery) {
-      ASSIGN_OR_RETURN(Statement touch,
-                       db.prepare("UPDATE sessions SET last_used = ? WHERE token_hash = ?"));
+      ASSIGN_OR_RETURN(Statement touch, db.prepare("UPDATE sessions SET last_used = ? WHERE token_hash = ?"));
       // The session is valid either way; a failed refresh only shortens it.
       if (touch.bind(1, now).bind(2, hash).run().ok()) used = now;
     }
@@ -450,11 +422,9 @@ struct AuthStore::Impl {
     l.expires_at = st.integer(5);
     l.revoked = st.integer(6) != 0;
     const auto j = parse_json(st.text(2));
-    if (!j.is_array())
-      return internal_error("accounts: share " + l.id + " has damaged measurements");
+    if (!j.is_array()) return internal_error("accounts: share " + l.id + " has damaged measurements");
     for (const auto& m : j) {
-      if (!m.is_string())
-        return internal_error("accounts: share " + l.id + " has damaged measurements");
+      if (!m.is_string()) return internal_error("accounts: share " + l.id + " has damaged measurements");
       l.measurements.push_back(m.get<std::string>());
     }
     return l;
@@ -464,11 +434,9 @@ struct AuthStore::Impl {
 AuthStore::AuthStore(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 AuthStore::~AuthStore() = default;
 
-StatusOr<std::unique_ptr<AuthStore>> AuthStore::open(const std::string& db_path,
-                                                     AuthOptions options) {
+StatusOr<std::unique_ptr<AuthStore>> AuthStore::open(const std::string& db_path, AuthOptions options) {
   if (sodium_init() < 0) return internal_error("accounts: libsodium failed to start");
-  if (options.session_lifetime_s <= 0 || options.session_idle_s <= 0 ||
-      options.failure_window_s <= 0)
+  if (options.session_lifetime_s <= 0 || options.session_idle_s <= 0 || options.failure_window_s <= 0)
     return invalid_argument("accounts: session lifetimes and the failure window must be positive");
   // Password hashes are nobody else's business: create the file (and so, as
   // SQLite copies its mode, the WAL beside it) readable by its owner only.
@@ -486,30 +454,25 @@ StatusOr<std::unique_ptr<AuthStore>> AuthStore::open(const std::string& db_path,
 
 // --- accounts ------------------------------------------------------------------
 
-StatusOr<Account> AuthStore::add_account(const std::string& username, const std::string& password,
-                                         Role role) {
+StatusOr<Account> AuthStore::add_account(const std::string& username, const std::string& password, Role role) {
   RETURN_IF_ERROR(check_username(username));
   RETURN_IF_ERROR(check_password(password));
   {
     std::lock_guard lock(impl_->mu);
     ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
-    if (existing)
-      return failed_precondition("an account named '" + existing->username + "' already exists");
+    if (existing) return failed_precondition("an account named '" + existing->username + "' already exists");
   }
   ASSIGN_OR_RETURN(std::string hash, impl_->hash_password(password));
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
   // Again: another thread may have added the name while the hash ran.
   ASSIGN_OR_RETURN(auto existing, impl_->find_account(username));
-  if (existing)
-    return failed_precondition("an account named '" + existing->username + "' already exists");
+  if (existing) return failed_precondition("an account named '" + existing->username + "' already exists");
   Account a{username, role, storage::iso8601_utc(impl_->now())};
   ASSIGN_OR_RETURN(
       Statement st,
-      impl_->db.prepare(
-          "INSERT INTO accounts(username, password_hash, role, created_at) VALUES (?, ?, ?, ?)"));
-  RETURN_IF_ERROR(
-      st.bind(1, a.username).bind(2, hash).bind(3, to_string(role)).bind(4, a.created_at).run());
+      impl_->db.prepare("INSERT INTO accounts(username, password_hash, role, created_at) VALUES (?, ?, ?, ?)"));
+  RETURN_IF_ERROR(st.bind(1, a.username).bind(2, hash).bind(3, to_string(role)).bind(4, a.created_at).run());
   RETURN_IF_ERROR(tx.commit());
   return a;
 }
@@ -527,11 +490,9 @@ Status AuthStore::set_password(const std::string& username, const std::string& p
   {
     std::lock_guard lock(impl_->mu);
     ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
-    ASSIGN_OR_RETURN(Statement st,
-                     impl_->db.prepare("UPDATE accounts SET password_hash = ? WHERE username = ?"));
+    ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("UPDATE accounts SET password_hash = ? WHERE username = ?"));
     RETURN_IF_ERROR(st.bind(1, hash).bind(2, username).run());
-    if (sqlite3_changes(impl_->db.handle()) == 0)
-      return not_found("no account named '" + username + "'");
+    if (sqlite3_changes(impl_->db.handle()) == 0) return not_found("no account named '" + username + "'");
     RETURN_IF_ERROR(impl_->delete_sessions_of(username));
     RETURN_IF_ERROR(tx.commit());
   }
@@ -550,11 +511,9 @@ Status AuthStore::set_role(const std::string& username, Role role) {
     if (existing->role == Role::kAdmin) {
       ASSIGN_OR_RETURN(int64_t admins, impl_->admin_count());
       if (admins <= 1)
-        return failed_precondition("'" + existing->username +
-                                   "' is the last admin; make another admin first");
+        return failed_precondition("'" + existing->username + "' is the last admin; make another admin first");
     }
-    ASSIGN_OR_RETURN(Statement st,
-                     impl_->db.prepare("UPDATE accounts SET role = ? WHERE username = ?"));
+    ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("UPDATE accounts SET role = ? WHERE username = ?"));
     RETURN_IF_ERROR(st.bind(1, to_string(role)).bind(2, username).run());
     RETURN_IF_ERROR(tx.commit());
     stored_name = existing->username;
@@ -573,8 +532,7 @@ Status AuthStore::delete_account(const std::string& username) {
     if (existing->role == Role::kAdmin) {
       ASSIGN_OR_RETURN(int64_t admins, impl_->admin_count());
       if (admins <= 1)
-        return failed_precondition("'" + existing->username +
-                                   "' is the last admin; make another admin first");
+        return failed_precondition("'" + existing->username + "' is the last admin; make another admin first");
     }
     // Sessions go with it (ON DELETE CASCADE); said explicitly so it does not
     // hang on a pragma.
@@ -590,9 +548,8 @@ Status AuthStore::delete_account(const std::string& username) {
 
 StatusOr<Account> AuthStore::account(const std::string& username) const {
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(
-      Statement st,
-      impl_->db.prepare("SELECT username, role, created_at FROM accounts WHERE username = ?"));
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("SELECT username, role, created_at FROM accounts WHERE username = ?"));
   st.bind(1, username);
   ASSIGN_OR_RETURN(bool row, st.step());
   if (!row) return not_found("no account named '" + username + "'");
@@ -603,9 +560,8 @@ StatusOr<Account> AuthStore::account(const std::string& username) const {
 
 StatusOr<std::vector<Account>> AuthStore::accounts() const {
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(
-      Statement st,
-      impl_->db.prepare("SELECT username, role, created_at FROM accounts ORDER BY username"));
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("SELECT username, role, created_at FROM accounts ORDER BY username"));
   std::vector<Account> out;
   for (;;) {
     ASSIGN_OR_RETURN(bool row, st.step());
@@ -672,14 +628,11 @@ LoginResult AuthStore::login(const std::string& username, const std::string& pas
 
   // Accounts made under weaker settings get the current cost now that the
   // password is at hand; failing to is no reason to refuse the login.
-  if (crypto_pwhash_str_needs_rehash(stored->hash.c_str(), impl_->opslimit(), impl_->memlimit()) !=
-      0) {
+  if (crypto_pwhash_str_needs_rehash(stored->hash.c_str(), impl_->opslimit(), impl_->memlimit()) != 0) {
     if (auto rehashed = impl_->hash_password(password); rehashed.ok()) {
       std::lock_guard lock(impl_->mu);
-      auto st = impl_->db.prepare(
-          "UPDATE accounts SET password_hash = ? WHERE username = ? AND password_hash = ?");
-      if (st.ok())
-        (void)st->bind(1, *rehashed).bind(2, stored->username).bind(3, stored->hash).run();
+      auto st = impl_->db.prepare("UPDATE accounts SET password_hash = ? WHERE username = ? AND password_hash = ?");
+      if (st.ok()) (void)st->bind(1, *rehashed).bind(2, stored->username).bind(3, stored->hash).run();
     }
   }
   return std::move(*ok);
@@ -730,14 +683,12 @@ void AuthStore::unwatch_sessions(int id) {
 
 // --- share links ---------------------------------------------------------------
 
-StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id,
-                                           const std::vector<std::string>& measurements,
+StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id, const std::vector<std::string>& measurements,
                                            int64_t valid_for_s, const std::string& created_by) {
   if (scan_id.empty() || scan_id.size() > kMaxScanId) return invalid_argument("share: bad scan id");
   if (valid_for_s <= 0 || valid_for_s > kMaxShareValidity)
     return invalid_argument("share: validity must be more than 0 seconds and at most 365 days");
-  if (measurements.size() > kMaxMeasurements)
-    return invalid_argument("share: too many measurements");
+  if (measurements.size() > kMaxMeasurements) return invalid_argument("share: too many measurements");
   nlohmann::json names = nlohmann::json::array();
   for (const auto& m : measurements) {
     if (m.empty() || m.size() > kMaxMeasurementName || !printable_utf8(m))
@@ -757,15 +708,10 @@ StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id,
   l.created_at = storage::iso8601_utc(now);
   l.expires_at = now + valid_for_s;
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(
-      Statement st,
-      impl_->db.prepare("INSERT INTO shares(id, token_hash, scan_id, measurements, created_by, "
-                        "created_at, created_at_s, expires_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?)"));
-  st.bind(1, l.id)
-      .bind(2, token_hash(out.token))
-      .bind(3, l.scan_id)
-      .bind(4, names_json)
-      .bind(5, l.created_by);
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("INSERT INTO shares(id, token_hash, scan_id, measurements, created_by, "
+                                     "created_at, created_at_s, expires_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?)"));
+  st.bind(1, l.id).bind(2, token_hash(out.token)).bind(3, l.scan_id).bind(4, names_json).bind(5, l.created_by);
   RETURN_IF_ERROR(st.bind(6, l.created_at).bind(7, now).bind(8, l.expires_at).run());
   return out;
 }
@@ -789,11 +735,9 @@ std::optional<ShareLink> AuthStore::share_by_token(const std::string& token) {
 
 StatusOr<std::vector<ShareLink>> AuthStore::shares(const std::string& scan_id) const {
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(
-      Statement st,
-      impl_->db.prepare(
-          "SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked "
-          "FROM shares WHERE scan_id = ? ORDER BY created_at_s, rowid"));
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked "
+                                     "FROM shares WHERE scan_id = ? ORDER BY created_at_s, rowid"));
   st.bind(1, scan_id);
   std::vector<ShareLink> out;
   for (;;) {
@@ -809,8 +753,7 @@ Status AuthStore::revoke_share(const std::string& share_id) {
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("UPDATE shares SET revoked = 1 WHERE id = ?"));
   RETURN_IF_ERROR(st.bind(1, share_id).run());
-  if (sqlite3_changes(impl_->db.handle()) == 0)
-    return not_found("no share link '" + share_id + "'");
+  if (sqlite3_changes(impl_->db.handle()) == 0) return not_found("no share link '" + share_id + "'");
   return Status::Ok();
 }
 

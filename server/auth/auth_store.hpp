@@ -103,8 +103,7 @@ class AuthStore {
   static constexpr size_t kMaxPasswordBytes = 1024;
   static constexpr int64_t kMaxShareValidity = 365 * 24 * 3600;
 
-  static StatusOr<std::unique_ptr<AuthStore>> open(const std::string& db_path,
-                                                   AuthOptions options = {});
+  static StatusOr<std::unique_ptr<AuthStore>> open(const std::string& db_path, AuthOptions options = {});
   ~AuthStore();
   AuthStore(const AuthStore&) = delete;
   AuthStore& operator=(const AuthStore&) = delete;
@@ -113,8 +112,7 @@ class AuthStore {
   // case ("Anna" and "anna" are one account; login accepts either spelling).
   // Passwords: at least 10 characters, at most 1024 bytes. An existing username
   // is failed_precondition; an unknown one not_found.
-  StatusOr<Account> add_account(const std::string& username, const std::string& password,
-                                Role role);
+  StatusOr<Account> add_account(const std::string& username, const std::string& password, Role role);
   // set_password ends that user's sessions. set_role refuses to demote the last
   // admin; delete_account refuses to delete it, and ends the account's sessions.
   Status set_password(const std::string& username, const std::string& password);
@@ -131,8 +129,7 @@ class AuthStore {
   // username at that address. Expired sessions are purged here.
   // `remote_address` is the client's (behind a trusted proxy, the address it
   // forwarded for).
-  LoginResult login(const std::string& username, const std::string& password,
-                    const std::string& remote_address);
+  LoginResult login(const std::string& username, const std::string& password, const std::string& remote_address);
   // The session for a cookie token: unexpired (absolute and idle) and its account
   // still there. Refreshes its last use. Anything malformed is just nullopt.
   // With `refresh` false the last use stays as it was: for a check that is not
@@ -148,12 +145,11 @@ class AuthStore {
   void unwatch_sessions(int id);
 
   // Share links. valid_for_s in (0, 365 days].
-  StatusOr<NewShare> create_share(const std::string& scan_id,
-                                  const std::vector<std::string>& measurements, int64_t valid_for_s,
-                                  const std::string& created_by);
-  std::optional<ShareLink> share_by_token(const std::string& token);  // unexpired and not revoked
+  StatusOr<NewShare> create_share(const std::string& scan_id, const std::vector<std::string>& measurements,
+                                  int64_t valid_for_s, const std::string& created_by);
+  std::optional<ShareLink> share_by_token(const std::string& token);          // unexpired and not revoked
   StatusOr<std::vector<ShareLink>> shares(const std::string& scan_id) const;  // all, oldest first
-  Status revoke_share(const std::string& share_id);          // not_found if unknown
+  Status revoke_share(const std::string& share_id);                           // not_found if unknown
   // When a scan or customer is erased (server/workstation/erasure.hpp); the
   // write-ahead log is checkpointed and truncated after.
   Status delete_shares_of_scan(const std::string& scan_id);

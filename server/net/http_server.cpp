@@ -5,13 +5,13 @@
 #include "server/net/http_server.hpp"
 
 #include <boost/asio/dispatch.hpp>
-#include <boost/asio/post.hpp>
-#include <boost/asio/signal_set.hpp>
-#include <boost/asio/steady_timer.hpp>
-#include <boost/asio/ssl.hpp>
-#include <boost/asio/strand.hpp>
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/ssl.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
@@ -66,9 +66,8 @@ class EventSessionBase {
 namespace {
 
 bool same_username(const std::string& a, const std::string& b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](unsigned char x, unsigned char y) {
-    return std::tolower(x) == std::tolower(y);
-  });
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](unsigned char x, unsigned char y) { return std::tolower(x) == std::tolower(y); });
 }
 
 }  // namespace
@@ -213,8 +212,7 @@ std::optional<std::pair<int, std::string>> refusal(beast::error_code ec) {
   if (ec == http::error::bad_method || ec == http::error::bad_target || ec == http::error::bad_version ||
       ec == http::error::bad_field || ec == http::error::bad_value || ec == http::error::bad_chunk ||
       ec == http::error::bad_chunk_extension || ec == http::error::bad_content_length ||
-      ec == http::error::bad_line_ending || ec == http::error::bad_obs_fold ||
-      ec == http::error::bad_transfer_encoding)
+      ec == http::error::bad_line_ending || ec == http::error::bad_obs_fold || ec == http::error::bad_transfer_encoding)
     return std::pair{400, "malformed request: " + ec.message()};
   return std::nullopt;
 }
@@ -317,9 +315,8 @@ class EventSession : public EventSessionBase, public std::enable_shared_from_thi
   // latest, ask the store whether the session still holds; a socket open in a
   // forgotten tab does not count as use.
   void watch_expiry(int64_t expires_at) {
-    const int64_t now = std::chrono::duration_cast<std::chrono::seconds>(
-                            std::chrono::system_clock::now().time_since_epoch())
-                            .count();
+    const int64_t now =
+        std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
     expiry_.expires_after(std::chrono::seconds(std::clamp<int64_t>(expires_at - now, 1, 300)));
     std::weak_ptr<EventSession> weak = this->shared_from_this();
     expiry_.async_wait([weak](beast::error_code ec) {
@@ -398,7 +395,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   HttpSession(Shared& shared, ConnectionSlot slot, std::optional<asio::ip::address> peer, Args&&... args)
       : stream_(std::forward<Args>(args)...), shared_(shared), slot_(std::move(slot)), peer_(std::move(peer)) {}
 
-  void run() { asio::dispatch(stream_.get_executor(), beast::bind_front_handler(&HttpSession::on_run, this->shared_from_this())); }
+  void run() {
+    asio::dispatch(stream_.get_executor(), beast::bind_front_handler(&HttpSession::on_run, this->shared_from_this()));
+  }
 
  private:
   beast::tcp_stream& tcp() { return beast::get_lowest_layer(stream_); }
@@ -422,7 +421,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     parser_->header_limit(static_cast<std::uint32_t>(shared_.options.header_limit));
     parser_->body_limit(shared_.options.body_limit);
     tcp().expires_after(shared_.options.timeout);
-    http::async_read(stream_, buffer_, *parser_, beast::bind_front_handler(&HttpSession::on_read, this->shared_from_this()));
+    http::async_read(stream_, buffer_, *parser_,
+                     beast::bind_front_handler(&HttpSession::on_read, this->shared_from_this()));
   }
 
   void on_read(beast::error_code ec, size_t) {
@@ -436,7 +436,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     if (websocket::is_upgrade(req)) {
       if (request.path != "/api/events") return reply_and_close(404, "WebSockets live at /api/events");
       // The session check reads the accounts database: on the pool, like all work.
-      asio::post(shared_.workers.get_executor(), [self = this->shared_from_this(), req = std::move(req), request]() mutable {
+      asio::post(shared_.workers.get_executor(), [self = this->shared_from_this(), req = std::move(req),
+                                                  request]() mutable {
         Session session;
         std::optional<HttpResponse> refused = self->shared_.api.refuse_events(request, &session);
         std::string hello;
@@ -458,17 +459,19 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     const bool head = req.method() == http::verb::head;
     // The work happens off the network thread; the answer comes back to this
     // session's strand.
-    asio::post(shared_.workers.get_executor(), [self = this->shared_from_this(), request = std::move(request), version, keep_alive, head]() {
-      HttpResponse response;
-      try {
-        response = self->shared_.api.handle(request);
-      } catch (const std::exception& e) {
-        response = error_response(500, std::string("internal error: ") + e.what());
-      }
-      asio::post(self->stream_.get_executor(), [self, response = std::move(response), version, keep_alive, head]() mutable {
-        self->send(make_message(std::move(response), version, keep_alive, head), keep_alive);
-      });
-    });
+    asio::post(shared_.workers.get_executor(),
+               [self = this->shared_from_this(), request = std::move(request), version, keep_alive, head]() {
+                 HttpResponse response;
+                 try {
+                   response = self->shared_.api.handle(request);
+                 } catch (const std::exception& e) {
+                   response = error_response(500, std::string("internal error: ") + e.what());
+                 }
+                 asio::post(self->stream_.get_executor(),
+                            [self, response = std::move(response), version, keep_alive, head]() mutable {
+                              self->send(make_message(std::move(response), version, keep_alive, head), keep_alive);
+                            });
+               });
   }
 
   // For a request refused before it was read whole: answer, stop sending, and
@@ -490,9 +493,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   void send(std::shared_ptr<Response> msg, bool keep_alive) {
     tcp().expires_after(shared_.options.timeout);
     Response& response = *msg;  // taken before the handler takes the pointer
-    http::async_write(stream_, response,
-                      beast::bind_front_handler(&HttpSession::on_write, this->shared_from_this(), std::move(msg),
-                                                keep_alive));
+    http::async_write(
+        stream_, response,
+        beast::bind_front_handler(&HttpSession::on_write, this->shared_from_this(), std::move(msg), keep_alive));
   }
 
   void on_write(const std::shared_ptr<Response>&, bool keep_alive, beast::error_code ec, size_t) {
@@ -574,7 +577,7 @@ struct HttpServer::Impl {
       ConnectionSlot slot(*shared);
       if (tls)
         std::make_shared<HttpSession<beast::ssl_stream<beast::tcp_stream>>>(*shared, std::move(slot), peer,
-                                                                             std::move(socket), *tls)
+                                                                            std::move(socket), *tls)
             ->run();
       else
         std::make_shared<HttpSession<beast::tcp_stream>>(*shared, std::move(slot), peer, std::move(socket))->run();
@@ -684,7 +687,8 @@ StatusOr<std::unique_ptr<HttpServer>> HttpServer::start(Api& api, Workstation& w
   if (!ec) impl->acceptor.bind(endpoint, ec);
   if (!ec) impl->acceptor.listen(asio::socket_base::max_listen_connections, ec);
   if (ec)
-    return unavailable("cannot listen on " + options.address + ":" + std::to_string(options.port) + ": " + ec.message());
+    return unavailable("cannot listen on " + options.address + ":" + std::to_string(options.port) + ": " +
+                       ec.message());
   impl->port = impl->acceptor.local_endpoint().port();
   impl->shared = std::make_unique<Shared>(api, ws, options);
   impl->shared->max_connections = connection_cap(options.max_connections);

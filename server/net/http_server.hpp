@@ -26,12 +26,12 @@ namespace bodyscan::server {
 
 struct NetOptions {
   std::string address = "0.0.0.0";
-  uint16_t port = 8080;        // 0: any free port (tests)
-  int io_threads = 1;          // network threads
-  int workers = 3;             // threads running requests' work
+  uint16_t port = 8080;           // 0: any free port (tests)
+  int io_threads = 1;             // network threads
+  int workers = 3;                // threads running requests' work
   std::string tls_cert, tls_key;  // PEM files; both or neither
   size_t header_limit = 8 * 1024;
-  size_t body_limit = 1 << 20;  // request bodies are JSON; nothing uploads meshes
+  size_t body_limit = 1 << 20;       // request bodies are JSON; nothing uploads meshes
   std::chrono::seconds timeout{30};  // to read a request, or write a response, or a TLS handshake
   size_t ws_queue_limit = 256;       // queued events before a WebSocket client is dropped
   size_t ws_preview_limit = 8;       // queued events past which camera previews are skipped

@@ -130,7 +130,8 @@ Status scan_sequence(const Rig& rig, const ShotSink& sink, int every, const Prog
   RETURN_IF_ERROR(ctl.set_room_lights(false));
   RETURN_IF_ERROR(ctl.set_frame_lights(false));
   size_t total = 0, done = 0;
-  for (size_t g = 0; g < desc.laser_groups.size(); ++g) total += static_cast<size_t>((group_steps(desc, g) + every - 1) / every);
+  for (size_t g = 0; g < desc.laser_groups.size(); ++g)
+    total += static_cast<size_t>((group_steps(desc, g) + every - 1) / every);
   for (size_t g = 0; g < desc.laser_groups.size(); ++g) {
     const std::vector<int> ids = group_lasers(desc, g);
     for (int i : ids) RETURN_IF_ERROR(ctl.home(i));

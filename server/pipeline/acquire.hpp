@@ -37,14 +37,14 @@ struct Rig {
 };
 
 enum class ShotKind {
-  kDotGrid,         // the lens board before this camera, room lights on
-  kRoom,            // room lights on (for people to look at)
-  kLightsOff,       // room and frame lights off: the base for the markers
-  kFrameLights,     // both frame-light circuits on
-  kFrontLights,     // the front poles' circuit only (which side a camera faces)
-  kLaserBase,       // lasers off, just before a laser or a group comes on
-  kLaserIdentify,   // one laser alone at an end or the middle of its sweep (which camera sees which laser)
-  kScanStep,        // a group's lasers on at a step
+  kDotGrid,        // the lens board before this camera, room lights on
+  kRoom,           // room lights on (for people to look at)
+  kLightsOff,      // room and frame lights off: the base for the markers
+  kFrameLights,    // both frame-light circuits on
+  kFrontLights,    // the front poles' circuit only (which side a camera faces)
+  kLaserBase,      // lasers off, just before a laser or a group comes on
+  kLaserIdentify,  // one laser alone at an end or the middle of its sweep (which camera sees which laser)
+  kScanStep,       // a group's lasers on at a step
 };
 const char* to_string(ShotKind k);
 
@@ -56,8 +56,8 @@ struct LaserState {
 struct Shot {
   ShotKind kind = ShotKind::kRoom;
   size_t camera = 0;
-  int group = -1;        // laser group (kLaserBase in a scan, kScanStep)
-  int step_index = -1;   // 0.. within the group's sweep (kScanStep)
+  int group = -1;                  // laser group (kLaserBase in a scan, kScanStep)
+  int step_index = -1;             // 0.. within the group's sweep (kScanStep)
   std::vector<LaserState> lasers;  // the lasers on
   hw::Frame frame;
 };

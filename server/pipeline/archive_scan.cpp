@@ -24,8 +24,10 @@ StatusOr<storage::ScanResults> to_results(const ScanJobResult& result, const Sca
   storage::ScanResults out;
   out.files = std::move(files.results);
   out.algorithms = algorithm_versions(options);
-  if (!result.surface_error.empty()) out.note = "surface failed: " + result.surface_error;
-  else if (!result.measure_error.empty()) out.note = "no automatic measurements: " + result.measure_error;
+  if (!result.surface_error.empty())
+    out.note = "surface failed: " + result.surface_error;
+  else if (!result.measure_error.empty())
+    out.note = "no automatic measurements: " + result.measure_error;
   if (result.body)
     for (const BodyMeasurement& m : result.body->measurements) {
       storage::MeasurementRecord r;
@@ -35,7 +37,6 @@ StatusOr<storage::ScanResults> to_results(const ScanJobResult& result, const Sca
     }
   return out;
 }
-
 
 }  // namespace
 

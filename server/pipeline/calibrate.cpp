@@ -57,7 +57,8 @@ void plan_sweeps(RigCalibration& cal, const hw::RigDescription& rig) {
       }
       if (closest > best) best = closest, best_mask = mask;
     }
-    for (size_t k = 1; k < ids.size(); ++k) cal.sweep_reversed[static_cast<size_t>(ids[k])] = (best_mask >> (k - 1)) & 1u;
+    for (size_t k = 1; k < ids.size(); ++k)
+      cal.sweep_reversed[static_cast<size_t>(ids[k])] = (best_mask >> (k - 1)) & 1u;
     cal.group_separation_mm.push_back(best >= 1e30 ? 0 : best);
   }
 }
@@ -163,23 +164,24 @@ StatusOr<RigCalibration> CalibrationBuilder::finish() {
     for (size_t i = 0; i < cameras_.size(); ++i) {
       std::vector<std::string> both;
       for (int l : out.lasers_seen[i])
-        if (std::find(group.begin(), group.end(), l) != group.end()) both.push_back(rig_.lasers[static_cast<size_t>(l)].id);
+        if (std::find(group.begin(), group.end(), l) != group.end())
+          both.push_back(rig_.lasers[static_cast<size_t>(l)].id);
       if (both.size() > 1) {
-        return failed_precondition("camera '" + rig_.cameras[i].id + "' sees lasers '" + both[0] + "' and '" +
-                                   both[1] + "' on the frame's poles, but they run together: put them in different "
+        return failed_precondition("camera '" + rig_.cameras[i].id + "' sees lasers '" + both[0] + "' and '" + both[1] +
+                                   "' on the frame's poles, but they run together: put them in different "
                                    "laser groups");
       }
     }
   }
   plan_sweeps(out, rig_);
-  out.processing_seconds =
-      lens_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.processing_seconds = lens_seconds_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 
 StatusOr<RigCalibration> calibrate_rig(const Rig& rig, const CalibrateOptions& options, const ProgressFn& progress) {
   CalibrationBuilder builder(*rig.description, options);
-  RETURN_IF_ERROR(acquire_calibration(rig, [&](Shot&& s) { return builder.consume(std::move(s)); }, progress));
+  RETURN_IF_ERROR(acquire_calibration(
+      rig, [&](Shot&& s) { return builder.consume(std::move(s)); }, progress));
   return builder.finish();
 }
 

@@ -37,7 +37,7 @@ struct RigCalibration {
   // their sweeps), which keeps each camera's stripe search clear of the others'.
   std::vector<bool> sweep_reversed;
   std::vector<double> group_separation_mm;  // per group, the closest the planes come at the sweep ends
-  double processing_seconds = 0;  // from frames to calibration, acquisition excluded
+  double processing_seconds = 0;            // from frames to calibration, acquisition excluded
 };
 
 struct CalibrateOptions {

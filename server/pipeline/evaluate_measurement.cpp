@@ -64,7 +64,7 @@ StatusOr<nlohmann::json> evaluate_measurement(const TriangleMesh& mesh, const nl
   if (kind == "distance") {
     ASSIGN_OR_RETURN(Eigen::Vector3d a, vec3(request, "from"));
     ASSIGN_OR_RETURN(Eigen::Vector3d b, vec3(request, "to"));
-    return nlohmann::json{{"kind", "distance"},       {"value_mm", (b - a).norm()}, {"from", point_json(a)},
+    return nlohmann::json{{"kind", "distance"},       {"value_mm", (b - a).norm()},    {"from", point_json(a)},
                           {"to", point_json(b)},      {"path", polyline_json({a, b})}, {"closed", false},
                           {"algorithm", "distance-1"}};
   }

@@ -26,10 +26,7 @@ nlohmann::json plane_json(const Plane& plane) {
 }
 
 nlohmann::json measurements_document(const std::string& file, const std::string& kind) {
-  return {{"schema", kMeasurementsSchema},
-          {"file", file},
-          {"kind", kind},
-          {"measurements", nlohmann::json::array()}};
+  return {{"schema", kMeasurementsSchema}, {"file", file}, {"kind", kind}, {"measurements", nlohmann::json::array()}};
 }
 
 nlohmann::json to_json(const BodyMeasurement& m) {
@@ -45,7 +42,7 @@ nlohmann::json to_json(const BodyMeasurement& m) {
                       {"min_confidence", m.min_confidence},
                       {"crosses_filled_hole", m.crosses_filled_hole()},
                       {"algorithm", std::string(kBodyMeasurementsAlgorithm) + "/" +
-                                        (m.kind == "girth" && m.plane ? kGirthAlgorithm
+                                        (m.kind == "girth" && m.plane                 ? kGirthAlgorithm
                                          : m.kind == "height" || m.kind == "distance" ? "straight-1"
                                                                                       : kSurfaceAlgorithm)}};
   if (m.plane) j["plane"] = plane_json(*m.plane);

@@ -83,7 +83,7 @@ Rig rig_handle(hw::DeviceRig& devices, AskOperator ask, bool ask_for_simulated) 
 }
 
 StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> open_simulated_rig(const std::string& rig,
-                                                                     const SimulatedSubject& subject) {
+                                                                    const SimulatedSubject& subject) {
   ASSIGN_OR_RETURN(const hw::RigDescription loaded, load_rig(rig));
   const hw::RigDescription desc = subject.applied_to(loaded);
   if (desc.has_real_devices()) {

@@ -21,7 +21,7 @@ struct SimulatedSubject {
   std::string body;  // a PLY mesh, mm, Y up; "" the description's
   // Arms and feet, by skinning (hw/sim/pose_body.hpp): a MakeHuman body only.
   hw::SubjectPosture posture;
-  std::optional<double> turn_deg;             // about the vertical: + turns the face from +Z toward +X
+  std::optional<double> turn_deg;              // about the vertical: + turns the face from +Z toward +X
   std::optional<Eigen::Vector2d> position_mm;  // (X, Z) on the floor where the body's centre stands
   // The description with these applied.
   hw::RigDescription applied_to(hw::RigDescription rig) const;
@@ -30,7 +30,7 @@ struct SimulatedSubject {
 // "sim" is the thesis rig with the shipped demo body; other names are shipped
 // layouts; anything with a '/' or ending in .json is a description file.
 StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> open_simulated_rig(const std::string& rig,
-                                                                     const SimulatedSubject& subject = {});
+                                                                    const SimulatedSubject& subject = {});
 
 // The description's devices, whatever they are; `subject` changes the simulated one.
 StatusOr<std::unique_ptr<hw::DeviceRig>> open_rig(const std::string& rig, const SimulatedSubject& subject = {});

@@ -68,8 +68,8 @@ Status ScanProcessor::consume(Shot&& shot) {
     // plane; keep every row's stripe until then.
     if (stats_.first_plane_error.empty()) stats_.first_plane_error = plane.status().message();
     ++stats_.frames_without_plane;
-    ASSIGN_OR_RETURN(r.samples,
-                     extract_plane_stripe(cal_.cameras[shot.camera], nullptr, f, b, r.full_scale, options_.triangulate));
+    ASSIGN_OR_RETURN(
+        r.samples, extract_plane_stripe(cal_.cameras[shot.camera], nullptr, f, b, r.full_scale, options_.triangulate));
     stats_.samples += r.samples.size();
     records_.push_back(std::move(r));
     stats_.processing_seconds += seconds_since(t0);
@@ -82,8 +82,8 @@ Status ScanProcessor::consume(Shot&& shot) {
     ++fourth_n_;
     stats_.fourth_point_rms_mm = std::sqrt(fourth_ss_ / static_cast<double>(fourth_n_));
   }
-  ASSIGN_OR_RETURN(r.samples, extract_plane_stripe(cal_.cameras[shot.camera], &*plane, f, b, r.full_scale,
-                                                   options_.triangulate));
+  ASSIGN_OR_RETURN(r.samples,
+                   extract_plane_stripe(cal_.cameras[shot.camera], &*plane, f, b, r.full_scale, options_.triangulate));
   r.plane = std::move(*plane);
   stats_.samples += r.samples.size();
   records_.push_back(std::move(r));
@@ -168,8 +168,8 @@ StatusOr<PointCloud> ScanProcessor::finish() {
       const auto it = sweeps.find(o.laser);
       if (it != sweeps.end()) others.push_back(it->second.plane(o.step));
     }
-    triangulate_samples(cam, plane, *samples, r.full_scale,
-                        {static_cast<int>(r.camera), r.laser, r.frame}, options_.triangulate, others, &parts[i]);
+    triangulate_samples(cam, plane, *samples, r.full_scale, {static_cast<int>(r.camera), r.laser, r.frame},
+                        options_.triangulate, others, &parts[i]);
   });
   for (const Status& s : errors) RETURN_IF_ERROR(s);
   stats_.frames_dropped = 0;
@@ -202,8 +202,8 @@ StatusOr<PointCloud> ScanProcessor::finish() {
   }
   if (options_.view.max_view_deg < 90) stats_.points_grazing = weigh_by_view_angle(cloud, options_.view).dropped;
   if (options_.redundant_radius_mm > 0) {
-    stats_.points_redundant = drop_redundant_points(cloud, options_.redundant_radius_mm, options_.redundant_ratio,
-                                                    options_.redundant_weak);
+    stats_.points_redundant =
+        drop_redundant_points(cloud, options_.redundant_radius_mm, options_.redundant_ratio, options_.redundant_weak);
   }
   stats_.points = cloud.size();
   stats_.processing_seconds += seconds_since(t0);

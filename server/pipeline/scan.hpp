@@ -16,8 +16,8 @@
 #include "recon/scan/laser_sweep.hpp"
 #include "recon/scan/redundancy.hpp"
 #include "recon/scan/subject_sway.hpp"
-#include "recon/scan/view_angle.hpp"
 #include "recon/scan/triangulate.hpp"
+#include "recon/scan/view_angle.hpp"
 #include "server/pipeline/calibrate.hpp"
 
 namespace bodyscan::pipeline {
@@ -50,9 +50,9 @@ struct ScanOptions {
 
 struct LaserSweepReport {
   int laser = 0;
-  bool fitted = false;        // else the per-frame planes were used
-  std::string error;          // why not
-  double rms_mm = 0;          // pole points to their step's fitted plane
+  bool fitted = false;  // else the per-frame planes were used
+  std::string error;    // why not
+  double rms_mm = 0;    // pole points to their step's fitted plane
   size_t points_used = 0, points_rejected = 0;
   double degrees_per_step = 0;
   Eigen::Vector3d axis_point = Eigen::Vector3d::Zero(), axis_direction = Eigen::Vector3d::Zero();
@@ -67,13 +67,13 @@ struct ScanStats {
   double fourth_point_rms_mm = 0;   // over frames with all four pole points measured
   size_t samples = 0;               // stripe samples kept for triangulation
   size_t points = 0;
-  size_t points_redundant = 0;      // dropped for a better point nearby
-  size_t points_grazing = 0;        // dropped for a grazing view (ScanOptions::view)
+  size_t points_redundant = 0;  // dropped for a better point nearby
+  size_t points_grazing = 0;    // dropped for a grazing view (ScanOptions::view)
   std::vector<LaserSweepReport> sweeps;
-  SwayEstimate sway;                // empty when not compensated
-  std::string sway_not_estimated;   // why there is no sway estimate (the cloud is kept as measured)
-  double processing_seconds = 0;    // frames to points, acquisition excluded
-  std::string first_plane_error;    // the first frame without a plane, for the log
+  SwayEstimate sway;               // empty when not compensated
+  std::string sway_not_estimated;  // why there is no sway estimate (the cloud is kept as measured)
+  double processing_seconds = 0;   // frames to points, acquisition excluded
+  std::string first_plane_error;   // the first frame without a plane, for the log
 };
 
 class ScanProcessor {

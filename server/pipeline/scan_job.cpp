@@ -21,10 +21,10 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // From the cloud on: the surface, then the automatic measurements.
 Status surface_and_measure(const ScanJobOptions& options, ScanJobResult* out) {
   if (out->cloud.size() < 1000) {
-    return failed_precondition("the scan gave " + std::to_string(out->cloud.size()) +
-                               " points: is someone standing in the frame, and are the lasers on? " +
-                               (out->scan.first_plane_error.empty() ? "" : "(first frame error: " +
-                                                                              out->scan.first_plane_error + ")"));
+    return failed_precondition(
+        "the scan gave " + std::to_string(out->cloud.size()) +
+        " points: is someone standing in the frame, and are the lasers on? " +
+        (out->scan.first_plane_error.empty() ? "" : "(first frame error: " + out->scan.first_plane_error + ")"));
   }
   if (options.reconstruct) {
     ReconstructOptions ro = with_scan_normals(options.surface, out->cloud);
@@ -45,8 +45,10 @@ Status surface_and_measure(const ScanJobOptions& options, ScanJobResult* out) {
     // light centres (world Y = 0) half a tube up.
     mo.floor_y = -0.5 * out->calibration.frame.tube;
     StatusOr<BodyMeasurements> body = measure_body(out->mesh, mo);
-    if (body.ok()) out->body = std::move(*body);
-    else out->measure_error = body.status().message();
+    if (body.ok())
+      out->body = std::move(*body);
+    else
+      out->measure_error = body.status().message();
   }
   return Status::Ok();
 }
@@ -75,8 +77,7 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, RigCalibration calibration,
         if (options.on_scan_shot) options.on_scan_shot(s);
         return processor.consume(std::move(s));
       },
-      options.every, options.progress,
-      out.calibration.sweep_reversed));
+      options.every, options.progress, out.calibration.sweep_reversed));
   if (options.record_raw) {
     out.raw_record = calibration_record(out.calibration);
     out.raw_record["scan_options"] = {{"max_view_deg", scan_options.view.max_view_deg}, {"every", options.every}};
@@ -89,7 +90,8 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, RigCalibration calibration,
   return out;
 }
 
-StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string_view stripes, const ScanJobOptions& options) {
+StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string_view stripes,
+                                       const ScanJobOptions& options) {
   ScanJobResult out;
   ASSIGN_OR_RETURN(out.calibration, calibration_from_record(record));
   const auto t0 = std::chrono::steady_clock::now();
@@ -172,11 +174,12 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
                  {"pair_rms_after_mm", w.rms_after_mm},
                  {"first_frame", w.first_frame},
                  {"knot_frames", w.knot_frames},
-                 {"hold", {{"still", w.regularization.still},
-                           {"per_axis", w.regularization.per_axis},
-                           {"ridge_scale", w.regularization.ridge_scale},
-                           {"slow_scale", w.regularization.slow_scale},
-                           {"held_out_rms_mm", w.held_out_rms_mm}}},
+                 {"hold",
+                  {{"still", w.regularization.still},
+                   {"per_axis", w.regularization.per_axis},
+                   {"ridge_scale", w.regularization.ridge_scale},
+                   {"slow_scale", w.regularization.slow_scale},
+                   {"held_out_rms_mm", w.held_out_rms_mm}}},
                  {"path_mm", path}};
   } else if (!r.scan.sway_not_estimated.empty()) {
     j["sway_not_estimated"] = r.scan.sway_not_estimated;
@@ -201,7 +204,8 @@ Status write_scan_results(const ScanJobResult& r, const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(d / "raw", ec);
   if (ec) return io_error("cannot create '" + (d / "raw").string() + "': " + ec.message());
-  for (const auto& [name, bytes] : files.raw) RETURN_IF_ERROR(write_file_atomically((d / "raw" / name).string(), bytes));
+  for (const auto& [name, bytes] : files.raw)
+    RETURN_IF_ERROR(write_file_atomically((d / "raw" / name).string(), bytes));
   // scan.json last: its presence says the rest is there.
   for (const auto& [name, bytes] : files.results)
     if (name != "scan.json") RETURN_IF_ERROR(write_file_atomically((d / name).string(), bytes));

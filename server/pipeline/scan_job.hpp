@@ -56,9 +56,9 @@ struct ScanJobOptions {
   std::optional<double> max_view_deg;
   bool reconstruct = true;
   ReconstructOptions surface = body_surface_options();
-  bool measure = true;  // the automatic set on the surface (measure_body)
+  bool measure = true;     // the automatic set on the surface (measure_body)
   bool record_raw = true;  // keep the raw record (scan_recording.hpp) in the result
-  ProgressFn progress;  // stages: calibration..., scan, surface...
+  ProgressFn progress;     // stages: calibration..., scan, surface...
   // Sees every scan shot before it is processed (live previews); called on the
   // job's thread, so it must be quick.
   std::function<void(const Shot&)> on_scan_shot;
@@ -96,7 +96,7 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, RigCalibration calibration,
 StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string_view stripes,
                                        const ScanJobOptions& options = {});
 
-inline constexpr const char* kRawRecordFile = "record.json";   // in DIR/raw and the archive's raw/
+inline constexpr const char* kRawRecordFile = "record.json";  // in DIR/raw and the archive's raw/
 inline constexpr const char* kRawStripesFile = "stripes.bin";
 
 // Every file a scan leaves, as bytes: the results (calibration.json, points.ply,

@@ -51,7 +51,10 @@ nlohmann::json calibration_record(const RigCalibration& cal) {
   }
   nlohmann::json sightings = nlohmann::json::array();
   for (const LaserSighting& s : cal.sightings)
-    sightings.push_back({{"laser", s.laser}, {"step", s.step}, {"camera", s.camera}, {"normal", vec(s.plane.normal)},
+    sightings.push_back({{"laser", s.laser},
+                         {"step", s.step},
+                         {"camera", s.camera},
+                         {"normal", vec(s.plane.normal)},
                          {"offset", s.plane.offset}});
   std::vector<int> reversed;
   for (bool b : cal.sweep_reversed) reversed.push_back(b ? 1 : 0);
@@ -59,7 +62,11 @@ nlohmann::json calibration_record(const RigCalibration& cal) {
   return {{"schema", kCalibrationRecordSchema},
           {"rig", cal.rig_name},
           {"frame",
-           {{"width", f.width}, {"depth", f.depth}, {"top_height", f.top_height}, {"tube", f.tube}, {"light_x", f.light_x}}},
+           {{"width", f.width},
+            {"depth", f.depth},
+            {"top_height", f.top_height},
+            {"tube", f.tube},
+            {"light_x", f.light_x}}},
           {"cameras", cams},
           {"laser_ids", cal.laser_ids},
           {"sweep_reversed", reversed},
@@ -114,7 +121,8 @@ StatusOr<RigCalibration> calibration_from_record(const nlohmann::json& j) {
         for (size_t i = 0; i < 2; ++i)
           if (!read_vec(m[p].at(i), &markers[p][i])) return bad("camera '" + id + "': a marker is not [x, y]");
       const FrameSide side = c.at("side").get<std::string>() == "back" ? FrameSide::kBack : FrameSide::kFront;
-      auto cam = camera_from_markers(id, c.at("width").get<int>(), c.at("height").get<int>(), cal.frame, lens, side, markers);
+      auto cam =
+          camera_from_markers(id, c.at("width").get<int>(), c.at("height").get<int>(), cal.frame, lens, side, markers);
       if (!cam.ok()) return bad(cam.status().message());
       cal.cameras.push_back(*cam);
       cal.lasers_seen.push_back(c.at("lasers_seen").get<std::vector<int>>());
@@ -243,7 +251,8 @@ Status ScanProcessor::load_recording(std::string_view bytes) {
   std::string raw(n, '\0');
   uLongf raw_size = n;
   if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &raw_size,
-                 reinterpret_cast<const Bytef*>(bytes.data() + sizeof kMagic + 8), bytes.size() - sizeof kMagic - 8) != Z_OK ||
+                 reinterpret_cast<const Bytef*>(bytes.data() + sizeof kMagic + 8),
+                 bytes.size() - sizeof kMagic - 8) != Z_OK ||
       raw_size != n)
     return bad("the compressed data is damaged");
   Reader rd(raw);

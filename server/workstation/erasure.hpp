@@ -16,7 +16,6 @@ namespace bodyscan::server {
 // without a workstation): there are no links then.
 Status erase_customer(storage::Archive& archive, AuthStore* accounts, const std::string& customer_id,
                       const std::string& actor);
-Status erase_scan(storage::Archive& archive, AuthStore* accounts, const std::string& scan_id,
-                  const std::string& actor);
+Status erase_scan(storage::Archive& archive, AuthStore* accounts, const std::string& scan_id, const std::string& actor);
 
 }  // namespace bodyscan::server

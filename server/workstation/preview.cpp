@@ -57,8 +57,7 @@ StatusOr<GrayImage> preview_image(const hw::Frame& f, int width) {
   img.pixels.resize(mean.size());
   // A block's brightest pixel counts when it stands far above the scene (a laser
   // line), not for sensor noise.
-  for (size_t i = 0; i < mean.size(); ++i)
-    img.pixels[i] = peak[i] > 2 * hi ? uint8_t{255} : level(mean[i]);
+  for (size_t i = 0; i < mean.size(); ++i) img.pixels[i] = peak[i] > 2 * hi ? uint8_t{255} : level(mean[i]);
   return img;
 }
 

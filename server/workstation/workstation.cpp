@@ -21,9 +21,9 @@
 #include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/archive_scan.hpp"
+#include "server/pipeline/rig_backend.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/scan_recording.hpp"
-#include "server/pipeline/rig_backend.hpp"
 #include "server/workstation/preview.hpp"
 #include "storage/archive/ids.hpp"
 
@@ -49,9 +49,9 @@ const char* to_string(JobState s) {
 }
 
 nlohmann::json to_json(const JobInfo& j) {
-  nlohmann::json out = {{"id", j.id},           {"kind", to_string(j.kind)}, {"state", to_string(j.state)},
-                        {"stage", j.stage},     {"fraction", j.fraction},    {"frames", j.frames},
-                        {"actor", j.actor},     {"started_at", j.started_at}};
+  nlohmann::json out = {{"id", j.id},       {"kind", to_string(j.kind)}, {"state", to_string(j.state)},
+                        {"stage", j.stage}, {"fraction", j.fraction},    {"frames", j.frames},
+                        {"actor", j.actor}, {"started_at", j.started_at}};
   if (!j.scan_id.empty()) out["scan_id"] = j.scan_id;
   if (!j.customer_id.empty()) out["customer_id"] = j.customer_id;
   if (!j.error.empty()) out["error"] = j.error;
@@ -70,9 +70,7 @@ nlohmann::json to_json(const JobInfo& j) {
 
 namespace {
 
-
 int64_t unix_now() { return static_cast<int64_t>(std::time(nullptr)); }
-
 
 std::string base64(const std::string& bytes) {
   std::string out(sodium_base64_encoded_len(bytes.size(), sodium_base64_VARIANT_ORIGINAL), '\0');
@@ -218,8 +216,7 @@ struct Workstation::Impl {
       if (!path.ok()) continue;
       StatusOr<std::string> text = read_whole_file(*path);
       if (!text.ok()) continue;
-      StatusOr<pipeline::RigCalibration> cal =
-          pipeline::calibration_from_record(parse_json(*text));
+      StatusOr<pipeline::RigCalibration> cal = pipeline::calibration_from_record(parse_json(*text));
       if (!cal.ok()) continue;
       std::tm tm{};
       if (!strptime(r.started_at.c_str(), "%Y-%m-%dT%H:%M:%S", &tm)) continue;
@@ -341,8 +338,10 @@ nlohmann::json Workstation::Impl::status_json() const {
   for (size_t i = 0; i < desc.lasers.size(); ++i) {
     // While a job runs the job owns the controller; the lasers are its to switch.
     nlohmann::json l = {{"id", desc.lasers[i].id}};
-    if (s.running) l["on"] = nullptr;
-    else l["on"] = s.rig.controller->laser_on(static_cast<int>(i));
+    if (s.running)
+      l["on"] = nullptr;
+    else
+      l["on"] = s.rig.controller->laser_on(static_cast<int>(i));
     lasers.push_back(l);
   }
   nlohmann::json out = {{"rig", desc.name},
@@ -406,8 +405,9 @@ void Workstation::Impl::run(JobInfo j, std::function<Status()> work) {
 // On the job's thread: shows the request as the job's prompt and waits for the
 // answer, a cancel or the timeout.
 Status Workstation::Impl::ask_operator(const pipeline::OperatorRequest& request) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                                std::chrono::duration<double>(options.operator_timeout_s));
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                             std::chrono::duration<double>(options.operator_timeout_s));
   std::string id;
   {
     std::lock_guard lock(mutex);
@@ -438,7 +438,7 @@ Status Workstation::Impl::ask_operator(const pipeline::OperatorRequest& request)
                                        : std::to_string(static_cast<int>(std::lround(t / 60))) + " minutes";
     // Not a device's fault (deadline_exceeded would be reported as one).
     return failed_precondition("nobody confirmed the dot-grid board in " + waited +
-                             "; calibrate again when someone can hold it");
+                               "; calibrate again when someone can hold it");
   }
   return Status::Ok();
 }
@@ -501,8 +501,7 @@ Status Workstation::Impl::do_scan(int every) {
     }
     const auto now = std::chrono::steady_clock::now();
     auto it = last_preview->find(shot.camera);
-    if (it != last_preview->end() &&
-        now - it->second < std::chrono::duration<double>(options.preview_interval_s))
+    if (it != last_preview->end() && now - it->second < std::chrono::duration<double>(options.preview_interval_s))
       return;
     (*last_preview)[shot.camera] = now;
     StatusOr<std::string> png = preview_png(shot.frame, options.preview_width);
@@ -587,7 +586,8 @@ Status Workstation::answer_prompt(const std::string& job_id, const std::string& 
   {
     std::lock_guard lock(s.mutex);
     if (!s.job || s.job->id != job_id) return not_found("no job " + job_id);
-    if (!s.running) return failed_precondition("job " + job_id + " has already ended (" + to_string(s.job->state) + ")");
+    if (!s.running)
+      return failed_precondition("job " + job_id + " has already ended (" + to_string(s.job->state) + ")");
     if (!s.job->prompt) return failed_precondition("job " + job_id + " is not waiting for anyone");
     if (s.job->prompt->id != prompt_id) {
       return failed_precondition("job " + job_id + " now asks " + s.job->prompt->id + " (\"" + s.job->prompt->text +

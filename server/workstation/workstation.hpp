@@ -31,7 +31,7 @@ struct WorkstationOptions {
   std::string rig = "sim";                 // sim | thesis | square | a rig description file
   pipeline::SimulatedSubject subject;      // the simulated subject, its posture and place
   AuthOptions auth;
-  int default_every = 1;                   // scan every Nth laser step unless a request says
+  int default_every = 1;  // scan every Nth laser step unless a request says
   // Live camera previews during a scan: at most one per camera this often, this wide.
   double preview_interval_s = 1.0;
   int preview_width = 160;
@@ -51,26 +51,26 @@ const char* to_string(JobState s);
 // What a job waits for a person to do (a calibration's dot grid): answered with
 // Workstation::answer_prompt, naming its id.
 struct JobPrompt {
-  std::string id;         // "p" + a number, new for every question
-  std::string kind;       // hold_dot_grid | remove_dot_grid
-  std::string camera;     // the camera's id (hold_dot_grid)
-  std::string text;       // the instruction, for the station to show
-  std::string why;        // why the last picture of the board could not be used
-  std::string asked_at;   // ISO 8601 UTC
+  std::string id;        // "p" + a number, new for every question
+  std::string kind;      // hold_dot_grid | remove_dot_grid
+  std::string camera;    // the camera's id (hold_dot_grid)
+  std::string text;      // the instruction, for the station to show
+  std::string why;       // why the last picture of the board could not be used
+  std::string asked_at;  // ISO 8601 UTC
 };
 
 struct JobInfo {
   std::string id;  // "j_" + 16 hex digits
   JobKind kind = JobKind::kScan;
   JobState state = JobState::kRunning;
-  std::string stage;       // e.g. "calibration: lens", "scan", "surface: field"
-  double fraction = 0;     // of the stage
-  int64_t frames = 0;      // camera frames processed so far (scans)
+  std::string stage;    // e.g. "calibration: lens", "scan", "surface: field"
+  double fraction = 0;  // of the stage
+  int64_t frames = 0;   // camera frames processed so far (scans)
   std::string scan_id, customer_id, actor;
-  std::string error;       // why it failed or was cancelled
+  std::string error;                    // why it failed or was cancelled
   std::string started_at, finished_at;  // ISO 8601 UTC
-  int version = 0;         // a reprocess's new version
-  std::optional<JobPrompt> prompt;  // what the job waits for a person to do
+  int version = 0;                      // a reprocess's new version
+  std::optional<JobPrompt> prompt;      // what the job waits for a person to do
 };
 nlohmann::json to_json(const JobInfo& job);
 

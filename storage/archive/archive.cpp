@@ -60,7 +60,6 @@ std::string now_iso() {
   return out;
 }
 
-
 // "s_20261122_101530_" + 8 hex digits: sorts by time, unguessable enough to be no
 // one's business, short enough to read out.
 std::string new_id(char kind) {
@@ -106,7 +105,9 @@ Status make_dirs(const fs::path& p) {
   return Status::Ok();
 }
 
-nlohmann::json file_json(const ArchivedFile& f) { return {{"name", f.name}, {"bytes", f.bytes}, {"blake2b", f.blake2b}}; }
+nlohmann::json file_json(const ArchivedFile& f) {
+  return {{"name", f.name}, {"bytes", f.bytes}, {"blake2b", f.blake2b}};
+}
 
 }  // namespace
 
@@ -129,9 +130,9 @@ struct Archive::Impl {
   }
 
   Status schema() {
-    RETURN_IF_ERROR(db.exec(
-        "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON; PRAGMA secure_delete=ON;"
-        "PRAGMA busy_timeout=5000;"));
+    RETURN_IF_ERROR(
+        db.exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA foreign_keys=ON; PRAGMA secure_delete=ON;"
+                "PRAGMA busy_timeout=5000;"));
     RETURN_IF_ERROR(db.exec(R"sql(
       CREATE TABLE IF NOT EXISTS meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);
       CREATE TABLE IF NOT EXISTS customers(
@@ -191,9 +192,9 @@ struct Archive::Impl {
   }
 
   StatusOr<std::vector<ArchivedFile>> files(const std::string& scan, int version) const {
-    ASSIGN_OR_RETURN(Statement st, db.prepare(
-                                       "SELECT name, bytes, blake2b FROM scan_files WHERE scan_id = ? AND version = ? "
-                                       "ORDER BY name"));
+    ASSIGN_OR_RETURN(Statement st,
+                     db.prepare("SELECT name, bytes, blake2b FROM scan_files WHERE scan_id = ? AND version = ? "
+                                "ORDER BY name"));
     st.bind(1, scan).bind(2, version);
     std::vector<ArchivedFile> out;
     for (;;) {
@@ -205,10 +206,10 @@ struct Archive::Impl {
   }
 
   StatusOr<ScanRecord> record(const std::string& id) const {
-    ASSIGN_OR_RETURN(Statement st, db.prepare(
-                                       "SELECT id, customer_id, operator, IFNULL(calibration_id, ''), status, "
-                                       "status_reason, started_at, IFNULL(finished_at, ''), rig, current_version "
-                                       "FROM scans WHERE id = ?"));
+    ASSIGN_OR_RETURN(Statement st,
+                     db.prepare("SELECT id, customer_id, operator, IFNULL(calibration_id, ''), status, "
+                                "status_reason, started_at, IFNULL(finished_at, ''), rig, current_version "
+                                "FROM scans WHERE id = ?"));
     st.bind(1, id);
     ASSIGN_OR_RETURN(bool row, st.step());
     if (!row) return not_found("archive: no scan '" + id + "'");
@@ -218,9 +219,8 @@ struct Archive::Impl {
     r.status_reason = st.text(5), r.started_at = st.text(6), r.finished_at = st.text(7);
     r.rig = parse_json(st.text(8));
     r.current_version = static_cast<int>(st.integer(9));
-    ASSIGN_OR_RETURN(Statement vs, db.prepare(
-                                       "SELECT version, created_at, algorithms, note FROM scan_versions "
-                                       "WHERE scan_id = ? ORDER BY version"));
+    ASSIGN_OR_RETURN(Statement vs, db.prepare("SELECT version, created_at, algorithms, note FROM scan_versions "
+                                              "WHERE scan_id = ? ORDER BY version"));
     vs.bind(1, id);
     for (;;) {
       ASSIGN_OR_RETURN(bool more, vs.step());
@@ -242,8 +242,11 @@ struct Archive::Impl {
     for (const ScanVersion& v : r.versions) {
       nlohmann::json files = nlohmann::json::array();
       for (const ArchivedFile& f : v.files) files.push_back(file_json(f));
-      versions.push_back({{"version", v.version}, {"created_at", v.created_at}, {"algorithms", v.algorithms},
-                          {"note", v.note}, {"files", files}});
+      versions.push_back({{"version", v.version},
+                          {"created_at", v.created_at},
+                          {"algorithms", v.algorithms},
+                          {"note", v.note},
+                          {"files", files}});
     }
     nlohmann::json raw = nlohmann::json::array();
     for (const ArchivedFile& f : r.raw) raw.push_back(file_json(f));
@@ -269,7 +272,8 @@ struct Archive::Impl {
   }
 
   // Writes files into `folder` (each whole or not at all) and lists them.
-  StatusOr<std::vector<ArchivedFile>> put_files(const fs::path& folder, const std::map<std::string, std::string>& files) {
+  StatusOr<std::vector<ArchivedFile>> put_files(const fs::path& folder,
+                                                const std::map<std::string, std::string>& files) {
     RETURN_IF_ERROR(make_dirs(folder));
     std::vector<ArchivedFile> out;
     for (const auto& [name, bytes] : files) {
@@ -282,8 +286,9 @@ struct Archive::Impl {
   }
 
   Status insert_files(const std::string& scan, int version, const std::vector<ArchivedFile>& files) {
-    ASSIGN_OR_RETURN(Statement st, db.prepare("INSERT OR REPLACE INTO scan_files(scan_id, version, name, bytes, blake2b) "
-                                              "VALUES (?, ?, ?, ?, ?)"));
+    ASSIGN_OR_RETURN(Statement st,
+                     db.prepare("INSERT OR REPLACE INTO scan_files(scan_id, version, name, bytes, blake2b) "
+                                "VALUES (?, ?, ?, ?, ?)"));
     for (const ArchivedFile& f : files) {
       st.bind(1, scan).bind(2, version).bind(3, f.name).bind(4, static_cast<int64_t>(f.bytes)).bind(5, f.blake2b);
       RETURN_IF_ERROR(st.run());
@@ -293,9 +298,10 @@ struct Archive::Impl {
   }
 
   Status insert_measurement(const MeasurementRecord& m, int64_t* id) {
-    ASSIGN_OR_RETURN(Statement st, db.prepare(
-                                       "INSERT INTO measurements(scan_id, version, source, name, label, kind, iso_clause, "
-                                       "value_mm, geometry, created_by, created_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+    ASSIGN_OR_RETURN(
+        Statement st,
+        db.prepare("INSERT INTO measurements(scan_id, version, source, name, label, kind, iso_clause, "
+                   "value_mm, geometry, created_by, created_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
     st.bind(1, m.scan_id).bind(2, m.version).bind(3, m.source).bind(4, m.name).bind(5, m.label).bind(6, m.kind);
     st.bind(7, m.iso_clause).bind(8, m.value_mm).bind(9, m.geometry.dump()).bind(10, m.created_by);
     st.bind(11, m.created_at.empty() ? now_iso() : m.created_at);
@@ -350,8 +356,9 @@ struct Archive::Impl {
         ASSIGN_OR_RETURN(Statement st, db.prepare(sql));
         RETURN_IF_ERROR(st.bind(1, id).run());
       }
-      ASSIGN_OR_RETURN(Statement st, db.prepare("UPDATE scans SET status = 'failed', status_reason = ?, finished_at = ?, "
-                                                "current_version = 0 WHERE id = ?"));
+      ASSIGN_OR_RETURN(Statement st,
+                       db.prepare("UPDATE scans SET status = 'failed', status_reason = ?, finished_at = ?, "
+                                  "current_version = 0 WHERE id = ?"));
       RETURN_IF_ERROR(st.bind(1, kInterrupted).bind(2, now_iso()).bind(3, id).run());
       RETURN_IF_ERROR(log("system", "recover", "scan", id, kInterrupted));
       RETURN_IF_ERROR(tx.commit());
@@ -382,7 +389,8 @@ struct Archive::Impl {
       for (const fs::path& p : extra) discard(p), ++recovery.versions_removed;
       const std::string want = manifest(r).dump(1);
       auto have = slurp(scan_dir(id) / "manifest.json");
-      if (!have.ok() || *have != want) RETURN_IF_ERROR(write_file_atomically((scan_dir(id) / "manifest.json").string(), want));
+      if (!have.ok() || *have != want)
+        RETURN_IF_ERROR(write_file_atomically((scan_dir(id) / "manifest.json").string(), want));
     }
     ASSIGN_OR_RETURN(std::vector<std::string> cals, ids("SELECT id FROM calibrations"));
     const std::set<std::string> cal_set(cals.begin(), cals.end());
@@ -438,12 +446,13 @@ StatusOr<std::unique_ptr<Archive>> Archive::open(const std::string& dir_in) {
 
 // --- customers ---------------------------------------------------------------
 
-StatusOr<Customer> Archive::add_customer(const std::optional<std::string>& name, const std::optional<std::string>& contact,
-                                         const std::string& actor) {
+StatusOr<Customer> Archive::add_customer(const std::optional<std::string>& name,
+                                         const std::optional<std::string>& contact, const std::string& actor) {
   std::lock_guard lock(impl_->mu);
   Customer c{"c_" + random_hex(8), name, contact, now_iso()};
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("INSERT INTO customers(id, name, contact, created_at) VALUES (?, ?, ?, ?)"));
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("INSERT INTO customers(id, name, contact, created_at) VALUES (?, ?, ?, ?)"));
   RETURN_IF_ERROR(st.bind(1, c.id).bind(2, c.name).bind(3, c.contact).bind(4, c.created_at).run());
   RETURN_IF_ERROR(impl_->log(actor, "add customer", "customer", c.id, ""));
   RETURN_IF_ERROR(tx.commit());
@@ -465,8 +474,8 @@ StatusOr<Customer> Archive::customer(const std::string& id) const {
 
 StatusOr<std::vector<Customer>> Archive::customers(const std::string& text) const {
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare(
-                                     "SELECT id, name, contact, created_at FROM customers WHERE ?1 = '' OR "
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("SELECT id, name, contact, created_at FROM customers WHERE ?1 = '' OR "
                                      "instr(lower(id), lower(?1)) OR instr(lower(IFNULL(name, '')), lower(?1)) OR "
                                      "instr(lower(IFNULL(contact, '')), lower(?1)) ORDER BY created_at DESC"));
   st.bind(1, text);
@@ -514,7 +523,8 @@ StatusOr<std::string> Archive::add_calibration(const nlohmann::json& rig, const 
   RETURN_IF_ERROR(write_file_atomically((folder / "calibration.json").string(), calibration.dump(1)));
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("INSERT INTO calibrations(id, created_at, created_by) VALUES (?, ?, ?)"));
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("INSERT INTO calibrations(id, created_at, created_by) VALUES (?, ?, ?)"));
   RETURN_IF_ERROR(st.bind(1, id).bind(2, now_iso()).bind(3, actor).run());
   RETURN_IF_ERROR(impl_->log(actor, "calibrate", "calibration", id, ""));
   RETURN_IF_ERROR(tx.commit());
@@ -531,9 +541,7 @@ StatusOr<nlohmann::json> Archive::calibration(const std::string& id) const {
   const fs::path folder = impl_->dir / "calibrations" / id;
   ASSIGN_OR_RETURN(std::string rig, slurp(folder / "rig.json"));
   ASSIGN_OR_RETURN(std::string cal, slurp(folder / "calibration.json"));
-  return nlohmann::json{{"id", id},
-                        {"rig", parse_json(rig)},
-                        {"calibration", parse_json(cal)}};
+  return nlohmann::json{{"id", id}, {"rig", parse_json(rig)}, {"calibration", parse_json(cal)}};
 }
 
 // --- scans -------------------------------------------------------------------
@@ -544,12 +552,15 @@ StatusOr<std::string> Archive::begin_scan(const std::string& customer_id, const 
   std::lock_guard lock(impl_->mu);
   const std::string id = new_id('s');
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare(
-                                     "INSERT INTO scans(id, customer_id, operator, calibration_id, status, started_at, rig) "
-                                     "VALUES (?, ?, ?, ?, 'running', ?, ?)"));
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare("INSERT INTO scans(id, customer_id, operator, calibration_id, status, started_at, rig) "
+                        "VALUES (?, ?, ?, ?, 'running', ?, ?)"));
   st.bind(1, id).bind(2, customer_id).bind(3, operator_name);
-  if (calibration_id.empty()) st.bind_null(4);
-  else st.bind(4, calibration_id);
+  if (calibration_id.empty())
+    st.bind_null(4);
+  else
+    st.bind(4, calibration_id);
   st.bind(5, now_iso()).bind(6, rig.dump());
   const Status s = st.run();
   if (!s.ok()) {
@@ -601,16 +612,18 @@ Status Archive::complete_scan(const std::string& scan_id, const ScanResults& res
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
   RETURN_IF_ERROR(impl_->insert_files(scan_id, 1, files));
-  ASSIGN_OR_RETURN(Statement v, impl_->db.prepare(
-                                    "INSERT INTO scan_versions(scan_id, version, created_at, algorithms, note) VALUES (?, 1, ?, ?, ?)"));
+  ASSIGN_OR_RETURN(
+      Statement v,
+      impl_->db.prepare(
+          "INSERT INTO scan_versions(scan_id, version, created_at, algorithms, note) VALUES (?, 1, ?, ?, ?)"));
   RETURN_IF_ERROR(v.bind(1, scan_id).bind(2, now_iso()).bind(3, results.algorithms.dump()).bind(4, results.note).run());
   for (MeasurementRecord m : results.measurements) {
     m.scan_id = scan_id, m.version = 1, m.source = "automatic";
     if (m.created_by.empty()) m.created_by = "system";
     RETURN_IF_ERROR(impl_->insert_measurement(m, nullptr));
   }
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare(
-                                     "UPDATE scans SET status = 'complete', status_reason = '', finished_at = ?, "
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("UPDATE scans SET status = 'complete', status_reason = '', finished_at = ?, "
                                      "current_version = 1 WHERE id = ?"));
   RETURN_IF_ERROR(st.bind(1, now_iso()).bind(2, scan_id).run());
   RETURN_IF_ERROR(impl_->log("system", "complete scan", "scan", scan_id, std::to_string(files.size()) + " files"));
@@ -630,10 +643,11 @@ Status Archive::end_scan(const std::string& scan_id, ScanStatus status, const st
     ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
     ASSIGN_OR_RETURN(Statement files, impl_->db.prepare("DELETE FROM scan_files WHERE scan_id = ?"));
     RETURN_IF_ERROR(files.bind(1, scan_id).run());
-    ASSIGN_OR_RETURN(Statement st, impl_->db.prepare(
-                                       "UPDATE scans SET status = ?, status_reason = ?, finished_at = ? WHERE id = ?"));
+    ASSIGN_OR_RETURN(Statement st,
+                     impl_->db.prepare("UPDATE scans SET status = ?, status_reason = ?, finished_at = ? WHERE id = ?"));
     RETURN_IF_ERROR(st.bind(1, to_string(status)).bind(2, reason).bind(3, now_iso()).bind(4, scan_id).run());
-    RETURN_IF_ERROR(impl_->log("system", status == ScanStatus::kFailed ? "scan failed" : "scan cancelled", "scan", scan_id, reason));
+    RETURN_IF_ERROR(impl_->log("system", status == ScanStatus::kFailed ? "scan failed" : "scan cancelled", "scan",
+                               scan_id, reason));
     RETURN_IF_ERROR(tx.commit());
   }
   impl_->discard(impl_->scan_dir(scan_id));
@@ -646,7 +660,8 @@ StatusOr<int> Archive::add_version(const std::string& scan_id, const ScanResults
   {
     std::lock_guard lock(impl_->mu);
     ASSIGN_OR_RETURN(ScanRecord r, impl_->record(scan_id));
-    if (r.status != ScanStatus::kComplete) return failed_precondition("archive: scan '" + scan_id + "' has no results to reprocess");
+    if (r.status != ScanStatus::kComplete)
+      return failed_precondition("archive: scan '" + scan_id + "' has no results to reprocess");
     version = r.versions.empty() ? 1 : r.versions.back().version + 1;
   }
   const fs::path folder = impl_->version_dir(scan_id, version);
@@ -659,9 +674,16 @@ StatusOr<int> Archive::add_version(const std::string& scan_id, const ScanResults
   Status s = [&]() -> Status {
     ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
     RETURN_IF_ERROR(impl_->insert_files(scan_id, version, *files));
-    ASSIGN_OR_RETURN(Statement v, impl_->db.prepare(
-                                      "INSERT INTO scan_versions(scan_id, version, created_at, algorithms, note) VALUES (?, ?, ?, ?, ?)"));
-    RETURN_IF_ERROR(v.bind(1, scan_id).bind(2, version).bind(3, now_iso()).bind(4, results.algorithms.dump()).bind(5, results.note).run());
+    ASSIGN_OR_RETURN(
+        Statement v,
+        impl_->db.prepare(
+            "INSERT INTO scan_versions(scan_id, version, created_at, algorithms, note) VALUES (?, ?, ?, ?, ?)"));
+    RETURN_IF_ERROR(v.bind(1, scan_id)
+                        .bind(2, version)
+                        .bind(3, now_iso())
+                        .bind(4, results.algorithms.dump())
+                        .bind(5, results.note)
+                        .run());
     for (MeasurementRecord m : results.measurements) {
       m.scan_id = scan_id, m.version = version, m.source = "automatic";
       if (m.created_by.empty()) m.created_by = actor;
@@ -704,13 +726,14 @@ StatusOr<ScanRecord> Archive::scan(const std::string& id) const {
 
 StatusOr<std::vector<ScanRecord>> Archive::scans(const ScanQuery& q) const {
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare(
-                                     "SELECT s.id FROM scans s JOIN customers c ON c.id = s.customer_id "
-                                     "WHERE (?1 = '' OR s.customer_id = ?1) "
-                                     "AND (?2 = '' OR instr(lower(s.id), lower(?2)) OR instr(lower(s.customer_id), lower(?2)) "
-                                     "     OR instr(lower(IFNULL(c.name, '')), lower(?2)) OR instr(lower(s.operator), lower(?2))) "
-                                     "AND (?3 = '' OR s.started_at >= ?3) AND (?4 = '' OR substr(s.started_at, 1, length(?4)) <= ?4) "
-                                     "ORDER BY s.started_at DESC, s.id DESC LIMIT ?5"));
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare(
+                       "SELECT s.id FROM scans s JOIN customers c ON c.id = s.customer_id "
+                       "WHERE (?1 = '' OR s.customer_id = ?1) "
+                       "AND (?2 = '' OR instr(lower(s.id), lower(?2)) OR instr(lower(s.customer_id), lower(?2)) "
+                       "     OR instr(lower(IFNULL(c.name, '')), lower(?2)) OR instr(lower(s.operator), lower(?2))) "
+                       "AND (?3 = '' OR s.started_at >= ?3) AND (?4 = '' OR substr(s.started_at, 1, length(?4)) <= ?4) "
+                       "ORDER BY s.started_at DESC, s.id DESC LIMIT ?5"));
   st.bind(1, q.customer_id).bind(2, q.text).bind(3, q.from).bind(4, q.to).bind(5, q.limit);
   std::vector<std::string> found;
   for (;;) {
@@ -751,25 +774,26 @@ StatusOr<std::vector<MeasurementRecord>> Archive::measurements(const std::string
   std::vector<MeasurementRecord> out;
   std::vector<std::string> geometry;  // parsed after the lock is let go: it is most of the work
   {
-  std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(ScanRecord r, impl_->record(scan_id));
-  const int v = version == 0 ? r.current_version : version;
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare(
-                                     "SELECT id, scan_id, version, source, name, label, kind, iso_clause, value_mm, geometry, "
-                                     "created_by, created_at FROM measurements WHERE scan_id = ? AND "
-                                     "(version = ? OR source = 'user') ORDER BY source, id"));
-  st.bind(1, scan_id).bind(2, v);
-  for (;;) {
-    ASSIGN_OR_RETURN(bool row, st.step());
-    if (!row) break;
-    MeasurementRecord m;
-    m.id = st.integer(0), m.scan_id = st.text(1), m.version = static_cast<int>(st.integer(2));
-    m.source = st.text(3), m.name = st.text(4), m.label = st.text(5), m.kind = st.text(6), m.iso_clause = st.text(7);
-    m.value_mm = st.real(8);
-    geometry.push_back(st.text(9));
-    m.created_by = st.text(10), m.created_at = st.text(11);
-    out.push_back(std::move(m));
-  }
+    std::lock_guard lock(impl_->mu);
+    ASSIGN_OR_RETURN(ScanRecord r, impl_->record(scan_id));
+    const int v = version == 0 ? r.current_version : version;
+    ASSIGN_OR_RETURN(
+        Statement st,
+        impl_->db.prepare("SELECT id, scan_id, version, source, name, label, kind, iso_clause, value_mm, geometry, "
+                          "created_by, created_at FROM measurements WHERE scan_id = ? AND "
+                          "(version = ? OR source = 'user') ORDER BY source, id"));
+    st.bind(1, scan_id).bind(2, v);
+    for (;;) {
+      ASSIGN_OR_RETURN(bool row, st.step());
+      if (!row) break;
+      MeasurementRecord m;
+      m.id = st.integer(0), m.scan_id = st.text(1), m.version = static_cast<int>(st.integer(2));
+      m.source = st.text(3), m.name = st.text(4), m.label = st.text(5), m.kind = st.text(6), m.iso_clause = st.text(7);
+      m.value_mm = st.real(8);
+      geometry.push_back(st.text(9));
+      m.created_by = st.text(10), m.created_at = st.text(11);
+      out.push_back(std::move(m));
+    }
   }
   for (size_t i = 0; i < out.size(); ++i) out[i].geometry = parse_json(geometry[i]);
   return out;
@@ -780,7 +804,8 @@ StatusOr<int64_t> Archive::save_measurement(const MeasurementRecord& in, const s
   if (in.name.empty()) return invalid_argument("archive: a saved measurement needs a name");
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(ScanRecord r, impl_->record(in.scan_id));
-  if (r.status != ScanStatus::kComplete) return failed_precondition("archive: scan '" + in.scan_id + "' has no surface to measure");
+  if (r.status != ScanStatus::kComplete)
+    return failed_precondition("archive: scan '" + in.scan_id + "' has no surface to measure");
   MeasurementRecord m = in;
   m.source = "user", m.version = r.current_version, m.created_by = actor, m.created_at = now_iso();
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
@@ -795,7 +820,8 @@ Status Archive::delete_measurement(const std::string& scan_id, int64_t id, const
   impl_->revision.fetch_add(1);
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("DELETE FROM measurements WHERE id = ? AND scan_id = ? AND source = 'user'"));
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("DELETE FROM measurements WHERE id = ? AND scan_id = ? AND source = 'user'"));
   RETURN_IF_ERROR(st.bind(1, id).bind(2, scan_id).run());
   if (sqlite3_changes(impl_->db.handle()) == 0)
     return not_found("archive: scan '" + scan_id + "' has no saved measurement " + std::to_string(id));
@@ -807,8 +833,8 @@ Status Archive::delete_measurement(const std::string& scan_id, int64_t id, const
 
 StatusOr<std::vector<AuditEntry>> Archive::audit(const std::string& target_id, int limit) const {
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare(
-                                     "SELECT id, at, actor, action, target_kind, target_id, detail FROM audit "
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("SELECT id, at, actor, action, target_kind, target_id, detail FROM audit "
                                      "WHERE ?1 = '' OR target_id = ?1 ORDER BY id DESC LIMIT ?2"));
   st.bind(1, target_id).bind(2, limit);
   std::vector<AuditEntry> out;
@@ -834,9 +860,11 @@ Status Archive::export_customer(const std::string& id, const std::string& dest, 
   ASSIGN_OR_RETURN(std::vector<ScanRecord> records, scans(q));
   nlohmann::json doc = {{"schema", "bodyscan.customer-export/1"},
                         {"exported_at", now_iso()},
-                        {"customer", {{"id", c.id}, {"name", c.name ? nlohmann::json(*c.name) : nlohmann::json()},
-                                      {"contact", c.contact ? nlohmann::json(*c.contact) : nlohmann::json()},
-                                      {"created_at", c.created_at}}},
+                        {"customer",
+                         {{"id", c.id},
+                          {"name", c.name ? nlohmann::json(*c.name) : nlohmann::json()},
+                          {"contact", c.contact ? nlohmann::json(*c.contact) : nlohmann::json()},
+                          {"created_at", c.created_at}}},
                         {"scans", nlohmann::json::array()},
                         {"audit", nlohmann::json::array()}};
   const fs::path out(dest);
@@ -844,8 +872,12 @@ Status Archive::export_customer(const std::string& id, const std::string& dest, 
   auto add_audit = [&](const std::string& target) -> Status {
     ASSIGN_OR_RETURN(std::vector<AuditEntry> entries, audit(target, 1 << 30));
     for (const AuditEntry& e : entries)
-      doc["audit"].push_back({{"at", e.at}, {"actor", e.actor}, {"action", e.action}, {"target_kind", e.target_kind},
-                              {"target_id", e.target_id}, {"detail", e.detail}});
+      doc["audit"].push_back({{"at", e.at},
+                              {"actor", e.actor},
+                              {"action", e.action},
+                              {"target_kind", e.target_kind},
+                              {"target_id", e.target_id},
+                              {"detail", e.detail}});
     return Status::Ok();
   };
   RETURN_IF_ERROR(add_audit(id));
@@ -858,13 +890,21 @@ Status Archive::export_customer(const std::string& id, const std::string& dest, 
         ASSIGN_OR_RETURN(std::vector<MeasurementRecord> ms, measurements(r.id, v.version));
         for (const MeasurementRecord& m : ms)
           if (m.version == v.version)
-            s["measurements"].push_back({{"id", m.id}, {"version", m.version}, {"source", m.source}, {"name", m.name},
-                                         {"label", m.label}, {"kind", m.kind}, {"iso_clause", m.iso_clause},
-                                         {"value_mm", m.value_mm}, {"geometry", m.geometry},
-                                         {"created_by", m.created_by}, {"created_at", m.created_at}});
+            s["measurements"].push_back({{"id", m.id},
+                                         {"version", m.version},
+                                         {"source", m.source},
+                                         {"name", m.name},
+                                         {"label", m.label},
+                                         {"kind", m.kind},
+                                         {"iso_clause", m.iso_clause},
+                                         {"value_mm", m.value_mm},
+                                         {"geometry", m.geometry},
+                                         {"created_by", m.created_by},
+                                         {"created_at", m.created_at}});
       }
       std::error_code ec;
-      fs::copy(impl_->scan_dir(r.id), out / "scans" / r.id, fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
+      fs::copy(impl_->scan_dir(r.id), out / "scans" / r.id,
+               fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
       if (ec) return io_error("archive: cannot copy scan " + r.id + " to " + dest + ": " + ec.message());
     }
     doc["scans"].push_back(std::move(s));
@@ -879,7 +919,8 @@ Status Archive::verify() const {
   {
     ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("PRAGMA integrity_check"));
     ASSIGN_OR_RETURN(bool row, st.step());
-    if (!row || st.text(0) != "ok") return io_error("archive: the database fails its integrity check: " + (row ? st.text(0) : ""));
+    if (!row || st.text(0) != "ok")
+      return io_error("archive: the database fails its integrity check: " + (row ? st.text(0) : ""));
     ASSIGN_OR_RETURN(Statement fk, impl_->db.prepare("PRAGMA foreign_key_check"));
     ASSIGN_OR_RETURN(bool bad, fk.step());
     if (bad) return io_error("archive: a record points at a missing " + fk.text(2));

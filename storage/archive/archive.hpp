@@ -65,8 +65,8 @@ struct ScanRecord {
   ScanStatus status = ScanStatus::kRunning;
   std::string status_reason;
   std::string started_at, finished_at;
-  nlohmann::json rig;           // the rig description the scan ran on
-  int current_version = 0;      // 0: no results (running or failed)
+  nlohmann::json rig;       // the rig description the scan ran on
+  int current_version = 0;  // 0: no results (running or failed)
   std::vector<ScanVersion> versions;
   std::vector<ArchivedFile> raw;
 };

@@ -20,7 +20,8 @@ Status classify(int extended_code, const std::string& msg) {
 
 StatusOr<Database> Database::open(const std::string& path) {
   sqlite3* db = nullptr;
-  const int rc = sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, nullptr);
+  const int rc =
+      sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, nullptr);
   if (rc != SQLITE_OK) {
     const std::string msg = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
     sqlite3_close(db);
@@ -93,7 +94,8 @@ StatusOr<bool> Statement::step() {
   if (rc == SQLITE_ROW) return true;
   if (rc == SQLITE_DONE) return false;
   const std::string sql = sqlite3_sql(st_) ? sqlite3_sql(st_) : "";
-  return classify(sqlite3_extended_errcode(db_), "archive database, '" + sql.substr(0, 60) + "': " + sqlite3_errmsg(db_));
+  return classify(sqlite3_extended_errcode(db_),
+                  "archive database, '" + sql.substr(0, 60) + "': " + sqlite3_errmsg(db_));
 }
 
 Status Statement::run() {
@@ -105,7 +107,8 @@ Status Statement::run() {
 
 std::string Statement::text(int col) const {
   const unsigned char* t = sqlite3_column_text(st_, col);
-  return t ? std::string(reinterpret_cast<const char*>(t), static_cast<size_t>(sqlite3_column_bytes(st_, col))) : std::string();
+  return t ? std::string(reinterpret_cast<const char*>(t), static_cast<size_t>(sqlite3_column_bytes(st_, col)))
+           : std::string();
 }
 std::optional<std::string> Statement::maybe_text(int col) const {
   if (sqlite3_column_type(st_, col) == SQLITE_NULL) return std::nullopt;

@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <map>
 #include <limits>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -60,7 +60,8 @@ double max_displacement(const std::vector<Vec3f>& a, const std::vector<Vec3f>& b
     std::sort(grid.begin(), grid.end());
     auto search = [&](const Vec3f& p, int64_t k, double* best) {
       auto it = std::lower_bound(grid.begin(), grid.end(), std::make_pair(k, uint32_t{0}));
-      for (; it != grid.end() && it->first == k; ++it) *best = std::min(*best, static_cast<double>((to[it->second] - p).norm()));
+      for (; it != grid.end() && it->first == k; ++it)
+        *best = std::min(*best, static_cast<double>((to[it->second] - p).norm()));
     };
     double worst = 0;
     for (const Vec3f& p : from) {
@@ -115,7 +116,6 @@ bool usable_normals(const std::vector<Vec3f>& normals, size_t n, const DracoOpti
   return o.normals && normals.size() == n && n > 0;
 }
 
-
 // What a check decodes: the positions (mm) and how many triangles (or points).
 struct Decoded {
   std::vector<Vec3f> positions;
@@ -137,13 +137,15 @@ StatusOr<DracoEncoded> encode_checked(const std::string& what, const std::vector
     auto back = decode(e.bytes);
     if (!back.ok()) return internal_error(what + ": the encoding does not decode: " + back.status().message());
     if (back->count != count)
-      return internal_error(what + ": decoding gave " + std::to_string(back->count) + " elements, not " + std::to_string(count));
+      return internal_error(what + ": decoding gave " + std::to_string(back->count) + " elements, not " +
+                            std::to_string(count));
     e.vertices = back->positions.size();
     e.triangles = is_mesh ? count : 0;
     e.max_error_mm = max_displacement(positions, back->positions, std::max(1.0, 2 * options.max_error_mm));
     if (e.max_error_mm <= options.max_error_mm) return e;
   }
-  return internal_error(what + ": no quantisation keeps the vertices within " + std::to_string(options.max_error_mm) + " mm");
+  return internal_error(what + ": no quantisation keeps the vertices within " + std::to_string(options.max_error_mm) +
+                        " mm");
 }
 
 // Positions (in metres) and triangles.
@@ -200,7 +202,9 @@ StatusOr<TriangleMesh> from_draco_mesh(const draco::Mesh& dm, const std::map<std
 
 StatusOr<TriangleMesh> decode_glb(std::string_view bytes) {
   // The container (glTF 2.0 §4.4): a 12-byte header, a JSON chunk, a BIN chunk.
-  auto bad = [](const std::string& why) { return invalid_argument("glb: not a glTF binary this reader understands (" + why + ")"); };
+  auto bad = [](const std::string& why) {
+    return invalid_argument("glb: not a glTF binary this reader understands (" + why + ")");
+  };
   auto u32 = [&](size_t at) {
     uint32_t v = 0;
     std::memcpy(&v, bytes.data() + at, 4);
@@ -270,10 +274,13 @@ StatusOr<PointCloud> decode_drc(std::string_view bytes) {
   buffer.Init(bytes.data(), bytes.size());
   draco::Decoder decoder;
   auto decoded = decoder.DecodePointCloudFromBuffer(&buffer);
-  if (!decoded.ok()) return invalid_argument("drc: not a Draco file this reader understands (" + decoded.status().error_msg_string() + ")");
+  if (!decoded.ok())
+    return invalid_argument("drc: not a Draco file this reader understands (" + decoded.status().error_msg_string() +
+                            ")");
   PointCloud cloud;
   cloud.positions = read_attribute(*decoded.value(), draco::GeometryAttribute::POSITION, 1000.f);
-  if (cloud.positions.empty() && decoded.value()->num_points() > 0) return invalid_argument("drc: the points have no positions");
+  if (cloud.positions.empty() && decoded.value()->num_points() > 0)
+    return invalid_argument("drc: the points have no positions");
   cloud.normals = read_attribute(*decoded.value(), draco::GeometryAttribute::NORMAL, 1.f);
   return cloud;
 }
@@ -308,7 +315,9 @@ StatusOr<TriangleMesh> decode_mesh_drc(std::string_view bytes) {
   buffer.Init(bytes.data(), bytes.size());
   draco::Decoder decoder;
   auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
-  if (!decoded.ok()) return invalid_argument("drc: not a Draco mesh this reader understands (" + decoded.status().error_msg_string() + ")");
+  if (!decoded.ok())
+    return invalid_argument("drc: not a Draco mesh this reader understands (" + decoded.status().error_msg_string() +
+                            ")");
   const draco::Mesh& dm = *decoded.value();
   TriangleMesh mesh;
   mesh.vertices = read_attribute(dm, draco::GeometryAttribute::POSITION, 1000.f);
@@ -342,7 +351,8 @@ StatusOr<DracoEncoded> encode_mesh_drc(const TriangleMesh& mesh, const DracoOpti
           ga.Init(draco::GeometryAttribute::GENERIC, nullptr, 1, draco::DT_FLOAT32, false, sizeof(float), 0);
           const int id = dm.AddAttribute(ga, true, static_cast<uint32_t>(mesh.num_vertices()));
           for (size_t i = 0; i < mesh.num_vertices(); ++i)
-            dm.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(static_cast<uint32_t>(i)), &mesh.confidence[i]);
+            dm.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(static_cast<uint32_t>(i)),
+                                                &mesh.confidence[i]);
         }
         draco::Encoder encoder;
         configure(options, bits, &encoder);

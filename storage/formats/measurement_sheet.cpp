@@ -77,9 +77,9 @@ std::string csv_field(const std::string& s) {
 std::string sheet_csv(const MeasurementSheet& sheet, LengthUnit unit) {
   std::string out = "iso_clause,name,label,value,unit,flagged,source,customer_ref,scan_id,taken_at\r\n";
   for (const SheetEntry& e : sheet.entries) {
-    for (const std::string& f : {e.iso_clause, e.name, e.label, format_length(e.value_mm, unit),
-                                 std::string(unit_symbol(unit)), std::string(e.flagged ? "yes" : "no"), e.source,
-                                 sheet.customer_ref, sheet.scan_id})
+    for (const std::string& f :
+         {e.iso_clause, e.name, e.label, format_length(e.value_mm, unit), std::string(unit_symbol(unit)),
+          std::string(e.flagged ? "yes" : "no"), e.source, sheet.customer_ref, sheet.scan_id})
       out += csv_field(f), out += ',';
     out += csv_field(sheet.taken_at);
     out += "\r\n";
@@ -125,7 +125,9 @@ struct Silhouette {
   int width = 0, height = 0;
   double lo_x = 0, hi_y = 0, mm_per_px = 1;
   std::vector<unsigned char> mask;  // width * height, 255 where the body is
-  Eigen::Vector2d to_px(const Eigen::Vector2d& p) const { return {(p.x() - lo_x) / mm_per_px, (hi_y - p.y()) / mm_per_px}; }
+  Eigen::Vector2d to_px(const Eigen::Vector2d& p) const {
+    return {(p.x() - lo_x) / mm_per_px, (hi_y - p.y()) / mm_per_px};
+  }
 };
 
 Silhouette rasterise(const TriangleMesh& mesh, const View& view, double mm_per_px) {
@@ -133,7 +135,8 @@ Silhouette rasterise(const TriangleMesh& mesh, const View& view, double mm_per_p
   double lo_x = std::numeric_limits<double>::max(), hi_x = -lo_x, lo_y = lo_x, hi_y = -lo_x;
   for (const Vec3f& v : mesh.vertices) {
     const Eigen::Vector2d p = view.project(v.cast<double>());
-    lo_x = std::min(lo_x, p.x()), hi_x = std::max(hi_x, p.x()), lo_y = std::min(lo_y, p.y()), hi_y = std::max(hi_y, p.y());
+    lo_x = std::min(lo_x, p.x()), hi_x = std::max(hi_x, p.x()), lo_y = std::min(lo_y, p.y()),
+    hi_y = std::max(hi_y, p.y());
   }
   s.lo_x = lo_x, s.hi_y = hi_y, s.mm_per_px = mm_per_px;
   s.width = static_cast<int>(std::ceil((hi_x - lo_x) / mm_per_px)) + 1;
@@ -172,7 +175,8 @@ class Page {
  public:
   explicit Page(cairo_t* cr) : cr_(cr) {}
   void text(double x, double y, const std::string& s, double size, bool bold = false, bool right = false) {
-    cairo_select_font_face(cr_, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_select_font_face(cr_, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL,
+                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
     cairo_set_font_size(cr_, size);
     if (right) {
       cairo_text_extents_t ext;
@@ -192,8 +196,8 @@ constexpr double kPageW = 595.276, kPageH = 841.89, kMargin = 40;  // A4 in poin
 
 // The silhouette at (x, y) (top left), `pt_per_mm`, with each entry's path drawn
 // and, on the front view, numbered.
-void draw_view(Page& page, const TriangleMesh& mesh, const View& view, const MeasurementSheet& sheet, double x, double y,
-               double pt_per_mm, bool numbers) {
+void draw_view(Page& page, const TriangleMesh& mesh, const View& view, const MeasurementSheet& sheet, double x,
+               double y, double pt_per_mm, bool numbers) {
   constexpr double kPxPerPt = 3;
   const Silhouette s = rasterise(mesh, view, 1 / (pt_per_mm * kPxPerPt));
   cairo_t* cr = page.cr();
@@ -238,7 +242,8 @@ StatusOr<std::string> sheet_pdf(const MeasurementSheet& sheet, const TriangleMes
   if (!mesh.is_consistent()) return invalid_argument("sheet: the mesh's indices or attributes are inconsistent");
   std::string out;
   cairo_surface_t* surface = cairo_pdf_surface_create_for_stream(append_to_string, &out, kPageW, kPageH);
-  cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_TITLE, ("Body measurements " + sheet.customer_ref).c_str());
+  cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_TITLE,
+                                 ("Body measurements " + sheet.customer_ref).c_str());
   cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_CREATOR, "bodyscan");
   cairo_t* cr = cairo_create(surface);
   Page page(cr);
@@ -254,7 +259,8 @@ StatusOr<std::string> sheet_pdf(const MeasurementSheet& sheet, const TriangleMes
     page.text(kMargin, 62, "Body measurements", 18, true);
     std::string meta = "Customer " + sheet.customer_ref + "    Scan " + sheet.scan_id + "    " + sheet.taken_at;
     page.text(kMargin, 82, meta, 9);
-    std::string meta2 = "Unit: " + std::string(unit_symbol(unit)) + (sheet.operator_name.empty() ? "" : "    Operator " + sheet.operator_name) +
+    std::string meta2 = "Unit: " + std::string(unit_symbol(unit)) +
+                        (sheet.operator_name.empty() ? "" : "    Operator " + sheet.operator_name) +
                         "    ISO 8559-1 clauses; girths as a tape takes them";
     page.text(kMargin, 95, meta2, 8);
     if (page_no > 1) page.text(table_right, 62, "page " + std::to_string(page_no), 8, false, true);
@@ -274,7 +280,8 @@ StatusOr<std::string> sheet_pdf(const MeasurementSheet& sheet, const TriangleMes
       page.text(kMargin, top - 12, "front", 7);
       page.text(kMargin, top + view_h + gap - 12, "left side", 7);
       draw_view(page, mesh, View{0, 1}, sheet, kMargin + (col_w - size.x() * scale) / 2, top, scale, true);
-      draw_view(page, mesh, View{2, -1}, sheet, kMargin + (col_w - size.z() * scale) / 2, top + view_h + gap, scale, false);
+      draw_view(page, mesh, View{2, -1}, sheet, kMargin + (col_w - size.z() * scale) / 2, top + view_h + gap, scale,
+                false);
     }
 
     double y = 125;
@@ -311,7 +318,8 @@ StatusOr<std::string> sheet_pdf(const MeasurementSheet& sheet, const TriangleMes
   cairo_surface_finish(surface);
   const cairo_status_t status = cairo_surface_status(surface);
   cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) return internal_error(std::string("sheet: Cairo failed: ") + cairo_status_to_string(status));
+  if (status != CAIRO_STATUS_SUCCESS)
+    return internal_error(std::string("sheet: Cairo failed: ") + cairo_status_to_string(status));
   return out;
 }
 

@@ -33,8 +33,8 @@ struct SheetEntry {
   std::string label;       // for people, e.g. "Waist girth"
   std::string kind;        // "girth", "height", "surface_length", "distance", "arc"
   double value_mm = 0;
-  bool flagged = false;    // crosses a hole-filled (invented) region of the surface
-  std::string source = "automatic";  // or "saved by <user>"
+  bool flagged = false;               // crosses a hole-filled (invented) region of the surface
+  std::string source = "automatic";   // or "saved by <user>"
   std::vector<Eigen::Vector3d> path;  // what to draw on the silhouettes (mm)
   bool closed = false;
 };
@@ -42,7 +42,7 @@ struct SheetEntry {
 struct MeasurementSheet {
   std::string customer_ref;  // the customer's pseudonymous reference
   std::string scan_id;
-  std::string taken_at;      // ISO 8601, e.g. "2026-11-22T10:15:00Z"
+  std::string taken_at;  // ISO 8601, e.g. "2026-11-22T10:15:00Z"
   std::string operator_name;
   std::vector<SheetEntry> entries;
 };

@@ -11,9 +11,9 @@
 #include <chrono>
 #include <filesystem>
 #include <random>
-#include <thread>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_measurements.hpp"
@@ -130,13 +130,15 @@ TEST(ArchiveCli, SheetExportAndErasure) {
     results.files["mesh.drc"] = storage::encode_mesh_drc(*mesh, keep)->bytes;
     for (const BodyMeasurement& m : body->measurements) {
       storage::MeasurementRecord rec;
-      rec.name = m.name, rec.label = m.label, rec.kind = m.kind, rec.iso_clause = m.iso_clause, rec.value_mm = m.value_mm;
+      rec.name = m.name, rec.label = m.label, rec.kind = m.kind, rec.iso_clause = m.iso_clause,
+      rec.value_mm = m.value_mm;
       results.measurements.push_back(rec);
     }
     ASSERT_TRUE((*ar)->complete_scan(scan, results).ok());
   }
   const std::string A = quote(dir + "/A");
-  const CliResult csv = bodyscan("archive " + A + " sheet " + scan + " -o " + quote(dir + "/s.csv") + " --unit mm", dir);
+  const CliResult csv =
+      bodyscan("archive " + A + " sheet " + scan + " -o " + quote(dir + "/s.csv") + " --unit mm", dir);
   ASSERT_EQ(csv.exit_code, 0) << csv.err;
   EXPECT_NE(slurp(dir + "/s.csv").find("5.3.10,waist_girth,Waist girth,"), std::string::npos);
   const CliResult pdf = bodyscan("archive " + A + " sheet " + scan + " -o " + quote(dir + "/s.pdf"), dir);
@@ -155,7 +157,8 @@ TEST(ArchiveCli, SheetExportAndErasure) {
   EXPECT_EQ(std::filesystem::file_size(dir + "/m.stl"), 84 + 50 * 107024u);
   EXPECT_EQ(bodyscan("archive " + A + " mesh " + scan + " -o " + quote(dir + "/m.docx"), dir).exit_code, 2);
 
-  const CliResult exported = bodyscan("archive " + A + " export " + customer + " " + quote(dir + "/X") + " --actor admin", dir);
+  const CliResult exported =
+      bodyscan("archive " + A + " export " + customer + " " + quote(dir + "/X") + " --actor admin", dir);
   ASSERT_EQ(exported.exit_code, 0) << exported.err;
   EXPECT_NE(slurp(dir + "/X/customer.json").find("Zora Quintrell"), std::string::npos);
 

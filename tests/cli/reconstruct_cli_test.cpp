@@ -79,8 +79,8 @@ TEST_F(ReconstructCli, ReconstructsTheShippedBody) {
   EXPECT_LT(std::abs(signed_volume(*mesh) / signed_volume(*truth) - 1.0), 0.02);
 
   // --keep-holes leaves the field's flaps open.
-  const CliResult open = bodyscan(
-      "reconstruct " + quote(path("body.ply")) + " -o " + quote(path("open.ply")) + " --keep-holes", dir_);
+  const CliResult open =
+      bodyscan("reconstruct " + quote(path("body.ply")) + " -o " + quote(path("open.ply")) + " --keep-holes", dir_);
   ASSERT_EQ(open.exit_code, 0) << open.err;
   EXPECT_NE(open.out.find("surface     open"), std::string::npos) << open.out;
 }
@@ -88,9 +88,10 @@ TEST_F(ReconstructCli, ReconstructsTheShippedBody) {
 TEST_F(ReconstructCli, QuietAsciiAndOptions) {
   PointCloud cloud = fibonacci_sphere(500, 1.0);
   ASSERT_TRUE(write_ply(path("s.ply"), cloud).ok());
-  const CliResult r = bodyscan("reconstruct " + quote(path("s.ply")) + " --output " + quote(path("m.ply")) +
-                             " --ascii -q --sigma 1.2 --normal-sigma 0.6 --normals mst --normal-k 15 --voxel 0.06",
-                         dir_);
+  const CliResult r =
+      bodyscan("reconstruct " + quote(path("s.ply")) + " --output " + quote(path("m.ply")) +
+                   " --ascii -q --sigma 1.2 --normal-sigma 0.6 --normals mst --normal-k 15 --voxel 0.06",
+               dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_TRUE(r.err.empty()) << r.err;
@@ -141,8 +142,8 @@ TEST_F(ReconstructCli, BodyTakesTheScanJobsSettings) {
   const long near = trimmed("0.5"), far = trimmed("50");
   EXPECT_GT(near, far);
   EXPECT_GE(far, 0);
-  const CliResult bad = bodyscan(
-      "reconstruct " + quote(path("cap.ply")) + " --trim-distance 0 -o " + quote(path("t.ply")), dir_);
+  const CliResult bad =
+      bodyscan("reconstruct " + quote(path("cap.ply")) + " --trim-distance 0 -o " + quote(path("t.ply")), dir_);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--trim-distance expects a positive number"), std::string::npos) << bad.err;
 }
@@ -181,8 +182,8 @@ TEST_F(ReconstructCli, BadOptionValuesExitTwo) {
   PointCloud cloud = fibonacci_sphere(100, 1.0);
   ASSERT_TRUE(write_ply(path("s.ply"), cloud).ok());
   const std::string io = quote(path("s.ply")) + " -o " + quote(path("m.ply"));
-  for (const std::string bad : {"--sigma abc", "--sigma -1", "--sigma 0", "--voxel nan", "--epsilon 1",
-                                "--epsilon 2", "--normals sideways", "--sharpen -0.5", "--sigma 1x"}) {
+  for (const std::string bad : {"--sigma abc", "--sigma -1", "--sigma 0", "--voxel nan", "--epsilon 1", "--epsilon 2",
+                                "--normals sideways", "--sharpen -0.5", "--sigma 1x"}) {
     const CliResult r = bodyscan("reconstruct " + io + " " + bad, dir_);
     EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
     EXPECT_FALSE(r.err.empty()) << bad;
@@ -204,8 +205,8 @@ TEST_F(ReconstructCli, UsageErrorsExitTwo) {
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--frobnicate"), std::string::npos) << r.err;
   }
-  EXPECT_EQ(bodyscan("reconstruct " + in, dir_).exit_code, 2);                            // no output
-  EXPECT_EQ(bodyscan("reconstruct -o " + quote(path("m.ply")), dir_).exit_code, 2);     // no input
+  EXPECT_EQ(bodyscan("reconstruct " + in, dir_).exit_code, 2);                       // no output
+  EXPECT_EQ(bodyscan("reconstruct -o " + quote(path("m.ply")), dir_).exit_code, 2);  // no input
   EXPECT_EQ(bodyscan("reconstruct " + in + " -o " + quote(path("m.off")), dir_).exit_code, 2);
   EXPECT_EQ(bodyscan("reconstruct " + in + " " + in + " -o " + quote(path("m.ply")), dir_).exit_code, 2);
   EXPECT_EQ(bodyscan("frobnicate", dir_).exit_code, 2);  // unknown command

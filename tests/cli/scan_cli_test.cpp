@@ -26,7 +26,7 @@ TEST(ScanCli, CalibratesScansAndWritesTheCloudAndFigures) {
   const nlohmann::json scan = nlohmann::json::parse(slurp(dir + "/scan/scan.json"));
   EXPECT_GT(scan["points"].get<size_t>(), 5000u);
   EXPECT_FALSE(std::filesystem::exists(dir + "/scan/mesh.ply"));  // --no-surface
-  EXPECT_EQ(scan["points_grazing"].get<size_t>(), 0u);              // off by default
+  EXPECT_EQ(scan["points_grazing"].get<size_t>(), 0u);            // off by default
   EXPECT_TRUE(cloud->cloud.normals.empty());
   // Every 12th step leaves the stripes 42 mm apart: too far to tell sway from shape.
   EXPECT_FALSE(scan.contains("sway"));
@@ -46,7 +46,8 @@ TEST(ScanCli, CalibratesScansAndWritesTheCloudAndFigures) {
   ASSERT_TRUE(viewed->has_cameras());
   size_t facing = 0;
   for (size_t i = 0; i < viewed->size(); ++i) {
-    const Vec3f to_camera = (viewed->camera_centres[static_cast<size_t>(viewed->camera[i])] - viewed->positions[i]).normalized();
+    const Vec3f to_camera =
+        (viewed->camera_centres[static_cast<size_t>(viewed->camera[i])] - viewed->positions[i]).normalized();
     facing += viewed->normals[i].dot(to_camera) >= std::cos(60.5 * M_PI / 180);
   }
   EXPECT_EQ(facing, viewed->size());
@@ -57,16 +58,16 @@ TEST(ScanCli, CalibratesScansAndWritesTheCloudAndFigures) {
 // input closed) stops the scan before anything is written.
 TEST(ScanCli, AsksOnTheTerminalForTheDotGrid) {
   const std::string dir = testing::temp_dir();
-  const CliResult r = bodyscan("scan --rig sim --out " + quote(dir + "/scan") +
-                                   " --every 24 --no-surface --operator-dot-grid",
-                               dir, "\n\n\n\n");
+  const CliResult r = bodyscan(
+      "scan --rig sim --out " + quote(dir + "/scan") + " --every 24 --no-surface --operator-dot-grid", dir, "\n\n\n\n");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   size_t holds = 0;
   for (size_t at = r.err.find("Hold the dot-grid board"); at != std::string::npos;
        at = r.err.find("Hold the dot-grid board", at + 1))
     ++holds;
   EXPECT_EQ(holds, 3u) << r.err;
-  for (const char* camera : {"'front-left'", "'front-right'", "'back'"}) EXPECT_NE(r.err.find(camera), std::string::npos);
+  for (const char* camera : {"'front-left'", "'front-right'", "'back'"})
+    EXPECT_NE(r.err.find(camera), std::string::npos);
   EXPECT_NE(r.err.find("Take the dot-grid board out of the rig"), std::string::npos) << r.err;
   EXPECT_TRUE(std::filesystem::exists(dir + "/scan/points.ply"));
 

@@ -2,8 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "recon/io/png_image.hpp"
 #include "tests/cli/cli_runner.hpp"

@@ -22,7 +22,7 @@ TEST(CameraModel, PinholeProjectionByHand) {
   ASSERT_TRUE(p);
   // Camera x = world -X here (x = y_cam x z_cam with y_cam = -Y, z_cam = +Z).
   EXPECT_NEAR(p->x(), 319.5 - 80.0, 1e-9);
-  EXPECT_NEAR(p->y(), 239.5 - 40.0, 1e-9);  // above the axis -> smaller y (image y is down)
+  EXPECT_NEAR(p->y(), 239.5 - 40.0, 1e-9);    // above the axis -> smaller y (image y is down)
   EXPECT_FALSE(m.project(Vec3d(0, 0, -10)));  // behind the camera
 }
 

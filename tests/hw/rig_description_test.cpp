@@ -17,9 +17,7 @@ RigDescription load_shipped(const std::string& name) {
 }
 
 // The shipped thesis layout as JSON, for tests to break.
-nlohmann::json thesis_json() {
-  return nlohmann::json::parse(to_json(load_shipped("thesis")));
-}
+nlohmann::json thesis_json() { return nlohmann::json::parse(to_json(load_shipped("thesis"))); }
 
 std::string parse_error(const nlohmann::json& j) {
   auto r = parse_rig_description(j.dump(), "test.json");
@@ -168,7 +166,8 @@ TEST(RigDescription, ErrorsNameTheField) {
   }
   {
     // A description nested past any real one's depth is refused as it is read.
-    auto r = parse_rig_description("{\"frame\": " + std::string(300000, '[') + std::string(300000, ']') + "}", "deep.json");
+    auto r =
+        parse_rig_description("{\"frame\": " + std::string(300000, '[') + std::string(300000, ']') + "}", "deep.json");
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.status().message().find("deep.json: not valid JSON, or nested more than 64"), std::string::npos)
         << r.status().message();
@@ -196,7 +195,8 @@ TEST(RigDescription, ErrorsNameTheField) {
   EXPECT_NE(parse_error(j).find("folds over"), std::string::npos) << parse_error(j);
   j = thesis_json();
   j["processing"]["max_view_deg"] = 120;
-  EXPECT_NE(parse_error(j).find("rig.processing: max_view_deg must be at most 90"), std::string::npos) << parse_error(j);
+  EXPECT_NE(parse_error(j).find("rig.processing: max_view_deg must be at most 90"), std::string::npos)
+      << parse_error(j);
   j = thesis_json();
   j["processing"]["smoothing"] = 3;
   EXPECT_NE(parse_error(j).find("unknown field 'smoothing'"), std::string::npos) << parse_error(j);
@@ -207,7 +207,8 @@ TEST(RigDescription, LasersWhosePlanesCrossInsideTheFrameCannotRunTogether) {
   // The two front lasers sweep the same region: their planes meet inside the frame.
   auto j = thesis_json();
   using nlohmann::json;  // json::array: a braced list of string pairs would become an object
-  j["laser_groups"] = json::array({json::array({"front-left", "front-right"}), json::array({"back-left", "back-right"})});
+  j["laser_groups"] =
+      json::array({json::array({"front-left", "front-right"}), json::array({"back-left", "back-right"})});
   const std::string e = parse_error(j);
   EXPECT_NE(e.find("cannot run together: their planes cross inside the frame"), std::string::npos) << e;
   // Lasers far apart may run together; a laser left out of every group runs alone.

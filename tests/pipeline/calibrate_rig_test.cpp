@@ -29,7 +29,8 @@ void expect_matches_truth(const hw::RigDescription& desc, const RigCalibration& 
     const hw::CameraModel truth = desc.cameras[c].model();
     EXPECT_EQ(cc.side, truth.centre().z() > 0 ? FrameSide::kFront : FrameSide::kBack) << cc.camera_id;
     // The centre of projection comes out of the two frames' transforms alone.
-    EXPECT_LT((cc.centre - truth.centre()).norm(), 15.0) << cc.camera_id;  // mm, 3 m off, half-size pixels; full size: < 4
+    EXPECT_LT((cc.centre - truth.centre()).norm(), 15.0)
+        << cc.camera_id;                               // mm, 3 m off, half-size pixels; full size: < 4
     EXPECT_LT(cc.ray_spread_mm, 4.0) << cc.camera_id;  // half-size pixels; full size: under 1 mm
     EXPECT_LT(cc.lens.held_out_rms_px(), 0.05) << cc.camera_id;
     // Each camera sees the lasers on its own side of the frame on the poles.

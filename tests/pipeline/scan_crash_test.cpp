@@ -120,8 +120,9 @@ TEST_P(ScanCrash, EveryLaserIsOffWhenTheScanDies) {
 }
 
 INSTANTIATE_TEST_SUITE_P(MidScan, ScanCrash,
-                         ::testing::Values(std::pair{Death::kStackOverflow, SIGSEGV}, std::pair{Death::kSegfault, SIGSEGV},
-                                           std::pair{Death::kAbort, SIGABRT}, std::pair{Death::kSighup, SIGHUP}),
+                         ::testing::Values(std::pair{Death::kStackOverflow, SIGSEGV},
+                                           std::pair{Death::kSegfault, SIGSEGV}, std::pair{Death::kAbort, SIGABRT},
+                                           std::pair{Death::kSighup, SIGHUP}),
                          death_name);
 
 }  // namespace

@@ -6,8 +6,8 @@
 
 #include "hw/sim/sim_rig.hpp"
 #include "recon/geometry/mesh_distance.hpp"
-#include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/rig_backend.hpp"
+#include "server/pipeline/scan_job.hpp"
 #include "tests/distance_after_shift.hpp"
 #include "tests/half_resolution.hpp"
 
@@ -53,8 +53,10 @@ TEST(ScanJob, PointsLieOnTheBodyFromEveryCamera) {
   for (size_t c = 0; c < 3; ++c) EXPECT_GT(per_camera[c], cloud.size() / 6) << "camera " << c;
   for (const LaserSweepReport& s : result->scan.sweeps) {
     EXPECT_TRUE(s.fitted) << s.error;
-    EXPECT_NEAR(s.degrees_per_step, rig->description().lasers[static_cast<size_t>(s.laser)].step_angle_deg *
-                                        (s.degrees_per_step < 0 ? -1 : 1), 0.001);
+    EXPECT_NEAR(
+        s.degrees_per_step,
+        rig->description().lasers[static_cast<size_t>(s.laser)].step_angle_deg * (s.degrees_per_step < 0 ? -1 : 1),
+        0.001);
   }
   for (int i = 0; i < rig->controller().num_lasers(); ++i) EXPECT_FALSE(rig->controller().laser_on(i));
 
@@ -141,8 +143,10 @@ TEST(ScanJob, ASwayingSubjectsSwayIsFoundAndUndone) {
   const MeshDistance truth((*rig)->scene().subject());
   const double undone = testing::rms_distance_after_shift(result->cloud, truth);
   const double as_measured = testing::rms_distance_after_shift(kept->cloud, truth);
-  std::printf("[ sway ] up to %.2f mm; sweeps meet within %.2f mm RMS (%.2f as measured); cloud to body %.3f mm RMS (%.3f as measured)\n",
-              sway.peak_mm, sway.rms_after_mm, sway.rms_before_mm, undone, as_measured);
+  std::printf(
+      "[ sway ] up to %.2f mm; sweeps meet within %.2f mm RMS (%.2f as measured); cloud to body %.3f mm RMS (%.3f as "
+      "measured)\n",
+      sway.peak_mm, sway.rms_after_mm, sway.rms_before_mm, undone, as_measured);
   EXPECT_LT(undone, 0.8 * as_measured);
   for (int i = 0; i < (*rig)->controller().num_lasers(); ++i) EXPECT_FALSE((*rig)->controller().laser_on(i));
 }

@@ -77,7 +77,8 @@ TEST_F(ApiAccess, AccessMatrixOverEveryEndpoint) {
   ServerUnderTest& s = *server_;
   Client admin = s.as("admin");
   ASSERT_FALSE(admin.cookie.empty());
-  const HttpReply made = admin.post("/api/scans/" + s.scan_id + "/shares", R"({"days": 1, "measurements": ["waist_girth"]})");
+  const HttpReply made =
+      admin.post("/api/scans/" + s.scan_id + "/shares", R"({"days": 1, "measurements": ["waist_girth"]})");
   ASSERT_EQ(made.status, 201) << made.body;
   const std::string token = parse(made)["token"];
 
@@ -99,8 +100,7 @@ TEST_F(ApiAccess, AccessMatrixOverEveryEndpoint) {
   auto body_for = [&](const Api::Route& r) -> std::string {
     if (r.pattern == "/api/login") return R"({"username": "op", "password": "correct horse battery"})";
     if (r.pattern == "/api/scans" && r.method == "POST") return R"({"customer_id": "c_0000000000000000"})";
-    if (r.pattern == "/api/scans/{id}/measure")
-      return R"({"kind": "distance", "from": [0, 0, 0], "to": [0, 100, 0]})";
+    if (r.pattern == "/api/scans/{id}/measure") return R"({"kind": "distance", "from": [0, 0, 0], "to": [0, 100, 0]})";
     if (r.method == "POST" || r.method == "PUT") return "{}";
     return "";
   };
@@ -288,18 +288,20 @@ TEST(ProxiedClients, LoginLimitsKeyOnTheAddressTheTrustedProxyForwarded) {
 TEST(ProxiedClients, ForwardedHeadersFromAnyoneElseAreIgnored) {
   ServerUnderTest s;
   for (int i = 0; i < 5; ++i)
-    EXPECT_EQ(login_from(s.port, "wrong guess " + std::to_string(i), {{"X-Forwarded-For", "10.0.1." + std::to_string(i)}})
-                  .status,
-              401);
+    EXPECT_EQ(
+        login_from(s.port, "wrong guess " + std::to_string(i), {{"X-Forwarded-For", "10.0.1." + std::to_string(i)}})
+            .status,
+        401);
   EXPECT_EQ(login_from(s.port, kPassword, {{"X-Forwarded-For", "10.0.1.99"}}).status, 429);
   Client admin = s.as("admin");
-  EXPECT_EQ(admin.request("POST", "/api/customers", R"({"name": "Q"})",
-                          {{"Origin", "https://evil.example"}, {"X-Forwarded-Host", "evil.example"}})
+  EXPECT_EQ(admin
+                .request("POST", "/api/customers", R"({"name": "Q"})",
+                         {{"Origin", "https://evil.example"}, {"X-Forwarded-Host", "evil.example"}})
                 .status,
             403);
-  const HttpReply plain = http(s.port, "POST", "/api/login",
-                               {{"Content-Type", "application/json"}, {"X-Forwarded-Proto", "https"}},
-                               std::string(R"({"username": "tailor", "password": ")") + kPassword + R"("})");
+  const HttpReply plain =
+      http(s.port, "POST", "/api/login", {{"Content-Type", "application/json"}, {"X-Forwarded-Proto", "https"}},
+           std::string(R"({"username": "tailor", "password": ")") + kPassword + R"("})");
   ASSERT_EQ(plain.status, 200);
   EXPECT_EQ(plain.header("set-cookie").find("; Secure"), std::string::npos) << "plain HTTP all the way";
 }
@@ -327,8 +329,9 @@ TEST(EventSockets, CloseWhenTheirSessionEndsOrChanges) {
   ServerUnderTest s;
   Client admin = s.as("admin");
   for (const char* name : {"anna", "ben", "carl"})
-    ASSERT_EQ(admin.post("/api/accounts", std::string(R"({"username": ")") + name +
-                                              R"(", "password": "a long password", "role": "operator"})")
+    ASSERT_EQ(admin
+                  .post("/api/accounts", std::string(R"({"username": ")") + name +
+                                             R"(", "password": "a long password", "role": "operator"})")
                   .status,
               201);
   const Client anna1 = login(s.port, "anna", "a long password"), anna2 = login(s.port, "anna", "a long password");
@@ -377,13 +380,23 @@ namespace {
 TEST(ApiAccounts, AdminManagesStaffAccounts) {
   ServerUnderTest s;
   Client admin = s.as("admin");
-  const HttpReply made = admin.post("/api/accounts", R"({"username": "fitter", "password": "measure twice cut once", "role": "tailor"})");
+  const HttpReply made =
+      admin.post("/api/accounts", R"({"username": "fitter", "password": "measure twice cut once", "role": "tailor"})");
   ASSERT_EQ(made.status, 201) << made.body;
   EXPECT_EQ(parse(made)["role"], "tailor");
-  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "fitter", "password": "measure twice cut once", "role": "tailor"})").status, 409);
-  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "x y", "password": "measure twice cut once", "role": "tailor"})").status, 400);
-  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "shorty", "password": "short", "role": "tailor"})").status, 400);
-  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "boss", "password": "measure twice cut once", "role": "king"})").status, 400);
+  EXPECT_EQ(
+      admin.post("/api/accounts", R"({"username": "fitter", "password": "measure twice cut once", "role": "tailor"})")
+          .status,
+      409);
+  EXPECT_EQ(
+      admin.post("/api/accounts", R"({"username": "x y", "password": "measure twice cut once", "role": "tailor"})")
+          .status,
+      400);
+  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "shorty", "password": "short", "role": "tailor"})").status,
+            400);
+  EXPECT_EQ(admin.post("/api/accounts", R"({"username": "boss", "password": "measure twice cut once", "role": "king"})")
+                .status,
+            400);
   const nlohmann::json list = parse(admin.get("/api/accounts"));
   EXPECT_EQ(list["accounts"].size(), 4u);
   Client fitter = login(s.port, "fitter", "measure twice cut once");

@@ -43,9 +43,10 @@ TEST(ApiScan, SimulatedScanThroughTheApiWithLiveEvents) {
   ASSERT_NE(events, nullptr);
   auto stalled = Connection::open(s.port);  // a WebSocket client that never reads
   ASSERT_NE(stalled, nullptr);
-  ASSERT_TRUE(stalled->send_all("GET /api/events HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                                "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\nCookie: " +
-                                op.cookie + "\r\n\r\n"));
+  ASSERT_TRUE(
+      stalled->send_all("GET /api/events HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\nCookie: " +
+                        op.cookie + "\r\n\r\n"));
 
   const HttpReply started = op.post("/api/scans", R"({"customer": {"name": "Walk-in"}})");
   ASSERT_EQ(started.status, 202) << started.body;
@@ -89,8 +90,9 @@ TEST(ApiScan, SimulatedScanThroughTheApiWithLiveEvents) {
   ASSERT_FALSE(finished.is_null());
   EXPECT_EQ(finished["state"], "complete") << finished.dump();
   EXPECT_TRUE(stages.count("scan")) << "stages seen: " << nlohmann::json(stages).dump();
-  EXPECT_TRUE(std::any_of(stages.begin(), stages.end(), [](const std::string& x) { return x.rfind("calibration", 0) == 0; }))
-      << "a fresh rig calibrates before its first scan";
+  EXPECT_TRUE(std::any_of(stages.begin(), stages.end(), [](const std::string& x) {
+    return x.rfind("calibration", 0) == 0;
+  })) << "a fresh rig calibrates before its first scan";
   EXPECT_GT(progress, 20);
   EXPECT_GT(previews, 3);
   EXPECT_GT(frames, 100);
@@ -237,13 +239,14 @@ TEST(ApiScan, AnOperatorAnswersTheCalibrationsPrompts) {
       EXPECT_EQ(op.post("/api/jobs/j_unknown/prompt", answer).status, 404);
       const HttpReply stale = op.post("/api/jobs/" + job + "/prompt", "{\"prompt\": \"p999\"}");
       EXPECT_EQ(stale.status, 409);
-      EXPECT_NE(stale.body.find(p["id"].get<std::string>()), std::string::npos) << "names the prompt asked: " << stale.body;
+      EXPECT_NE(stale.body.find(p["id"].get<std::string>()), std::string::npos)
+          << "names the prompt asked: " << stale.body;
     }
     prompts.push_back(p);
     const HttpReply answered = op.post("/api/jobs/" + job + "/prompt", answer);
     ASSERT_EQ(answered.status, 202) << answered.body;
-    EXPECT_TRUE(parse(answered)["job"]["prompt"].is_null() ||
-                parse(answered)["job"]["prompt"]["id"] != p["id"]) << answered.body;
+    EXPECT_TRUE(parse(answered)["job"]["prompt"].is_null() || parse(answered)["job"]["prompt"]["id"] != p["id"])
+        << answered.body;
   }
   const nlohmann::json rig = parse(op.get("/api/rig"));
   ASSERT_EQ(prompts.size(), rig["cameras"].size() + 1);
@@ -318,7 +321,8 @@ TEST(ApiScan, TailorMeasuresSavesAndExports) {
   ASSERT_EQ(g.status, 200) << g.body;
   EXPECT_NEAR(parse(g)["value_mm"].get<double>(), waist_mm, 3.0) << "the same cut as the automatic waist";
   EXPECT_TRUE(parse(g)["closed"].get<bool>());
-  const HttpReply saved = t.post(base + "/measurements", "{\"name\": \"waist at the line\", \"request\": " + line + "}");
+  const HttpReply saved =
+      t.post(base + "/measurements", "{\"name\": \"waist at the line\", \"request\": " + line + "}");
   ASSERT_EQ(saved.status, 201) << saved.body;
   const int64_t id = parse(saved)["id"];
   EXPECT_EQ(parse(saved)["source"], "user");
@@ -337,19 +341,23 @@ TEST(ApiScan, TailorMeasuresSavesAndExports) {
   EXPECT_EQ(pdf.body.substr(0, 5), "%PDF-");
   EXPECT_EQ(t.get(base + "/sheet.csv?unit=furlong").status, 400);
   // Other kinds: point to point, over the skin, along the tape.
-  EXPECT_NEAR(parse(t.post(base + "/measure", R"({"kind": "distance", "from": [0, 0, 0], "to": [30, 40, 0]})"))["value_mm"]
-                  .get<double>(),
-              50.0, 1e-9);
+  EXPECT_NEAR(
+      parse(t.post(base + "/measure", R"({"kind": "distance", "from": [0, 0, 0], "to": [30, 40, 0]})"))["value_mm"]
+          .get<double>(),
+      50.0, 1e-9);
   EXPECT_EQ(t.post(base + "/measure", R"({"kind": "girth"})").status, 400);
-  EXPECT_EQ(t.post(base + "/measure", R"({"kind": "girth", "plane": {"point": [0, 1, 0], "normal": [0, 0, 0]}})").status,
-            400);
+  EXPECT_EQ(
+      t.post(base + "/measure", R"({"kind": "girth", "plane": {"point": [0, 1, 0], "normal": [0, 0, 0]}})").status,
+      400);
   EXPECT_EQ(t.post(base + "/measure", R"({"kind": "spiral"})").status, 400);
   EXPECT_EQ(t.post(base + "/measure", R"({"kind": "distance", "from": [0, 0], "to": [1, 1, 1]})").status, 400);
-  EXPECT_EQ(t.post("/api/scans/s_none/measure", R"({"kind": "girth", "plane": {"point": [0, 1, 0], "normal": [0, 1, 0]}})")
-                .status,
-            404);
+  EXPECT_EQ(
+      t.post("/api/scans/s_none/measure", R"({"kind": "girth", "plane": {"point": [0, 1, 0], "normal": [0, 1, 0]}})")
+          .status,
+      404);
   // The automatic set cannot be deleted; the saved one can.
-  EXPECT_EQ(t.del(base + "/measurements/" + std::to_string(auto_set["measurements"][0]["id"].get<int64_t>())).status, 404);
+  EXPECT_EQ(t.del(base + "/measurements/" + std::to_string(auto_set["measurements"][0]["id"].get<int64_t>())).status,
+            404);
   EXPECT_EQ(t.del(base + "/measurements/" + std::to_string(id)).status, 204);
   EXPECT_EQ(t.get(base + "/sheet.csv").body.find("waist at the line"), std::string::npos);
   // Downloads: the ETag is the file's checksum; a match is 304 with no body.

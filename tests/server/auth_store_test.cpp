@@ -35,10 +35,9 @@ bool url_safe(const std::string& s) {
 std::string decode_base64url(const std::string& s) {
   std::string out(s.size(), '\0');
   size_t len = 0;
-  EXPECT_EQ(
-      sodium_base642bin(reinterpret_cast<unsigned char*>(out.data()), out.size(), s.data(),
-                        s.size(), nullptr, &len, nullptr, sodium_base64_VARIANT_URLSAFE_NO_PADDING),
-      0);
+  EXPECT_EQ(sodium_base642bin(reinterpret_cast<unsigned char*>(out.data()), out.size(), s.data(), s.size(), nullptr,
+                              &len, nullptr, sodium_base64_VARIANT_URLSAFE_NO_PADDING),
+            0);
   out.resize(len);
   return out;
 }
@@ -66,17 +65,14 @@ class AuthStoreTest : public ::testing::Test {
   int64_t now() const { return clock_->load(); }
 
   // Everything SQLite has on disk for the store: the database and its WAL.
-  std::string disk_bytes() const {
-    return slurp(path_) + slurp(path_ + "-wal") + slurp(path_ + "-shm");
-  }
+  std::string disk_bytes() const { return slurp(path_) + slurp(path_ + "-wal") + slurp(path_ + "-shm"); }
 
   std::string path_;
   std::shared_ptr<std::atomic<int64_t>> clock_ = std::make_shared<std::atomic<int64_t>>(kStart);
 };
 
 TEST(RoleTest, NamesRoundTrip) {
-  for (Role r : {Role::kOperator, Role::kTailor, Role::kAdmin})
-    EXPECT_EQ(role_from_string(to_string(r)), r);
+  for (Role r : {Role::kOperator, Role::kTailor, Role::kAdmin}) EXPECT_EQ(role_from_string(to_string(r)), r);
   EXPECT_STREQ(to_string(Role::kTailor), "tailor");
   EXPECT_FALSE(role_from_string("Admin"));
   EXPECT_FALSE(role_from_string(""));
@@ -85,23 +81,20 @@ TEST(RoleTest, NamesRoundTrip) {
 TEST_F(AuthStoreTest, AddAccountValidatesNamesAndPasswords) {
   auto store = open();
   ASSERT_TRUE(store);
-  for (const std::string& bad :
-       {std::string(), std::string(65, 'a'), std::string("a b"), std::string("a/b"),
-        std::string("j\xc3\xbcrgen"), std::string("x\0y", 3), std::string("<script>")}) {
+  for (const std::string& bad : {std::string(), std::string(65, 'a'), std::string("a b"), std::string("a/b"),
+                                 std::string("j\xc3\xbcrgen"), std::string("x\0y", 3), std::string("<script>")}) {
     auto a = store->add_account(bad, kPassword, Role::kOperator);
     ASSERT_FALSE(a.ok()) << bad;
     EXPECT_EQ(a.status().code(), StatusCode::kInvalidArgument) << bad;
   }
-  EXPECT_EQ(store->add_account("anna", "123456789", Role::kOperator).status().code(),
-            StatusCode::kInvalidArgument);
+  EXPECT_EQ(store->add_account("anna", "123456789", Role::kOperator).status().code(), StatusCode::kInvalidArgument);
   EXPECT_EQ(store->add_account("anna", std::string(1025, 'p'), Role::kOperator).status().code(),
             StatusCode::kInvalidArgument);
   // Nine two-byte characters are 18 bytes but still too short; ten are enough.
   std::string nine, ten;
   for (int i = 0; i < 9; ++i) nine += "\xc3\xa4";
   ten = nine + "\xc3\xa4";
-  EXPECT_EQ(store->add_account("anna", nine, Role::kOperator).status().code(),
-            StatusCode::kInvalidArgument);
+  EXPECT_EQ(store->add_account("anna", nine, Role::kOperator).status().code(), StatusCode::kInvalidArgument);
   EXPECT_TRUE(store->add_account("anna", ten, Role::kOperator).ok());
 
   auto max = store->add_account(std::string(64, 'z'), std::string(1024, 'p'), Role::kTailor);
@@ -111,10 +104,8 @@ TEST_F(AuthStoreTest, AddAccountValidatesNamesAndPasswords) {
   EXPECT_EQ(dotted->role, Role::kAdmin);
   EXPECT_EQ(dotted->created_at, "2023-11-14T22:13:20Z");
 
-  EXPECT_EQ(store->add_account("anna", kPassword, Role::kAdmin).status().code(),
-            StatusCode::kFailedPrecondition);
-  EXPECT_EQ(store->add_account("ANNA", kPassword, Role::kAdmin).status().code(),
-            StatusCode::kFailedPrecondition);
+  EXPECT_EQ(store->add_account("anna", kPassword, Role::kAdmin).status().code(), StatusCode::kFailedPrecondition);
+  EXPECT_EQ(store->add_account("ANNA", kPassword, Role::kAdmin).status().code(), StatusCode::kFailedPrecondition);
 
   auto all = store->accounts();
   ASSERT_TRUE(all.ok());
@@ -181,10 +172,8 @@ TEST_F(AuthStoreTest, LoginChecksThePassword) {
   EXPECT_TRUE(wrong.token.empty());
   EXPECT_EQ(store->login("bert", kPassword, "10.0.0.1").outcome, LoginResult::kBadCredentials);
   EXPECT_EQ(store->login("", "", "10.0.0.1").outcome, LoginResult::kBadCredentials);
-  EXPECT_EQ(store->login("anna", std::string(5000, 'x'), "10.0.0.1").outcome,
-            LoginResult::kBadCredentials);
-  EXPECT_EQ(store->login("not a name", kPassword, "10.0.0.1").outcome,
-            LoginResult::kBadCredentials);
+  EXPECT_EQ(store->login("anna", std::string(5000, 'x'), "10.0.0.1").outcome, LoginResult::kBadCredentials);
+  EXPECT_EQ(store->login("not a name", kPassword, "10.0.0.1").outcome, LoginResult::kBadCredentials);
 }
 
 TEST_F(AuthStoreTest, SessionLookupAndLogout) {
@@ -258,8 +247,7 @@ TEST_F(AuthStoreTest, ExpiredSessionsArePurgedAtLogin) {
   auto store = open();
   ASSERT_TRUE(store);
   ASSERT_TRUE(store->add_account("anna", kPassword, Role::kOperator).ok());
-  for (int i = 0; i < 5; ++i)
-    ASSERT_EQ(store->login("anna", kPassword, "10.0.0.1").outcome, LoginResult::kOk);
+  for (int i = 0; i < 5; ++i) ASSERT_EQ(store->login("anna", kPassword, "10.0.0.1").outcome, LoginResult::kOk);
   advance(2 * 3600);
   ASSERT_EQ(store->login("anna", kPassword, "10.0.0.1").outcome, LoginResult::kOk);
   auto db = storage::Database::open(path_);
@@ -287,8 +275,7 @@ TEST_F(AuthStoreTest, LoginUpgradesHashesMadeAtALowerCost) {
   o.opslimit = crypto_pwhash_OPSLIMIT_MIN + 1;
   auto store = open(o);
   ASSERT_TRUE(store);
-  EXPECT_EQ(store->login("anna", "wrong password", "10.0.0.1").outcome,
-            LoginResult::kBadCredentials);
+  EXPECT_EQ(store->login("anna", "wrong password", "10.0.0.1").outcome, LoginResult::kBadCredentials);
   EXPECT_EQ(stored_hash(), before);
   ASSERT_EQ(store->login("anna", kPassword, "10.0.0.1").outcome, LoginResult::kOk);
   const std::string after = stored_hash();
@@ -401,9 +388,9 @@ TEST_F(AuthStoreTest, SprayingPutsTheBrakeOnEveryAccount) {
   ASSERT_TRUE(store);
   ASSERT_TRUE(store->add_account("anna", kPassword, Role::kOperator).ok());
   for (int i = 0; i < 100; ++i)
-    EXPECT_EQ(store->login("user" + std::to_string(i % 50), "wrong password", "10.8." + std::to_string(i) + ".1")
-                  .outcome,
-              LoginResult::kBadCredentials);
+    EXPECT_EQ(
+        store->login("user" + std::to_string(i % 50), "wrong password", "10.8." + std::to_string(i) + ".1").outcome,
+        LoginResult::kBadCredentials);
   EXPECT_EQ(store->login("anna", "one typo here", "10.0.0.5").outcome, LoginResult::kBadCredentials);
   EXPECT_EQ(store->login("anna", kPassword, "10.0.0.5").outcome, LoginResult::kRateLimited);
   EXPECT_EQ(store->login("anna", kPassword, "10.0.0.6").outcome, LoginResult::kOk);
@@ -555,21 +542,15 @@ TEST_F(AuthStoreTest, ShareLinks) {
 TEST_F(AuthStoreTest, CreateShareValidatesInput) {
   auto store = open();
   ASSERT_TRUE(store);
-  EXPECT_EQ(store->create_share("s_1", {"waist"}, 0, "anna").status().code(),
-            StatusCode::kInvalidArgument);
-  EXPECT_EQ(store->create_share("s_1", {"waist"}, -5, "anna").status().code(),
-            StatusCode::kInvalidArgument);
+  EXPECT_EQ(store->create_share("s_1", {"waist"}, 0, "anna").status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(store->create_share("s_1", {"waist"}, -5, "anna").status().code(), StatusCode::kInvalidArgument);
   EXPECT_EQ(store->create_share("s_1", {"waist"}, 365 * 86400 + 1, "anna").status().code(),
             StatusCode::kInvalidArgument);
   EXPECT_TRUE(store->create_share("s_1", {"waist"}, 365 * 86400, "anna").ok());
-  EXPECT_EQ(store->create_share("", {"waist"}, 60, "anna").status().code(),
-            StatusCode::kInvalidArgument);
-  EXPECT_EQ(store->create_share("s_1", {""}, 60, "anna").status().code(),
-            StatusCode::kInvalidArgument);
-  EXPECT_EQ(store->create_share("s_1", {"bad\xff"}, 60, "anna").status().code(),
-            StatusCode::kInvalidArgument);
-  EXPECT_EQ(store->create_share("s_1", {"line\nbreak"}, 60, "anna").status().code(),
-            StatusCode::kInvalidArgument);
+  EXPECT_EQ(store->create_share("", {"waist"}, 60, "anna").status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(store->create_share("s_1", {""}, 60, "anna").status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(store->create_share("s_1", {"bad\xff"}, 60, "anna").status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(store->create_share("s_1", {"line\nbreak"}, 60, "anna").status().code(), StatusCode::kInvalidArgument);
 }
 
 TEST_F(AuthStoreTest, MalformedTokensAreJustUnknown) {
@@ -635,8 +616,7 @@ TEST_F(AuthStoreTest, ConcurrentLoginsAndLookups) {
           auto s = store->session(r.token);
           if (!s || s->username != name) ++failures;
         }
-        if (store->login(name, "wrong password", addr).outcome != LoginResult::kBadCredentials)
-          ++failures;
+        if (store->login(name, "wrong password", addr).outcome != LoginResult::kBadCredentials) ++failures;
         auto share = store->create_share("s_" + std::to_string(i), {"waist"}, 60, name);
         if (!share.ok() || !store->share_by_token(share->token)) ++failures;
         store->logout(r.token);
@@ -669,8 +649,7 @@ TEST_F(AuthStoreTest, RefusesBadOptions) {
   AuthOptions o = options();
   o.session_idle_s = 0;
   EXPECT_EQ(AuthStore::open(path_, o).status().code(), StatusCode::kInvalidArgument);
-  EXPECT_FALSE(
-      AuthStore::open(bodyscan::testing::temp_dir() + "/missing/dir/accounts.db", options()).ok());
+  EXPECT_FALSE(AuthStore::open(bodyscan::testing::temp_dir() + "/missing/dir/accounts.db", options()).ok());
 }
 
 }  // namespace

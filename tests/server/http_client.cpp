@@ -69,8 +69,9 @@ void Connection::close() {
 bool Connection::send_all(const std::string& bytes) {
   size_t done = 0;
   while (done < bytes.size()) {
-    const ssize_t n = ssl_ ? SSL_write(static_cast<SSL*>(ssl_), bytes.data() + done, static_cast<int>(bytes.size() - done))
-                           : ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
+    const ssize_t n =
+        ssl_ ? SSL_write(static_cast<SSL*>(ssl_), bytes.data() + done, static_cast<int>(bytes.size() - done))
+             : ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
     if (n <= 0) return false;
     done += static_cast<size_t>(n);
   }
@@ -100,7 +101,8 @@ bool Connection::read_exact(std::string* out, size_t n, std::chrono::millisecond
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   out->clear();
   while (out->size() < n) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) return false;
     std::string part = receive(n - out->size(), left);
     if (part.empty()) return false;
@@ -115,7 +117,8 @@ HttpReply Connection::read_reply(std::chrono::milliseconds timeout, bool no_body
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   size_t end = std::string::npos;
   while ((end = head.find("\r\n\r\n")) == std::string::npos) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) return r;
     std::string part = receive(65536, left);
     if (part.empty()) return r;
@@ -143,7 +146,8 @@ HttpReply Connection::read_reply(std::chrono::milliseconds timeout, bool no_body
   if (no_body || r.status == 101 || r.status == 204 || r.status == 304) return r;
   if (r.headers.count("content-length")) {
     const size_t n = std::stoull(r.headers["content-length"]);
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (!read_exact(&r.body, n, left)) r.status = 0;
   } else {
     for (std::string part; !(part = receive(65536, std::chrono::seconds(5))).empty();) r.body += part;
@@ -157,7 +161,8 @@ HttpReply http(int port, const std::string& method, const std::string& target,
   if (!c) return {};
   std::string req = method + " " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\n";
   for (const auto& [k, v] : headers) req += k + ": " + v + "\r\n";
-  if (!body.empty() || method == "POST" || method == "PUT") req += "Content-Length: " + std::to_string(body.size()) + "\r\n";
+  if (!body.empty() || method == "POST" || method == "PUT")
+    req += "Content-Length: " + std::to_string(body.size()) + "\r\n";
   req += "Connection: close\r\n\r\n" + body;
   // A server may answer before the body is all sent (413): read what it said.
   c->send_all(req);

@@ -53,15 +53,17 @@ TEST_F(HttpLimits, WrongTypesBadEncodingsAndConflictingLengthsAre400) {
   EXPECT_EQ(status_of(raw(port, "GET /api/health?x=%c3%28 HTTP/1.1\r\nHost: x\r\n\r\n")), 400);
   EXPECT_EQ(server_->as("op").request("GET", "/api/jobs/%ff", "").status, 400);
   // Two Content-Length headers that disagree: answered, not dropped.
-  EXPECT_EQ(status_of(raw(port, "POST /api/login HTTP/1.1\r\nHost: x\r\nContent-Length: 2\r\n"
-                                "Content-Length: 3\r\n\r\n{}")),
+  EXPECT_EQ(status_of(raw(port,
+                          "POST /api/login HTTP/1.1\r\nHost: x\r\nContent-Length: 2\r\n"
+                          "Content-Length: 3\r\n\r\n{}")),
             400);
   // A Host that is no host name (it would end up in a share link).
   EXPECT_EQ(status_of(raw(port, "GET /api/health HTTP/1.1\r\nHost: \x8f\x8f\r\n\r\n")), 400);
   // Fields of the wrong JSON type.
   Client admin = server_->as("admin");
-  EXPECT_EQ(admin.request("POST", "/api/accounts", R"({"username": "zed", "password": "long enough pw", "role": 5})").status,
-            400);
+  EXPECT_EQ(
+      admin.request("POST", "/api/accounts", R"({"username": "zed", "password": "long enough pw", "role": 5})").status,
+      400);
   EXPECT_EQ(admin.request("PUT", "/api/accounts/op", R"({"role": ["admin"]})").status, 400);
   Client tailor = server_->as("tailor");
   const std::string scan = "/api/scans/" + server_->scan_id;
@@ -78,7 +80,8 @@ TEST_F(HttpLimits, OversizedRequestsAreRefused) {
   const std::string big(2 << 20, ' ');
   const HttpReply body = t.request("POST", "/api/scans/" + server_->scan_id + "/measure", "{" + big + "}", {});
   EXPECT_EQ(body.status, 413);
-  const std::string huge_header = "GET /api/health HTTP/1.1\r\nHost: x\r\nX-Junk: " + std::string(20000, 'a') + "\r\n\r\n";
+  const std::string huge_header =
+      "GET /api/health HTTP/1.1\r\nHost: x\r\nX-Junk: " + std::string(20000, 'a') + "\r\n\r\n";
   EXPECT_EQ(status_of(raw(port, huge_header)), 431);
   // The server is still there.
   EXPECT_EQ(http(port, "GET", "/api/health").status, 200);
@@ -88,9 +91,10 @@ TEST_F(HttpLimits, StaticFilesStayInTheWebRootWithTheirMimeTypes) {
   const std::string& web = server_->web;
   std::filesystem::create_directories(web + "/assets");
   std::filesystem::create_directories(web + "/draco");
-  for (auto [name, body] : {std::pair{"index.html", "<!doctype html><title>bodyscan</title>"},
-                            std::pair{"assets/app-1234.mjs", "export {}"}, std::pair{"draco/decoder.wasm", "\0asm"},
-                            std::pair{"model.glb", "glTF"}, std::pair{"cloud.drc", "DRACO"}, std::pair{".env", "secret"}}) {
+  for (auto [name, body] :
+       {std::pair{"index.html", "<!doctype html><title>bodyscan</title>"},
+        std::pair{"assets/app-1234.mjs", "export {}"}, std::pair{"draco/decoder.wasm", "\0asm"},
+        std::pair{"model.glb", "glTF"}, std::pair{"cloud.drc", "DRACO"}, std::pair{".env", "secret"}}) {
     std::ofstream(web + "/" + name) << body;
   }
   const std::string outside = temp_dir() + "/secret.txt";
@@ -115,9 +119,10 @@ TEST_F(HttpLimits, StaticFilesStayInTheWebRootWithTheirMimeTypes) {
   EXPECT_NE(http(port, "GET", "/s/sometoken").body.find("<title>bodyscan</title>"), std::string::npos);
   EXPECT_EQ(http(port, "GET", "/missing.js").status, 404);
   // Escapes, encoded or not, hidden files, and symlinks out of the root.
-  for (const char* evil : {"/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd", "/assets/..%2f..%2fsecret",
-                                  "/.env", "/%2eenv", "/assets/%00x", "/a\\..\\b", "/link.txt", "//etc/passwd"}) {
-    const std::string reply = raw(port, std::string("GET ") + evil + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  for (const char* evil : {"/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd", "/assets/..%2f..%2fsecret", "/.env",
+                           "/%2eenv", "/assets/%00x", "/a\\..\\b", "/link.txt", "//etc/passwd"}) {
+    const std::string reply =
+        raw(port, std::string("GET ") + evil + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
     const int st = status_of(reply);
     EXPECT_TRUE(st == 400 || st == 404) << evil << ": " << st;
     EXPECT_EQ(reply.find("secret"), std::string::npos) << evil;
@@ -144,8 +149,9 @@ TEST_F(HttpLimits, StaticFilesComeGzippedToBrowsersThatTakeIt) {
   EXPECT_EQ(zipped.header("content-type"), "text/javascript; charset=utf-8");
   EXPECT_EQ(zipped.header("vary"), "Accept-Encoding");
   for (const char* ae : {"", "identity", "gzip;q=0", "br"}) {
-    const HttpReply r = http(port, "GET", "/assets/big-1.js", ae[0] ? std::map<std::string, std::string>{{"Accept-Encoding", ae}}
-                                                                     : std::map<std::string, std::string>{});
+    const HttpReply r = http(
+        port, "GET", "/assets/big-1.js",
+        ae[0] ? std::map<std::string, std::string>{{"Accept-Encoding", ae}} : std::map<std::string, std::string>{});
     EXPECT_EQ(r.body, plain) << ae;
     EXPECT_EQ(r.header("content-encoding"), "") << ae;
     EXPECT_NE(r.header("etag"), zipped.header("etag")) << ae;
@@ -153,7 +159,10 @@ TEST_F(HttpLimits, StaticFilesComeGzippedToBrowsersThatTakeIt) {
   const HttpReply alone = http(port, "GET", "/assets/alone-1.js", {{"Accept-Encoding", "gzip"}});
   EXPECT_EQ(alone.body, "no twin");
   EXPECT_EQ(alone.header("content-encoding"), "");
-  EXPECT_EQ(http(port, "GET", "/assets/big-1.js", {{"Accept-Encoding", "gzip"}, {"If-None-Match", zipped.header("etag")}}).status, 304);
+  EXPECT_EQ(
+      http(port, "GET", "/assets/big-1.js", {{"Accept-Encoding", "gzip"}, {"If-None-Match", zipped.header("etag")}})
+          .status,
+      304);
 }
 
 // A client that asks for the model and hangs up after the first bytes: the
@@ -163,8 +172,8 @@ TEST_F(HttpLimits, AClientThatDisconnectsMidDownloadHarmsNothing) {
   for (int i = 0; i < 5; ++i) {
     auto c = Connection::open(server_->port);
     ASSERT_NE(c, nullptr);
-    ASSERT_TRUE(c->send_all("GET /api/scans/" + server_->scan_id + "/points.drc HTTP/1.1\r\nHost: x\r\nCookie: " +
-                            t.cookie + "\r\n\r\n"));
+    ASSERT_TRUE(c->send_all("GET /api/scans/" + server_->scan_id +
+                            "/points.drc HTTP/1.1\r\nHost: x\r\nCookie: " + t.cookie + "\r\n\r\n"));
     const std::string first = c->receive(100, 5s);
     EXPECT_EQ(status_of(first), 200);
     c->close();

@@ -39,8 +39,8 @@ struct ServeStart {
 Child start_serve(const std::string& data, const std::string& password, const ServeStart& how = {}) {
   int fds[2];
   if (pipe(fds) != 0) return {};
-  std::vector<std::string> args = {BODYSCAN_BIN, "serve", "--data", data, "--port", "0", "--address", "127.0.0.1",
-                                   "--every", "4"};
+  std::vector<std::string> args = {BODYSCAN_BIN, "serve",     "--data",    data,      "--port",
+                                   "0",          "--address", "127.0.0.1", "--every", "4"};
   args.insert(args.end(), how.extra_args.begin(), how.extra_args.end());
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
@@ -169,9 +169,9 @@ TEST(ServeCli, TheFirstAdminPasswordFileIsPrivateAndGoesWhenThePasswordChanges) 
   Client admin = login(port, "admin", password);
   ASSERT_FALSE(admin.cookie.empty()) << "the file holds the working password";
   // Another account changing its password leaves the file alone.
-  ASSERT_EQ(admin.post("/api/accounts", R"({"username": "zoe", "password": "zoes long password", "role": "tailor"})")
-                .status,
-            201);
+  ASSERT_EQ(
+      admin.post("/api/accounts", R"({"username": "zoe", "password": "zoes long password", "role": "tailor"})").status,
+      201);
   ASSERT_EQ(admin.put("/api/accounts/zoe", R"({"password": "zoes new long password"})").status, 200);
   EXPECT_EQ(stat(file.c_str(), &st), 0);
   ASSERT_EQ(admin.put("/api/accounts/admin", R"({"password": "the admin's own password"})").status, 200);

@@ -260,7 +260,8 @@ TEST(Archive, FindsScansByCustomerTextAndDate) {
   Archive& ar = **a;
   const Customer ana = *ar.add_customer("Ana Souza", std::nullopt, "op");
   const Customer bo = *ar.add_customer("Bo Li", std::nullopt, "op");
-  for (const Customer* c : {&ana, &ana, &bo}) ASSERT_TRUE(ar.complete_scan(*ar.begin_scan(c->id, "maria", kRig, ""), results(1)).ok());
+  for (const Customer* c : {&ana, &ana, &bo})
+    ASSERT_TRUE(ar.complete_scan(*ar.begin_scan(c->id, "maria", kRig, ""), results(1)).ok());
   ScanQuery q;
   q.customer_id = ana.id;
   EXPECT_EQ(ar.scans(q)->size(), 2u);
@@ -326,8 +327,8 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
   // Not one byte of theirs anywhere in the archive's folder: the database, its
   // write-ahead log, the files.
   const std::string all = everything(dir);
-  for (const std::string& needle : {std::string("Zora Quintrell"), std::string("zora.q@example.org"), gone.id,
-                                    scans[0], scans[1], scans[2], std::string("ZORA-RAW-"), std::string("zora_special")})
+  for (const std::string& needle : {std::string("Zora Quintrell"), std::string("zora.q@example.org"), gone.id, scans[0],
+                                    scans[1], scans[2], std::string("ZORA-RAW-"), std::string("zora_special")})
     EXPECT_EQ(all.find(needle), std::string::npos) << needle;
   // The others are untouched, and the log says an erasure happened, by whom.
   EXPECT_EQ(ar.scan(kept_scan)->status, ScanStatus::kComplete);
@@ -388,8 +389,10 @@ TEST(Archive, AFullDiskGivesAClearErrorAndLosesNothing) {
   const auto all = *(*a)->scans();
   ASSERT_EQ(all.size(), 2u);
   for (const ScanRecord& r : all) {
-    if (r.id == kept) EXPECT_EQ(r.status, ScanStatus::kComplete);
-    else EXPECT_EQ(r.status, ScanStatus::kFailed) << r.status_reason;
+    if (r.id == kept)
+      EXPECT_EQ(r.status, ScanStatus::kComplete);
+    else
+      EXPECT_EQ(r.status, ScanStatus::kFailed) << r.status_reason;
   }
   EXPECT_EQ(slurp(*(*a)->file_path(kept, 0, "mesh.glb")), bytes(50000, 1));
 }
@@ -418,8 +421,9 @@ TEST(ArchiveCrash, SigkillAtRandomPointsLosesNoCompletedScan) {
       std::vector<std::string> mine;
       for (int i = 0;; ++i) {
         auto cs = ar.customers();
-        std::string customer = cs->empty() || i % 4 == 0 ? ar.add_customer("P" + std::to_string(i), std::nullopt, "op")->id
-                                                          : (*cs)[local() % cs->size()].id;
+        std::string customer = cs->empty() || i % 4 == 0
+                                   ? ar.add_customer("P" + std::to_string(i), std::nullopt, "op")->id
+                                   : (*cs)[local() % cs->size()].id;
         auto id = ar.begin_scan(customer, "op", kRig, "");
         if (!id.ok()) _exit(4);
         if (!ar.put_raw(*id, "stripes.bin", bytes(20000 + local() % 20000, local())).ok()) _exit(5);
@@ -451,8 +455,10 @@ TEST(ArchiveCrash, SigkillAtRandomPointsLosesNoCompletedScan) {
     std::istringstream lines(said);
     std::string tag, id;
     while (lines >> tag >> id) {
-      if (tag == "C") completed.insert(id);
-      else deleted.insert(id);  // may or may not have happened before the kill
+      if (tag == "C")
+        completed.insert(id);
+      else
+        deleted.insert(id);  // may or may not have happened before the kill
     }
     auto a = Archive::open(dir);
     ASSERT_TRUE(a.ok()) << "kill " << k << ": " << a.status().message();
@@ -487,9 +493,10 @@ TEST(ArchiveCrash, SigkillAtRandomPointsLosesNoCompletedScan) {
       }
     }
   }
-  std::printf("crash drill: %d kills, %zu scans completed before them, %zu interrupted scans marked failed, "
-              "%zu kills left half-written files; 0 completed scans lost\n",
-              points, completed.size(), recovered_running, kills_mid_write);
+  std::printf(
+      "crash drill: %d kills, %zu scans completed before them, %zu interrupted scans marked failed, "
+      "%zu kills left half-written files; 0 completed scans lost\n",
+      points, completed.size(), recovered_running, kills_mid_write);
 }
 
 }  // namespace

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <tuple>
 #include <sstream>
+#include <tuple>
 
 #include "recon/io/ply.hpp"
 #include "storage/formats/draco_files.hpp"
@@ -129,7 +129,8 @@ TEST(MeshDrc, TheArchivedSurfaceKeepsItsShapeAndConfidence) {
   // Confidence survives to 8 bits: match each decoded vertex to its original by position.
   std::map<std::tuple<int, int, int>, float> by_place;
   for (size_t i = 0; i < mesh.num_vertices(); ++i)
-    by_place[{static_cast<int>(std::lround(mesh.vertices[i].x() * 10)), static_cast<int>(std::lround(mesh.vertices[i].y() * 10)),
+    by_place[{static_cast<int>(std::lround(mesh.vertices[i].x() * 10)),
+              static_cast<int>(std::lround(mesh.vertices[i].y() * 10)),
               static_cast<int>(std::lround(mesh.vertices[i].z() * 10))}] = mesh.confidence[i];
   size_t matched = 0;
   for (size_t i = 0; i < back->num_vertices(); ++i) {

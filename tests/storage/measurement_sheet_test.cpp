@@ -44,9 +44,12 @@ std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
   for (size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     if (quoted) {
-      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') field += '"', ++i;
-      else if (c == '"') quoted = false;
-      else field += c;
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"')
+        field += '"', ++i;
+      else if (c == '"')
+        quoted = false;
+      else
+        field += c;
     } else if (c == '"') {
       quoted = true;
     } else if (c == ',') {
@@ -117,9 +120,7 @@ TEST(MeasurementSheet, JsonCarriesTheSameValues) {
 
 std::string pdf_text(const std::string& pdf) {
   const std::string dir = testing::temp_dir();
-  {
-    std::ofstream(dir + "/sheet.pdf", std::ios::binary) << pdf;
-  }
+  { std::ofstream(dir + "/sheet.pdf", std::ios::binary) << pdf; }
   const std::string cmd = "pdftotext -layout " + dir + "/sheet.pdf " + dir + "/sheet.txt 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << "pdftotext (poppler-utils) reads the sheet back";
   std::ifstream in(dir + "/sheet.txt");

@@ -95,7 +95,8 @@ StatusOr<Girth> limb_cut(const BodyCuts& cuts, const Eigen::Vector3d& p, const E
 // either side (an inclined forearm blurs the horizontal ones), read at a stable
 // level. `hand` is +1 where the hand lies along +forearm from the elbow, else -1.
 // Moves *wrist_c to the wrist and returns its cut.
-StatusOr<Girth> wrist_girth(const BodyCuts& cuts, const Eigen::Vector3d& forearm, double hand, Eigen::Vector3d* wrist_c) {
+StatusOr<Girth> wrist_girth(const BodyCuts& cuts, const Eigen::Vector3d& forearm, double hand,
+                            Eigen::Vector3d* wrist_c) {
   const double stature = cuts.stature();
   const std::vector<uint32_t> triangles = cuts.triangles_near(*wrist_c, 0.07 * stature);
   std::vector<double> gs, ts;  // the cuts' tapes and offsets along the forearm from wrist_c
@@ -183,10 +184,10 @@ StatusOr<Girth> upper_arm_girth(const BodyCuts& cuts, const Eigen::Vector3d& mid
 // changes with the limb's slope; cuts square to the axis meet the same skin
 // however the arm is raised. Nothing under five cuts.
 std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> square_cut_axis(const BodyCuts& cuts,
-                                                                            const Eigen::Vector3d& elbow,
-                                                                            const Eigen::Vector3d& dir, double from,
-                                                                            double length,
-                                                                            const std::vector<uint32_t>& triangles) {
+                                                                           const Eigen::Vector3d& elbow,
+                                                                           const Eigen::Vector3d& dir, double from,
+                                                                           double length,
+                                                                           const std::vector<uint32_t>& triangles) {
   const double reach_limit = 0.05 * cuts.stature();
   std::vector<Eigen::Vector3d> centres;
   for (double t = from; t <= from + length; t += kSquareStepMm) {
@@ -257,8 +258,8 @@ std::optional<Eigen::Vector3d> outer_side_axis(const BodyCuts& cuts, double arm_
   return Eigen::Vector3d(slope, 1, 0).normalized();
 }
 
-std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y,
-                                     double crotch_y, Side side) {
+std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y, double crotch_y,
+                                     Side side) {
   ArmTrack track = follow_arm(cuts, arm_apart_y, crotch_y, side);
   if (track.centres.size() < 30) {
     sheet.posture().arm_against_body[side == Side::kLeft ? 0 : 1] = true;
@@ -292,8 +293,8 @@ std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& she
   // skin's noise, and the shoulder rule reads the arm's slope from them).
   const double stature = cuts.stature();
   arm.elbow_centre = elbow_centre(arm, c[e], stature);
-  const std::vector<uint32_t> triangles = cuts.triangles_near(
-      arm.elbow_centre, (kSquareFromElbow + std::max(kSquareUpper, kSquareFore) + 0.05) * stature);
+  const std::vector<uint32_t> triangles =
+      cuts.triangles_near(arm.elbow_centre, (kSquareFromElbow + std::max(kSquareUpper, kSquareFore) + 0.05) * stature);
   ArmAxes square = arm;
   for (int round = 0; round < kSquareRounds; ++round) {
     const auto upper = square_cut_axis(cuts, square.elbow_centre, square.upper_dir, kSquareFromElbow * stature,
@@ -377,9 +378,9 @@ size_t wrist_cut(const std::vector<double>& g, double palm_rise) {
     if (g[i] - g[low] > rise) rise = g[i] - g[low], palm = i;
   }
   if (rise > palm_rise)
-    w = static_cast<size_t>(std::min_element(g.begin() + static_cast<std::ptrdiff_t>(from),
-                                             g.begin() + static_cast<std::ptrdiff_t>(palm)) -
-                            g.begin());
+    w = static_cast<size_t>(
+        std::min_element(g.begin() + static_cast<std::ptrdiff_t>(from), g.begin() + static_cast<std::ptrdiff_t>(palm)) -
+        g.begin());
   // A heavy forearm narrows twice above the hand, a few cm apart and within a mm or
   // two of each other, and the narrowest flips between them with the skin's noise
   // (the forearm's axis, fitted down to it, and the elbow with it). A second narrow

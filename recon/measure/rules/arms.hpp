@@ -34,8 +34,8 @@ struct ArmAxes {
 // Records the arm's abduction and elbow bend into the sheet's posture. Nothing
 // when the arm is too short to follow (under 30 cuts: it lies against the flank,
 // which the posture records).
-std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y,
-                                     double crotch_y, Side side);
+std::optional<ArmAxes> find_arm_axes(const BodyCuts& cuts, MeasurementSheet& sheet, double arm_apart_y, double crotch_y,
+                                     Side side);
 
 // The slope of an arm that lies against the flank (find_arm_axes found nothing),
 // from its outer side seen from the front: a line fitted to the cuts' outermost

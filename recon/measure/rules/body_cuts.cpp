@@ -181,7 +181,7 @@ Eigen::Vector3d loop_centre(const std::vector<Eigen::Vector3d>& loop) {
 }
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Vector3d>& p, size_t b, size_t e,
-                                                      double* residual) {
+                                                     double* residual) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (size_t i = b; i < e; ++i) c += p[i];
   c /= static_cast<double>(e - b);

@@ -83,7 +83,8 @@ class BodyCuts {
   StatusOr<Girth> level_girth(double y, const Eigen::Vector3d& near) const;
   // Triangles with a corner within r of c, for the tilted cuts (among `among`
   // when given: a subset known to hold them all).
-  std::vector<uint32_t> triangles_near(const Eigen::Vector3d& c, double r, const std::vector<uint32_t>& among = {}) const;
+  std::vector<uint32_t> triangles_near(const Eigen::Vector3d& c, double r,
+                                       const std::vector<uint32_t>& among = {}) const;
 
  private:
   BodyFrame frame_;
@@ -137,7 +138,7 @@ Eigen::Vector3d loop_centre(const std::vector<Eigen::Vector3d>& loop);
 // `residual`, when given, receives the spread off the line (the two smaller
 // eigenvalues' sum).
 std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Vector3d>& p, size_t b, size_t e,
-                                                      double* residual = nullptr);
+                                                     double* residual = nullptr);
 
 // Whether a loop in the plane with normal n winds round p (the loop is the limb's
 // own, not a neighbour's that the nearest-loop rule fell back to).

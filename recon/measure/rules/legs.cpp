@@ -123,7 +123,8 @@ std::optional<Knee> find_knee(const BodyCuts& cuts, Side side) {
   std::vector<Eigen::Vector3d> cs;
   cuts.prefetch(cuts.level(0.18), cuts.level(0.36), 2);
   for (double y = cuts.level(0.18); y <= cuts.level(0.36); y += 2)
-    if (const Ring* l = leg_loop(cuts, cuts.at(y), side)) ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
+    if (const Ring* l = leg_loop(cuts, cuts.at(y), side))
+      ys.push_back(y), gs.push_back(l->girth), cs.push_back(l->centroid);
   if (gs.size() < 10) return std::nullopt;
   size_t lowest = 0;
   double deepest = kInf;
@@ -147,8 +148,8 @@ std::optional<Knee> find_knee(const BodyCuts& cuts, Side side) {
   return knee;
 }
 
-void measure_leg(const BodyCuts& cuts, MeasurementSheet& sheet, double crotch_y, const PerSide<std::optional<Knee>>& knees,
-                 Side side) {
+void measure_leg(const BodyCuts& cuts, MeasurementSheet& sheet, double crotch_y,
+                 const PerSide<std::optional<Knee>>& knees, Side side) {
   const std::string sd = side_name(side), other_sd = side_name(opposite(side));
   const double stature = cuts.stature();
   // Thigh: the largest cut from kThighBelowCrotch of the stature below the crotch
@@ -187,7 +188,8 @@ void measure_leg(const BodyCuts& cuts, MeasurementSheet& sheet, double crotch_y,
                              : "knee level above the floor");
   }
   sheet.girth("knee_girth_" + sd, "Knee girth (" + sd + ")", "5.3.22", cuts.level_girth(knee->y, knee->centre),
-              {"knee_" + sd}, "horizontal, the narrowest cut of the leg between calf and thigh (18-36 % of the height)");
+              {"knee_" + sd},
+              "horizontal, the narrowest cut of the leg between calf and thigh (18-36 % of the height)");
   // Mid-thigh: halfway between the crotch and the knee's reading level.
   const double mid_y = 0.5 * (crotch_y + reading_y);
   const Ring* mid_leg = leg_loop(cuts, cuts.at(mid_y), side);
@@ -198,8 +200,8 @@ void measure_leg(const BodyCuts& cuts, MeasurementSheet& sheet, double crotch_y,
               mid_landmarks,
               level_knees ? "horizontal, halfway between crotch and the knees' mean level"
                           : "horizontal, halfway between crotch and kneecap");
-  sheet.girth("calf_girth_" + sd, "Calf girth (" + sd + ")", "5.3.24", cuts.level_girth(calf_y, calf_c),
-              {"knee_" + sd}, "horizontal, the largest between ankle and knee");
+  sheet.girth("calf_girth_" + sd, "Calf girth (" + sd + ")", "5.3.24", cuts.level_girth(calf_y, calf_c), {"knee_" + sd},
+              "horizontal, the largest between ankle and knee");
   double ankle_y = cuts.level(0.06);
   const Eigen::Vector3d ankle_c = extreme_cut(cuts, crotch_y, side, cuts.level(0.04), calf_y, false, &ankle_y);
   sheet.girth("min_leg_girth_" + sd, "Minimum leg girth (" + sd + ")", "5.3.25", cuts.level_girth(ankle_y, ankle_c), {},

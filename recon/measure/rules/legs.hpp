@@ -25,8 +25,8 @@ std::optional<Knee> find_knee(const BodyCuts& cuts, Side side);
 
 // The leg on `side`: thigh, knee, mid-thigh, calf and minimum leg girths and the
 // knee height. Records `knee_<side>`.
-void measure_leg(const BodyCuts& cuts, MeasurementSheet& sheet, double crotch_y, const PerSide<std::optional<Knee>>& knees,
-                 Side side);
+void measure_leg(const BodyCuts& cuts, MeasurementSheet& sheet, double crotch_y,
+                 const PerSide<std::optional<Knee>>& knees, Side side);
 
 // The distance between the legs' centres at the ankles, into `posture`.
 void read_stance(const BodyCuts& cuts, BodyPosture* posture);

@@ -49,8 +49,7 @@ constexpr double kOutlineColumnMm = 3;
 // spaced), s the side's sign: in each plane, the points where an edge crosses it.
 std::vector<std::vector<Eigen::Vector3d>> vertical_sections(const TriangleMesh& mesh, double mid_x, double s,
                                                             double y_lo, double y_hi,
-                                                            const std::function<double(size_t)>& offset,
-                                                            size_t count) {
+                                                            const std::function<double(size_t)>& offset, size_t count) {
   std::vector<std::vector<Eigen::Vector3d>> column(count);
   const double c_lo = offset(0), c_hi = offset(count - 1), step = count > 1 ? offset(1) - offset(0) : 1;
   for (const auto& t : mesh.triangles)
@@ -185,8 +184,7 @@ Status find_shoulder_point(const BodyCuts& cuts, MeasurementSheet& sheet, double
   // the section in each column's central plane (a column's highest vertex drops
   // wherever a coarse mesh has no vertex near the top). u: out from the midline.
   const std::vector<std::vector<Eigen::Vector3d>> column = vertical_sections(
-      cuts.mesh(), mid_x, s, arm_apart_y, y_hi, [&](size_t c) { return u0 + (c + 0.5) * kOutlineColumnMm; },
-      columns);
+      cuts.mesh(), mid_x, s, arm_apart_y, y_hi, [&](size_t c) { return u0 + (c + 0.5) * kOutlineColumnMm; }, columns);
   std::vector<double> us = {neck_out}, tops = {side_neck.y()};
   const double y_arm = arm_apart_y + 0.25 * (side_neck.y() - arm_apart_y);  // well down the arm
   for (size_t c = 0; c < columns && tops.back() > y_arm; ++c) {
@@ -205,8 +203,8 @@ Status find_shoulder_point(const BodyCuts& cuts, MeasurementSheet& sheet, double
   // The top of the shoulder runs front to back: its middle there, between the
   // section's points.
   const double u = *corner;
-  const std::vector<std::vector<Eigen::Vector3d>> at_corner =
-      vertical_sections(cuts.mesh(), mid_x, s, arm_apart_y, y_hi, [u](size_t) { return u; }, 1);
+  const std::vector<std::vector<Eigen::Vector3d>> at_corner = vertical_sections(
+      cuts.mesh(), mid_x, s, arm_apart_y, y_hi, [u](size_t) { return u; }, 1);
   const std::vector<Eigen::Vector3d>& top =
       at_corner[0].empty()
           ? column[std::min(columns - 1, static_cast<size_t>(std::max(0.0, (u - u0) / kOutlineColumnMm)))]
@@ -277,8 +275,8 @@ void measure_neck(const BodyCuts& cuts, MeasurementSheet& sheet, const NeckLevel
   }
   // Neck base: the tape round the neck's base through its four points.
   const std::vector<Eigen::Vector3d> via = {sheet.position("back_neck_point"), sheet.position("side_neck_point_left"),
-                                            sheet.position("front_neck_point"),
-                                            sheet.position("side_neck_point_right"), sheet.position("back_neck_point")};
+                                            sheet.position("front_neck_point"), sheet.position("side_neck_point_right"),
+                                            sheet.position("back_neck_point")};
   sheet.surface("neck_base_girth", "Neck base girth", "5.3.3", via,
                 {"back_neck_point", "side_neck_point_left", "front_neck_point", "side_neck_point_right"},
                 "round the neck's base over the skin through the back, side and front neck points");

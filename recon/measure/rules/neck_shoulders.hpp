@@ -15,9 +15,9 @@ namespace bodyscan::rules {
 
 // The neck's narrowest stretch.
 struct NeckLevel {
-  double y = 0;                                        // its middle, mm above the floor
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();    // the midline loop's centroid there
-  double radius = 0;  // the narrowest horizontal tape's length / 2 pi
+  double y = 0;                                      // its middle, mm above the floor
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // the midline loop's centroid there
+  double radius = 0;                                 // the narrowest horizontal tape's length / 2 pi
 };
 
 // The neck between the higher armpit (+4 % of the stature) and the head (-9 %):

@@ -215,8 +215,9 @@ StatusOr<double> find_crotch(const BodyCuts& cuts, MeasurementSheet& sheet) {
     above = y;
   }
   if (crotch_y < 0)
-    return not_found("measure: the legs are not apart below the trunk down to a quarter of the height; stand with "
-                     "feet apart");
+    return not_found(
+        "measure: the legs are not apart below the trunk down to a quarter of the height; stand with "
+        "feet apart");
   // Where the thighs nearly touch no camera sees between them, and the surface
   // bridges the gap below the real crotch; the real crotch's front and back are
   // seen. Up from the join, the first level whose midline crossings are measured
@@ -247,7 +248,8 @@ StatusOr<ArmJoin> find_arm_join(const BodyCuts& cuts, MeasurementSheet& sheet, d
   for (;; y += step) {
     while (y < cuts.level(0.9) && !arm(y)) y += step;
     if (y >= cuts.level(0.9))
-      return not_found("measure: no " + side_name(side) + " arm apart from the body; hold the arms away from the sides");
+      return not_found("measure: no " + side_name(side) +
+                       " arm apart from the body; hold the arms away from the sides");
     first = last = y;
     for (y += step; y < cuts.level(0.95) && arm(y); y += step) last = y;
     if (last - first >= 0.04 * stature) break;
@@ -355,9 +357,9 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
   // Hip: the buttocks' greatest backward projection. The back is flat over its
   // backmost on a heavy body, so the level is the vertex of a parabola whose weights
   // fall to zero kHipHalf of the stature either side of itself.
-  out.hip_y = extreme_level(cuts, crotch_y + 0.01 * stature, crotch_y + 0.16 * stature,
-                            [](const Ring& m) { return m.z_min; }, false, 0.5, crotch_y + 0.08 * stature,
-                            kHipHalf * stature, true);
+  out.hip_y = extreme_level(
+      cuts, crotch_y + 0.01 * stature, crotch_y + 0.16 * stature, [](const Ring& m) { return m.z_min; }, false, 0.5,
+      crotch_y + 0.08 * stature, kHipHalf * stature, true);
   // The hip's back point is on the tape at the centre back: the tape spans the
   // cleft between the buttocks at their backmost, wherever on either side that is.
   Eigen::Vector3d hip_point(mid_x, out.hip_y, mid_z);

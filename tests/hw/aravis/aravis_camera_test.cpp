@@ -134,9 +134,7 @@ class GvSimulator {
       pid_ = -1;
     }
   }
-  bool running() {
-    return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0;
-  }
+  bool running() { return pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) == 0; }
 
  private:
   std::string address_;

@@ -23,7 +23,8 @@ TEST(FrameMarkersOnRig, EveryThesisCameraFindsItsEightLights) {
     ASSERT_TRUE(c.set_frame_lights(true).ok());
     auto on = rig.camera(i).grab();
     ASSERT_TRUE(off.ok() && on.ok());
-    auto markers = find_markers({on->pixels.data(), on->width, on->height}, {off->pixels.data(), off->width, off->height});
+    auto markers =
+        find_markers({on->pixels.data(), on->width, on->height}, {off->pixels.data(), off->width, off->height});
     ASSERT_TRUE(markers.ok()) << markers.status().message();
     auto ordered = order_frame_markers(*markers);
     ASSERT_TRUE(ordered.ok()) << desc->cameras[i].id << ": " << ordered.status().message();

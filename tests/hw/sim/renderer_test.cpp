@@ -96,7 +96,10 @@ TEST(Renderer, StripeOnAPlaneIsWhereGeometrySaysToAHundredthOfAPixel) {
     double lo = -500, hi = 2500;
     for (int it = 0; it < 60; ++it) {
       const double mid = 0.5 * (lo + hi);
-      if (pixel_at(mid).y() > y) lo = mid; else hi = mid;  // image y grows downward
+      if (pixel_at(mid).y() > y)
+        lo = mid;
+      else
+        hi = mid;  // image y grows downward
     }
     const double expected = pixel_at(0.5 * (lo + hi)).x();
     ss += (measured - expected) * (measured - expected);
@@ -122,8 +125,8 @@ TEST(Renderer, BoxBeforeAWallCastsALaserShadowAndHidesTheWall) {
   const double shift = (**scene).subject().vertices[4].x() - x0;  // where standing moved the box
   for (int s = l.min_step; s <= l.max_step; ++s) {
     const double box_z = (**scene).subject().vertices[4].z();
-    const double x_at_box = (l.plane_offset(s) - l.plane_normal(s).y() * 1000 - l.plane_normal(s).z() * box_z) /
-                            l.plane_normal(s).x();
+    const double x_at_box =
+        (l.plane_offset(s) - l.plane_normal(s).y() * 1000 - l.plane_normal(s).z() * box_z) / l.plane_normal(s).x();
     const double miss = std::abs(x_at_box - (shift + 0.5 * (x0 + x1)));
     if (miss < best) best = miss, step = s;
   }
@@ -185,7 +188,8 @@ TEST(Renderer, BoxBeforeAWallCastsALaserShadowAndHidesTheWall) {
   EXPECT_GT(shadowed_wall, 10u);  // the shadow is there and dark
   // The camera does not see the wall through the box: the box's face is what the
   // centre ray through it hits.
-  const auto box_centre_px = r.model().project(Vec3d(shift + 0.5 * (x0 + x1), (**scene).subject().vertices[4].y() + 150, (**scene).subject().vertices[4].z()));
+  const auto box_centre_px = r.model().project(
+      Vec3d(shift + 0.5 * (x0 + x1), (**scene).subject().vertices[4].y() + 150, (**scene).subject().vertices[4].z()));
   ASSERT_TRUE(box_centre_px);
   EXPECT_NEAR(r.surface_at(**scene, *box_centre_px).position.z(), (**scene).subject().vertices[4].z(), 1e-3);
 }
@@ -238,7 +242,8 @@ TEST(Renderer, AStripeSeenAtAGrazingAngleLiesOnTheSurface) {
     lit.lasers.push_back({&l, step});
     const std::vector<float> on = r.irradiance(**scene, lit);
     std::vector<uint16_t> px(on.size()), zero(on.size(), 0);
-    for (size_t i = 0; i < on.size(); ++i) px[i] = static_cast<uint16_t>(std::clamp((on[i] - off[i]) * 20000.f, 0.f, 65535.f));
+    for (size_t i = 0; i < on.size(); ++i)
+      px[i] = static_cast<uint16_t>(std::clamp((on[i] - off[i]) * 20000.f, 0.f, 65535.f));
     auto samples = extract_stripe(ImageView{px.data(), w, h}, ImageView{zero.data(), w, h}, StripeOptions{}, 1 << 30);
     ASSERT_TRUE(samples.ok());
     const Vec3d n = l.plane_normal(step);
@@ -250,7 +255,8 @@ TEST(Renderer, AStripeSeenAtAGrazingAngleLiesOnTheSurface) {
       Vec3d radial(p.x() - axis.x(), 0, p.z() - axis.z());
       const double err = radial.norm() - 60;
       if (std::abs(err) > 10) continue;  // the stripe on the floor or the frame
-      const double view = std::acos(std::abs(radial.normalized().dot((r.model().centre() - p).normalized()))) * 180 / M_PI;
+      const double view =
+          std::acos(std::abs(radial.normalized().dot((r.model().centre() - p).normalized()))) * 180 / M_PI;
       (view < 45 ? frontal : view > 70 ? grazing : frontal).push_back(err);
     }
   }
@@ -302,7 +308,8 @@ TEST(Renderer, ASwayingSubjectIsRecastWhereItMovesAndNowhereElseChanges) {
       EXPECT_EQ(a, b) << "at " << t << " s, blur " << blur;
       EXPECT_NE(a, at_rest) << "at " << t << " s: the subject did not move";
       if (both) {
-        EXPECT_EQ(kept.irradiance(**scene, framed), fresh.irradiance(**scene, framed)) << "at " << t << " s, blur " << blur;
+        EXPECT_EQ(kept.irradiance(**scene, framed), fresh.irradiance(**scene, framed))
+            << "at " << t << " s, blur " << blur;
       }
     }
   }
@@ -323,7 +330,8 @@ TEST(Renderer, FrameLightsAndNoiseAreDeterministic) {
   const Renderer r(rig.cameras[0], rig.simulation);
   Lighting lights;
   lights.front_frame_lights = lights.back_frame_lights = true;
-  const Frame a = r.render(**scene, lights, {}, 7), b = r.render(**scene, lights, {}, 7), c = r.render(**scene, lights, {}, 8);
+  const Frame a = r.render(**scene, lights, {}, 7), b = r.render(**scene, lights, {}, 7),
+              c = r.render(**scene, lights, {}, 8);
   EXPECT_EQ(a.pixels, b.pixels);
   EXPECT_NE(a.pixels, c.pixels);  // noise differs frame to frame
   // Every front light in view is bright at its centre (saturated: frame_light 1.5

@@ -89,7 +89,8 @@ TEST(SimulatedRig, GrabsFramesWithIdsTimesAndTheBodyLitByTheLaser) {
     ++rows_with_stripe;
     const Hit h = rig->renderer(0).surface_at(rig->scene(), Vec2d(best, y));
     ASSERT_NE(h.surface, Surface::kNone);
-    worst_plane_distance = std::max(worst_plane_distance, std::abs(l.plane_normal(step).dot(h.position) - l.plane_offset(step)));
+    worst_plane_distance =
+        std::max(worst_plane_distance, std::abs(l.plane_normal(step).dot(h.position) - l.plane_offset(step)));
   }
   // The body spans about 140 of the 256 rows (the camera sees the whole frame);
   // the plane crosses the torso and a leg.
@@ -138,7 +139,8 @@ TEST(SimulatedRig, PosesTurnsAndPlacesItsSubjectAsDescribed) {
   const Eigen::Matrix3d turn = Eigen::AngleAxisd(30 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
   const Eigen::Vector3d shift = subject.vertices[0].cast<double>() - turn * posed->mesh.vertices[0].cast<double>();
   for (size_t i = 0; i < subject.vertices.size(); i += 101)
-    EXPECT_LT((subject.vertices[i].cast<double>() - turn * posed->mesh.vertices[i].cast<double>() - shift).norm(), 0.01);
+    EXPECT_LT((subject.vertices[i].cast<double>() - turn * posed->mesh.vertices[i].cast<double>() - shift).norm(),
+              0.01);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Vec3f& v : subject.vertices) mean += v.cast<double>();
   mean /= static_cast<double>(subject.vertices.size());
@@ -210,7 +212,8 @@ TEST(SimulatedRig, SubjectStandsOnTheFloorAndBreathes) {
   const TriangleMesh rest = s.subject();
   const_cast<Scene&>(s).set_time(1.0);
   double most = 0;
-  for (size_t i = 0; i < rest.vertices.size(); ++i) most = std::max(most, static_cast<double>((s.subject().vertices[i] - rest.vertices[i]).norm()));
+  for (size_t i = 0; i < rest.vertices.size(); ++i)
+    most = std::max(most, static_cast<double>((s.subject().vertices[i] - rest.vertices[i]).norm()));
   EXPECT_NEAR(most, 6.0, 0.01);
 }
 

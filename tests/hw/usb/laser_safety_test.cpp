@@ -28,7 +28,13 @@ namespace {
 using namespace std::chrono_literals;
 
 enum class Death {
-  kSegfault, kAbort, kTerminate, kSigterm, kSigint, kSigkill, kSighup,
+  kSegfault,
+  kAbort,
+  kTerminate,
+  kSigterm,
+  kSigint,
+  kSigkill,
+  kSighup,
   kStackOverflow,               // on the main thread, which installed the handlers
   kStackOverflowOnRigThread,    // on a thread that switched the laser on
   kStackOverflowOnOtherThread,  // on a thread that asked for an alternate stack
@@ -79,9 +85,7 @@ int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoar
           overflow_stack(0);
         }).join();
         break;
-      default:
-        switch_on_and_wait();
-        break;
+      default: switch_on_and_wait(); break;
     }
     switch (death) {
       case Death::kSegfault: raise(SIGSEGV); break;
@@ -113,16 +117,23 @@ int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoar
 double off_within(SimTmclBoard& board, int output, std::chrono::milliseconds limit) {
   const auto t0 = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() - t0 < limit) {
-    if (!board.output(output)) return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (!board.output(output))
+      return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::this_thread::sleep_for(1ms);
   }
   return -1;
 }
 
 std::string death_name(const ::testing::TestParamInfo<std::pair<Death, int>>& p) {
-  static const char* const names[] = {"Segfault", "Abort",         "Terminate",
-                                      "Sigterm",  "Sigint",        "Sigkill",
-                                      "Sighup",   "StackOverflow", "StackOverflowOnTheRigThread",
+  static const char* const names[] = {"Segfault",
+                                      "Abort",
+                                      "Terminate",
+                                      "Sigterm",
+                                      "Sigint",
+                                      "Sigkill",
+                                      "Sighup",
+                                      "StackOverflow",
+                                      "StackOverflowOnTheRigThread",
                                       "StackOverflowOnAnotherThread"};
   return names[static_cast<int>(p.param.first)];
 }

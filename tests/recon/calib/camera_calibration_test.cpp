@@ -10,7 +10,8 @@ namespace {
 FrameMarkers front_markers() {
   FrameMarkers m;
   m.top = {Eigen::Vector2d(300, 40), Eigen::Vector2d(420, 150), Eigen::Vector2d(860, 150), Eigen::Vector2d(980, 40)};
-  m.bottom = {Eigen::Vector2d(300, 980), Eigen::Vector2d(420, 860), Eigen::Vector2d(860, 860), Eigen::Vector2d(980, 980)};
+  m.bottom = {Eigen::Vector2d(300, 980), Eigen::Vector2d(420, 860), Eigen::Vector2d(860, 860),
+              Eigen::Vector2d(980, 980)};
   return m;
 }
 

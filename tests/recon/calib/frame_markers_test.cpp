@@ -18,7 +18,8 @@ Image discs(int w, int h, const std::vector<Eigen::Vector2d>& centres, double r,
     for (int x = 0; x < w; ++x)
       for (const auto& c : centres) {
         const double d = (Eigen::Vector2d(x, y) - c).norm();
-        if (d < r + 1) im.px[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(bg + 200 * std::clamp(r + 0.5 - d, 0.0, 1.0));
+        if (d < r + 1)
+          im.px[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(bg + 200 * std::clamp(r + 0.5 - d, 0.0, 1.0));
       }
   return im;
 }

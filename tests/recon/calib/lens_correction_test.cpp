@@ -136,8 +136,8 @@ TEST_P(LensGridTurn, IndexesADistortedTurnedGridWithGapsAndStrays) {
   s.k = 0.1;
   s.turn_deg = GetParam();
   s.removed = {{2, 1}, {-3, 0}, {5, -4}, {-6, 3}, {0, 5}};
-  for (const auto& [c, r] : std::vector<std::pair<double, double>>{{0.5, 0.5}, {-2.5, 1.5}, {3.5, -2.5}, {-5.5, -3.5},
-                                                                    {6.5, 2.5}})
+  for (const auto& [c, r] :
+       std::vector<std::pair<double, double>>{{0.5, 0.5}, {-2.5, 1.5}, {3.5, -2.5}, {-5.5, -3.5}, {6.5, 2.5}})
     s.strays.push_back(s.node(c, r));
   const Image im = s.render();
   auto dots = find_dots(im.view());
@@ -231,14 +231,15 @@ TEST(LensCorrection, MatchesTheTrueUndistortionUpToAHomography) {
   ASSERT_GT(truth.size(), 2000u);
   const auto [rms, worst] = after_homography(corrected, truth);
   const auto [raw_rms, raw_worst] = after_homography(raw, truth);
-  EXPECT_LT(rms, 0.02);    // measured 0.0063
-  EXPECT_LT(worst, 0.06);   // measured 0.018
-  EXPECT_GT(raw_rms, 3.0);  // uncorrected: the distortion itself (4.4 px)
+  EXPECT_LT(rms, 0.02);                        // measured 0.0063
+  EXPECT_LT(worst, 0.06);                      // measured 0.018
+  EXPECT_GT(raw_rms, 3.0);                     // uncorrected: the distortion itself (4.4 px)
   EXPECT_LT(c.lens->held_out_rms_px(), 0.03);  // measured 0.011
-  std::printf("[ lens ] synthetic k=0.1: %d dots found, %d used, fit %.4f px, held-out %.4f px; truth RMS %.4f max "
-              "%.4f px (uncorrected %.2f / %.2f)\n",
-              c.lens->dots_found(), c.lens->dots_used(), c.lens->fit_rms_px(), c.lens->held_out_rms_px(), rms, worst,
-              raw_rms, raw_worst);
+  std::printf(
+      "[ lens ] synthetic k=0.1: %d dots found, %d used, fit %.4f px, held-out %.4f px; truth RMS %.4f max "
+      "%.4f px (uncorrected %.2f / %.2f)\n",
+      c.lens->dots_found(), c.lens->dots_used(), c.lens->fit_rms_px(), c.lens->held_out_rms_px(), rms, worst, raw_rms,
+      raw_worst);
 }
 
 TEST(LensCorrection, TableMatchesTheExactSpline) {

@@ -63,9 +63,8 @@ TEST(FillHoles, CubeMissingAFaceClosesWithTheRightWinding) {
 TEST(FillHoles, PlanarHoleIsFilledFlatAtTheMeshDensity) {
   // A 6 x 6 hole in a 20 x 20 grid; the outer rim (80 edges) is left open by the
   // size limit, which shows the limit works.
-  TriangleMesh m = without(grid(20), [](const Vec3f& p) {
-    return p.x() >= 7 && p.x() <= 13 && p.y() >= 7 && p.y() <= 13;
-  });
+  TriangleMesh m =
+      without(grid(20), [](const Vec3f& p) { return p.x() >= 7 && p.x() <= 13 && p.y() >= 7 && p.y() <= 13; });
   const size_t before = m.triangles.size();
   HoleFillOptions o;
   o.max_hole_edges = 40;
@@ -202,7 +201,8 @@ TEST(FillHoles, HolesMeetingAtAVertexAndSeveralHolesAllClose) {
 TEST(FillHoles, OpeningsLargerThanTheAreaLimitStayOpen) {
   // A 4 x 4 grid missing a 1 x 1 square: its rim would take a fill of area 16, the
   // square one of area 1; with a limit of 2 only the square is filled.
-  TriangleMesh m = without(grid(4), [](const Vec3f& p) { return p.x() >= 1 && p.x() <= 2 && p.y() >= 1 && p.y() <= 2; });
+  TriangleMesh m =
+      without(grid(4), [](const Vec3f& p) { return p.x() >= 1 && p.x() <= 2 && p.y() >= 1 && p.y() <= 2; });
   const size_t grid_vertices = m.vertices.size();
   HoleFillOptions o;
   o.max_hole_area = 2.0;
@@ -240,10 +240,11 @@ TEST(TrimBoundaryFlaps, PeelsOnlyUnsupportedTrianglesReachableFromTheBoundary) {
 
   // An unsupported island inside a supported region is not reachable either.
   TriangleMesh g = grid(10);
-  EXPECT_EQ(trim_boundary_flaps(g, [&](uint32_t v) {
-              const Vec3f& p = g.vertices[v];
-              return p.x() >= 4 && p.x() <= 6 && p.y() >= 4 && p.y() <= 6;
-            }),
+  EXPECT_EQ(trim_boundary_flaps(g,
+                                [&](uint32_t v) {
+                                  const Vec3f& p = g.vertices[v];
+                                  return p.x() >= 4 && p.x() <= 6 && p.y() >= 4 && p.y() <= 6;
+                                }),
             0u);
 }
 

@@ -45,8 +45,8 @@ double triangle_distance(const Vec3d& q, const Vec3d& a, const Vec3d& b, const V
   if (n.squaredNorm() > 0) {
     const Vec3d unit = n.normalized();
     const Vec3d p = q - (q - a).dot(unit) * unit;
-    const bool inside = (b - a).cross(p - a).dot(n) >= 0 && (c - b).cross(p - b).dot(n) >= 0 &&
-                        (a - c).cross(p - c).dot(n) >= 0;
+    const bool inside =
+        (b - a).cross(p - a).dot(n) >= 0 && (c - b).cross(p - b).dot(n) >= 0 && (a - c).cross(p - c).dot(n) >= 0;
     if (inside) best = std::min(best, (q - p).norm());
   }
   return best;
@@ -55,17 +55,16 @@ double triangle_distance(const Vec3d& q, const Vec3d& a, const Vec3d& b, const V
 double brute_force_distance(const TriangleMesh& m, const Vec3f& q) {
   double best = std::numeric_limits<double>::infinity();
   for (const Triangle& t : m.triangles) {
-    best = std::min(
-        best, triangle_distance(q.cast<double>(), m.vertices[t[0]].cast<double>(),
-                                m.vertices[t[1]].cast<double>(), m.vertices[t[2]].cast<double>()));
+    best = std::min(best, triangle_distance(q.cast<double>(), m.vertices[t[0]].cast<double>(),
+                                            m.vertices[t[1]].cast<double>(), m.vertices[t[2]].cast<double>()));
   }
   return best;
 }
 
 double distance_to_triangle(const TriangleMesh& m, uint32_t t, const Vec3f& q) {
   const Triangle& tri = m.triangles[t];
-  return triangle_distance(q.cast<double>(), m.vertices[tri[0]].cast<double>(),
-                           m.vertices[tri[1]].cast<double>(), m.vertices[tri[2]].cast<double>());
+  return triangle_distance(q.cast<double>(), m.vertices[tri[0]].cast<double>(), m.vertices[tri[1]].cast<double>(),
+                           m.vertices[tri[2]].cast<double>());
 }
 
 // Generalized winding number (Jacobson et al., SIGGRAPH 2013) from the solid angles of
@@ -84,8 +83,7 @@ double winding_number(const TriangleMesh& m, const Vec3d& q) {
   return total / (4.0 * std::numbers::pi);
 }
 
-std::vector<Vec3f> random_points_in_box(const TriangleMesh& m, double margin, size_t n,
-                                        uint64_t seed) {
+std::vector<Vec3f> random_points_in_box(const TriangleMesh& m, double margin, size_t n, uint64_t seed) {
   Vec3f lo = m.vertices[0], hi = m.vertices[0];
   for (const Vec3f& v : m.vertices) {
     lo = lo.cwiseMin(v);
@@ -106,8 +104,7 @@ std::vector<Vec3f> vertex_normals(const TriangleMesh& m) {
   std::vector<Vec3d> sum(m.vertices.size(), Vec3d::Zero());
   for (const Triangle& t : m.triangles) {
     const Vec3d a = m.vertices[t[0]].cast<double>();
-    const Vec3d n =
-        (m.vertices[t[1]].cast<double>() - a).cross(m.vertices[t[2]].cast<double>() - a);
+    const Vec3d n = (m.vertices[t[1]].cast<double>() - a).cross(m.vertices[t[2]].cast<double>() - a);
     for (uint32_t v : t) sum[v] += n;
   }
   std::vector<Vec3f> normals;

@@ -80,8 +80,8 @@ TEST(FibonacciSphere, NearestNeighbourSpacingIsNearlyUniform) {
   EXPECT_LT(*hi, 1.1 * expected);
   // Equal areas: each hemisphere of every axis holds half the points.
   for (int axis = 0; axis < 3; ++axis) {
-    const auto upper = std::count_if(cloud.positions.begin(), cloud.positions.end(),
-                                     [&](const Vec3f& p) { return p[axis] > 0; });
+    const auto upper =
+        std::count_if(cloud.positions.begin(), cloud.positions.end(), [&](const Vec3f& p) { return p[axis] > 0; });
     EXPECT_NEAR(static_cast<double>(upper), 512.0, 12.0) << "axis " << axis;
   }
 }
@@ -100,9 +100,8 @@ TEST(SampleMeshUniform, BodySamplesLieOnTheMeshWithTheirTriangleNormals) {
     ASSERT_NEAR(cloud.normals[i].norm(), 1.0f, 1e-5f);
     // The nearest triangle may be a neighbour when the sample sits on a shared edge.
     const Triangle& t = body.triangles[cp.triangle];
-    const Vec3f n = (body.vertices[t[1]] - body.vertices[t[0]])
-                        .cross(body.vertices[t[2]] - body.vertices[t[0]])
-                        .normalized();
+    const Vec3f n =
+        (body.vertices[t[1]] - body.vertices[t[0]]).cross(body.vertices[t[2]] - body.vertices[t[0]]).normalized();
     normal_mismatches += n.dot(cloud.normals[i]) < 0.999f;
   }
   EXPECT_LT(normal_mismatches, 100u);
@@ -191,8 +190,7 @@ TEST(SampleMeshUniform, BodyRegionGetsSamplesInProportionToArea) {
   double region_area = 0, total_area = 0;
   for (size_t t = 0; t < body.triangles.size(); ++t) {
     const Triangle& tri = body.triangles[t];
-    const float y =
-        (body.vertices[tri[0]].y() + body.vertices[tri[1]].y() + body.vertices[tri[2]].y()) / 3.0f;
+    const float y = (body.vertices[tri[0]].y() + body.vertices[tri[1]].y() + body.vertices[tri[2]].y()) / 3.0f;
     in_region[t] = y > 1400.0f;
     total_area += triangle_area(body, t);
     if (in_region[t]) region_area += triangle_area(body, t);
@@ -295,10 +293,8 @@ TEST(NonuniformSphere, RatioOneIsUniformAndSeedsAreDeterministic) {
   size_t top = 0;
   for (const Vec3f& p : uniform.positions) top += p.y() > 5.0f;  // cap of 1/4 the area
   EXPECT_LT(std::abs(binomial_z(top, 100000, 0.25)), 4.0);
-  EXPECT_EQ(nonuniform_sphere(1000, 10.0, 8.0, 4).positions,
-            nonuniform_sphere(1000, 10.0, 8.0, 4).positions);
-  EXPECT_NE(nonuniform_sphere(1000, 10.0, 8.0, 4).positions,
-            nonuniform_sphere(1000, 10.0, 8.0, 5).positions);
+  EXPECT_EQ(nonuniform_sphere(1000, 10.0, 8.0, 4).positions, nonuniform_sphere(1000, 10.0, 8.0, 4).positions);
+  EXPECT_NE(nonuniform_sphere(1000, 10.0, 8.0, 4).positions, nonuniform_sphere(1000, 10.0, 8.0, 5).positions);
 }
 
 }  // namespace

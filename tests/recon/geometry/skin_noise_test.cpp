@@ -12,8 +12,7 @@ namespace {
 // The displacement of each vertex along its (outward) radius.
 std::vector<double> radial_moves(const TriangleMesh& before, const TriangleMesh& after) {
   std::vector<double> d;
-  for (size_t i = 0; i < before.vertices.size(); ++i)
-    d.push_back(after.vertices[i].norm() - before.vertices[i].norm());
+  for (size_t i = 0; i < before.vertices.size(); ++i) d.push_back(after.vertices[i].norm() - before.vertices[i].norm());
   return d;
 }
 

@@ -109,9 +109,8 @@ TEST(PlyBadInputTest, BadHeaderLines) {
   EXPECT_ERROR_CONTAINS(kAsciiStart + kAsciiStart.substr(4) + "end_header\n", "second format line");
   EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex -3\n" + kXyz + "end_header\n",
                         "count '-3' is not a non-negative integer");
-  EXPECT_ERROR_CONTAINS(
-      kAsciiStart + "element vertex 18446744073709551616\n" + kXyz + "end_header\n",
-      "is not a non-negative integer");
+  EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 18446744073709551616\n" + kXyz + "end_header\n",
+                        "is not a non-negative integer");
   EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 1\nproperty float32 x\nproperty float32 x\n",
                         "header line 5: element 'vertex' has two properties named 'x'");
   EXPECT_ERROR_CONTAINS(kAsciiStart + "property float x\nend_header\n", "before any element");
@@ -119,9 +118,8 @@ TEST(PlyBadInputTest, BadHeaderLines) {
                         "unknown property type 'half'");
   EXPECT_ERROR_CONTAINS(kAsciiStart + "element face 1\nproperty list float int vertex_indices\n",
                         "list count type 'float' is not an integer type");
-  EXPECT_ERROR_CONTAINS(
-      kAsciiStart + "element vertex 0\n" + kXyz + "element vertex 0\n" + kXyz + "end_header\n",
-      "declared twice");
+  EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 0\n" + kXyz + "element vertex 0\n" + kXyz + "end_header\n",
+                        "declared twice");
   EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 1\nproperty float x y\nend_header\n",
                         "expected 'property <type> <name>'");
 }
@@ -139,12 +137,11 @@ TEST(PlyBadInputTest, MissingOrMisshapenVertexProperties) {
                             "element vertex 1\nproperty list uchar float x\n"
                             "property float y\nproperty float z\nend_header\n1 1 2 3\n",
                         "vertex property 'x' is a list");
+  EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 1\n" + kXyz + "property float nx\nend_header\n1 2 3 4\n",
+                        "only some of the normal properties");
   EXPECT_ERROR_CONTAINS(
-      kAsciiStart + "element vertex 1\n" + kXyz + "property float nx\nend_header\n1 2 3 4\n",
-      "only some of the normal properties");
-  EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 1\n" + kXyz +
-                            "element face 1\nproperty int vertex_indices\nend_header\n1 2 3\n0\n",
-                        "must be a list");
+      kAsciiStart + "element vertex 1\n" + kXyz + "element face 1\nproperty int vertex_indices\nend_header\n1 2 3\n0\n",
+      "must be a list");
   EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 1\n" + kXyz +
                             "element face 1\nproperty list uchar float vertex_indices\n"
                             "end_header\n1 2 3\n3 0 0 0\n",
@@ -187,8 +184,7 @@ TEST(PlyBadInputTest, TruncationMessageNamesRecordAndOffset) {
   const size_t header = s.size();
   s.append(12 * 1234 + 5, '\0');
   EXPECT_EQ(error_of(s), "bad.ply: truncated: vertex 1234 of 5000 needs 12 bytes at offset " +
-                             std::to_string(header + 12 * 1234) + ", file has " +
-                             std::to_string(s.size()) + " bytes");
+                             std::to_string(header + 12 * 1234) + ", file has " + std::to_string(s.size()) + " bytes");
 }
 
 // A header claiming 2^40 records in a tiny file must be refused before anything is
@@ -196,12 +192,10 @@ TEST(PlyBadInputTest, TruncationMessageNamesRecordAndOffset) {
 TEST(PlyBadInputTest, HugeCountsInATinyFile) {
   const auto start = std::chrono::steady_clock::now();
   std::string tail(24, '\0');
-  EXPECT_ERROR_CONTAINS(
-      kBinaryStart + "element vertex 1099511627776\n" + kXyz + "end_header\n" + tail,
-      "truncated: vertex 2 of 1099511627776 needs 12 bytes");
-  EXPECT_ERROR_CONTAINS(
-      kAsciiStart + "element vertex 1099511627776\n" + kXyz + "end_header\n" + "1 2 3\n",
-      "header declares 1099511627776 vertex records");
+  EXPECT_ERROR_CONTAINS(kBinaryStart + "element vertex 1099511627776\n" + kXyz + "end_header\n" + tail,
+                        "truncated: vertex 2 of 1099511627776 needs 12 bytes");
+  EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 1099511627776\n" + kXyz + "end_header\n" + "1 2 3\n",
+                        "header declares 1099511627776 vertex records");
   // Faces and skipped elements are read record by record up to the first one cut off.
   std::string faces = kBinaryStart + "element vertex 1\n" + kXyz +
                       "element face 1099511627776\nproperty list uchar int vertex_indices\n"
@@ -214,9 +208,9 @@ TEST(PlyBadInputTest, HugeCountsInATinyFile) {
                             "property list uint uchar data\nelement vertex 0\n" +
                             kXyz + "end_header\n" + tail,
                         "blob 6 of 18446744073709551615, property 'data': truncated");
-  EXPECT_ERROR_CONTAINS(kBinaryStart + "element camera 1099511627776\n" + kXyz +
-                            "element vertex 0\n" + kXyz + "end_header\n" + tail,
-                        "camera 2 of 1099511627776");
+  EXPECT_ERROR_CONTAINS(
+      kBinaryStart + "element camera 1099511627776\n" + kXyz + "element vertex 0\n" + kXyz + "end_header\n" + tail,
+      "camera 2 of 1099511627776");
   // Failing fast is the point: far below what touching terabytes would take.
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
 }
@@ -262,9 +256,9 @@ TEST(PlyBadInputTest, NegativeListCount) {
   put_le(s, int8_t{-1});
   s.append(12, '\0');
   EXPECT_ERROR_CONTAINS(s, "negative list count -1");
-  EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 0\n" + kXyz +
-                            "element tags 1\nproperty list int uchar t\nend_header\n-5 1 2\n",
-                        "negative list count -5 on line 10");
+  EXPECT_ERROR_CONTAINS(
+      kAsciiStart + "element vertex 0\n" + kXyz + "element tags 1\nproperty list int uchar t\nend_header\n-5 1 2\n",
+      "negative list count -5 on line 10");
 }
 
 TEST(PlyBadInputTest, ListCountLargerThanTheFile) {
@@ -275,14 +269,14 @@ TEST(PlyBadInputTest, ListCountLargerThanTheFile) {
   s.append(12, '\0');
   EXPECT_ERROR_CONTAINS(s, "truncated: a list of 255 int needs 1020 bytes");
   // The same on a list nobody reads, and in ASCII.
-  std::string skipped = kBinaryStart + "element vertex 0\n" + kXyz +
-                        "element junk 1\nproperty list uint double j\nend_header\n";
+  std::string skipped =
+      kBinaryStart + "element vertex 0\n" + kXyz + "element junk 1\nproperty list uint double j\nend_header\n";
   put_le(skipped, uint32_t{4000000000u});
   skipped.append(16, '\0');
   EXPECT_ERROR_CONTAINS(skipped, "truncated: a list of 4000000000 double");
-  EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 0\n" + kXyz +
-                            "element junk 1\nproperty list uchar int j\nend_header\n255 1 2 3\n",
-                        "cannot fit");
+  EXPECT_ERROR_CONTAINS(
+      kAsciiStart + "element vertex 0\n" + kXyz + "element junk 1\nproperty list uchar int j\nend_header\n255 1 2 3\n",
+      "cannot fit");
 }
 
 TEST(PlyBadInputTest, AsciiNonNumberToken) {
@@ -301,16 +295,13 @@ TEST(PlyBadInputTest, AsciiNonNumberToken) {
 
 TEST(PlyBadInputTest, AsciiTooFewOrTooManyValues) {
   const std::string head = kAsciiStart + "element vertex 2\n" + kXyz + "end_header\n";
-  EXPECT_ERROR_CONTAINS(head + "1 2\n3 4 5\n",
-                        "vertex 0 of 2, property 'z': line 8 ends before all values were read");
+  EXPECT_ERROR_CONTAINS(head + "1 2\n3 4 5\n", "vertex 0 of 2, property 'z': line 8 ends before all values were read");
   // Fewer records than declared: refused before the vertices are allocated.
   EXPECT_ERROR_CONTAINS(head + "1 2 3\n",
                         "truncated: the header declares 2 vertex records of at least 5 bytes "
                         "each, but only 6 bytes are left");
-  EXPECT_ERROR_CONTAINS(head + "1 2 3\n\n\n\n\n\n",
-                        "vertex 1 of 2, property 'x': unexpected end of file on line 14");
-  EXPECT_ERROR_CONTAINS(head + "1 2 3\n4 5 6 7\n",
-                        "vertex 1 of 2: unexpected extra value '7' on line 9");
+  EXPECT_ERROR_CONTAINS(head + "1 2 3\n\n\n\n\n\n", "vertex 1 of 2, property 'x': unexpected end of file on line 14");
+  EXPECT_ERROR_CONTAINS(head + "1 2 3\n4 5 6 7\n", "vertex 1 of 2: unexpected extra value '7' on line 9");
 }
 
 TEST(PlyBadInputTest, NonFiniteCoordinates) {
@@ -336,13 +327,11 @@ TEST(PlyBadInputTest, NonFiniteCoordinates) {
 
 TEST(PlyBadInputTest, CameraIdsMustIndexTheCentres) {
   const std::string head = kAsciiStart + "element vertex 2\n" + kXyz + "property int camera\n";
-  EXPECT_ERROR_CONTAINS(
-      head + "element camera 1\n" + kXyz + "end_header\n1 2 3 0\n1 2 3 1\n0 0 0\n",
-      "vertex 1 has camera id 1, but the file has 1 camera centres");
+  EXPECT_ERROR_CONTAINS(head + "element camera 1\n" + kXyz + "end_header\n1 2 3 0\n1 2 3 1\n0 0 0\n",
+                        "vertex 1 has camera id 1, but the file has 1 camera centres");
   EXPECT_ERROR_CONTAINS(head + "end_header\n1 2 3 0\n1 2 3 -2\n", "camera id -2");
-  EXPECT_ERROR_CONTAINS(
-      kAsciiStart + "element vertex 1\n" + kXyz + "property double camera\nend_header\n1 2 3 1.5\n",
-      "not a 32-bit integer");
+  EXPECT_ERROR_CONTAINS(kAsciiStart + "element vertex 1\n" + kXyz + "property double camera\nend_header\n1 2 3 1.5\n",
+                        "not a 32-bit integer");
 }
 
 TEST(PlyBadInputTest, BinaryIdsMustBe32BitIntegers) {
@@ -355,8 +344,7 @@ TEST(PlyBadInputTest, BinaryIdsMustBe32BitIntegers) {
                         "vertex 1 of 2, property 'frame': value 3000000000 is not a 32-bit "
                         "integer at offset " +
                             std::to_string(s.size() - 4));
-  std::string d =
-      kBinaryStart + "element vertex 1\n" + kXyz + "property double laser\nend_header\n";
+  std::string d = kBinaryStart + "element vertex 1\n" + kXyz + "property double laser\nend_header\n";
   for (int k = 0; k < 3; ++k) put_le(d, 1.0f);
   put_le(d, 2.5);
   EXPECT_ERROR_CONTAINS(d, "property 'laser': value 2.5 is not a 32-bit integer");
@@ -403,9 +391,12 @@ TEST(PlyBadInputTest, RandomByteFlips) {
 std::string long_header(int lines) {
   std::string s = kBinaryStart + "element vertex 0\n" + kXyz;
   for (int i = 0; i < lines; ++i) {
-    if (i % 3 == 0) s += "element e" + std::to_string(i) + " 0\n";
-    else if (i % 3 == 1) s += "property float p" + std::to_string(i) + "\n";
-    else s += "comment line " + std::to_string(i) + "\n";
+    if (i % 3 == 0)
+      s += "element e" + std::to_string(i) + " 0\n";
+    else if (i % 3 == 1)
+      s += "property float p" + std::to_string(i) + "\n";
+    else
+      s += "comment line " + std::to_string(i) + "\n";
   }
   return s + "end_header\n";
 }

@@ -135,11 +135,8 @@ TEST_P(PlyRoundTrip, CloudThroughDiskOverwritesOldFile) {
   expect_same_cloud(second, read->cloud);
 }
 
-INSTANTIATE_TEST_SUITE_P(PlyFormats, PlyRoundTrip,
-                         ::testing::Values(PlyFormat::kBinaryLittleEndian, PlyFormat::kAscii),
-                         [](const auto& info) {
-                           return info.param == PlyFormat::kAscii ? "Ascii" : "Binary";
-                         });
+INSTANTIATE_TEST_SUITE_P(PlyFormats, PlyRoundTrip, ::testing::Values(PlyFormat::kBinaryLittleEndian, PlyFormat::kAscii),
+                         [](const auto& info) { return info.param == PlyFormat::kAscii ? "Ascii" : "Binary"; });
 
 TEST(PlyTest, EncodesTheDocumentedHeader) {
   PointCloud cloud;
@@ -223,11 +220,9 @@ TEST(PlyTest, BigEndianMatchesAscii) {
   const std::string props =
       "property double x\nproperty double y\nproperty double z\nproperty short extra\n"
       "element face 2\nproperty list ushort int vertex_indices\nend_header\n";
-  const std::string big =
-      "ply\nformat binary_big_endian 1.0\nelement vertex 5\n" + props + be.str();
-  const std::string ascii =
-      "ply\nformat ascii 1.0\nelement vertex 5\n" + props +
-      "0 0 0 -7\n1.5 0 0 -7\n1.5 2.25 0 -7\n0 2.25 0 -7\n0.75 3 -1 -7\n4 0 1 2 3\n3 3 2 4\n";
+  const std::string big = "ply\nformat binary_big_endian 1.0\nelement vertex 5\n" + props + be.str();
+  const std::string ascii = "ply\nformat ascii 1.0\nelement vertex 5\n" + props +
+                            "0 0 0 -7\n1.5 0 0 -7\n1.5 2.25 0 -7\n0 2.25 0 -7\n0.75 3 -1 -7\n4 0 1 2 3\n3 3 2 4\n";
   auto a = parse_ply(big, "big.ply");
   auto b = parse_ply(ascii, "ascii.ply");
   ASSERT_TRUE(a.ok()) << a.status().message();
@@ -346,8 +341,7 @@ TEST(PlyTest, CameraElementGivesCentres) {
       "100 200 300\n-100 200 300\n";
   auto data = parse_ply(ply);
   ASSERT_TRUE(data.ok()) << data.status().message();
-  EXPECT_EQ(data->cloud.camera_centres,
-            (std::vector<Vec3f>{Vec3f(100, 200, 300), Vec3f(-100, 200, 300)}));
+  EXPECT_EQ(data->cloud.camera_centres, (std::vector<Vec3f>{Vec3f(100, 200, 300), Vec3f(-100, 200, 300)}));
   EXPECT_TRUE(data->cloud.has_cameras());
 }
 

@@ -72,7 +72,7 @@ TEST(BodyFrame, ARigidMotionChangesNoMeasurement) {
 
 TEST(BodyFrame, RefusesWhatIsNoStandingBody) {
   EXPECT_FALSE(find_body_frame(TriangleMesh{}).ok());
-  EXPECT_FALSE(find_body_frame(testing::icosphere(3, 100)).ok());   // 200 mm tall
+  EXPECT_FALSE(find_body_frame(testing::icosphere(3, 100)).ok());  // 200 mm tall
 }
 
 }  // namespace

@@ -53,7 +53,8 @@ const ShippedBody* shipped_body(const std::string& file) {
   if (it == cache.end()) {
     std::optional<ShippedBody> body;
     if (auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/" + file); mesh.ok())
-      if (auto measured = measure_body(*mesh); measured.ok()) body = ShippedBody{std::move(*mesh), std::move(*measured)};
+      if (auto measured = measure_body(*mesh); measured.ok())
+        body = ShippedBody{std::move(*mesh), std::move(*measured)};
     it = cache.emplace(file, std::move(body)).first;
   }
   return it->second ? &*it->second : nullptr;
@@ -84,12 +85,32 @@ class BodyMeasurementsTest : public ::testing::TestWithParam<Truth> {
 TEST_P(BodyMeasurementsTest, TakesTheWholeSet) {
   const BodyMeasurements& b = measured(GetParam().file);
   EXPECT_TRUE(b.skipped.empty()) << b.skipped.front();
-  for (const char* name :
-       {"stature", "cervical_height", "crotch_height", "neck_girth", "neck_base_girth", "chest_girth", "bust_girth",
-        "underbust_girth", "waist_girth", "hip_girth", "max_hip_girth", "waist_height", "hip_height",
-        "thigh_girth_left", "mid_thigh_girth_left", "knee_girth_left", "calf_girth_left", "min_leg_girth_left",
-        "upper_arm_girth_left", "wrist_girth_left", "outer_arm_length_left", "thigh_girth_right",
-        "upper_arm_girth_right", "shoulder_width", "biacromial_breadth", "back_neck_to_waist"}) {
+  for (const char* name : {"stature",
+                           "cervical_height",
+                           "crotch_height",
+                           "neck_girth",
+                           "neck_base_girth",
+                           "chest_girth",
+                           "bust_girth",
+                           "underbust_girth",
+                           "waist_girth",
+                           "hip_girth",
+                           "max_hip_girth",
+                           "waist_height",
+                           "hip_height",
+                           "thigh_girth_left",
+                           "mid_thigh_girth_left",
+                           "knee_girth_left",
+                           "calf_girth_left",
+                           "min_leg_girth_left",
+                           "upper_arm_girth_left",
+                           "wrist_girth_left",
+                           "outer_arm_length_left",
+                           "thigh_girth_right",
+                           "upper_arm_girth_right",
+                           "shoulder_width",
+                           "biacromial_breadth",
+                           "back_neck_to_waist"}) {
     const BodyMeasurement* m = b.find(name);
     ASSERT_NE(m, nullptr) << name;
     EXPECT_GT(m->value_mm, 0) << name;
@@ -150,7 +171,8 @@ TEST_P(BodyMeasurementsTest, GirthsAgreeWithTheManifestAndAreSymmetric) {
   EXPECT_LT(value(b, "knee_girth_left"), value(b, "thigh_girth_left"));
   EXPECT_GT(value(b, "shoulder_width"), value(b, "biacromial_breadth"));
   // The bodies are mirror-symmetric.
-  for (const char* m : {"thigh_girth", "knee_girth", "calf_girth", "upper_arm_girth", "wrist_girth", "outer_arm_length"})
+  for (const char* m :
+       {"thigh_girth", "knee_girth", "calf_girth", "upper_arm_girth", "wrist_girth", "outer_arm_length"})
     EXPECT_NEAR(value(b, std::string(m) + "_left"), value(b, std::string(m) + "_right"), 1.0) << m;
 }
 
@@ -193,13 +215,16 @@ TEST(BodyMeasurements, AStrayFoldBesideTheFlankDoesNotEndTheArm) {
   const Ring* torso = nullptr;
   const Ring* arm = nullptr;
   for (const Ring& r : cut) {
-    if (r.spans_x(0)) torso = &r;
-    else if (r.centroid.x() > 0 && (!arm || r.centroid.x() > arm->centroid.x())) arm = &r;
+    if (r.spans_x(0))
+      torso = &r;
+    else if (r.centroid.x() > 0 && (!arm || r.centroid.x() > arm->centroid.x()))
+      arm = &r;
   }
   ASSERT_TRUE(torso && arm);
   const Eigen::Vector2d at(torso->x_max + 12, torso->centroid.z());
   ASSERT_GT(arm->x_min, at.x() + 40);  // clear of the arm
-  const TriangleMesh with_fold = testing::merged(*mesh, testing::prism(testing::circle(10, at, 90), at, y - 15, y + 15));
+  const TriangleMesh with_fold =
+      testing::merged(*mesh, testing::prism(testing::circle(10, at, 90), at, y - 15, y + 15));
   auto b = measure_body(with_fold);
   ASSERT_TRUE(b.ok()) << b.status().message();
   for (const char* name : {"wrist_girth_left", "upper_arm_girth_left", "outer_arm_length_left"})
@@ -225,7 +250,8 @@ TEST(BodyMeasurements, AScrapBesideTheHipIsNoArm) {
   ASSERT_TRUE(torso);
   const Eigen::Vector2d at(torso->x_max + 9, torso->centroid.z());
   // 8 mm round (a tape of 50 mm) and 30 mm tall, 1 mm clear of the flank.
-  const TriangleMesh with_scrap = testing::merged(*mesh, testing::prism(testing::circle(8, at, 60), at, y - 15, y + 15));
+  const TriangleMesh with_scrap =
+      testing::merged(*mesh, testing::prism(testing::circle(8, at, 60), at, y - 15, y + 15));
   auto b = measure_body(with_scrap);
   ASSERT_TRUE(b.ok()) << b.status().message();
   EXPECT_NEAR(b->landmark("armpit_left")->position.y(), clean->landmark("armpit_left")->position.y(), 0.5);
@@ -418,8 +444,8 @@ TEST(BodyMeasurements, AShallowUnderBustFoldStaysPutUnderTheScansNoise) {
   // Refined to the vertex of a parabola it stays within 3 mm; the girth within 4 mm
   // (the noise itself widens the tape by 1-2 mm).
   under_skin_noise({1u, 2u, 3u}, [](const BodyMeasurements& b, const BodyMeasurements& clean, uint32_t seed) {
-    EXPECT_NEAR(b.landmark("underbust_front_point")->position.y(), clean.landmark("underbust_front_point")->position.y(),
-                3.0)
+    EXPECT_NEAR(b.landmark("underbust_front_point")->position.y(),
+                clean.landmark("underbust_front_point")->position.y(), 3.0)
         << "seed " << seed;
     EXPECT_NEAR(b.find("underbust_girth")->value_mm, clean.find("underbust_girth")->value_mm, 4.0) << "seed " << seed;
   });
@@ -569,7 +595,9 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
       auto moved = [&](const std::string& name) {
         return (b.landmark(name)->position - clean.landmark(name)->position).norm();
       };
-      auto diff = [&](const std::string& name) { return std::abs(b.find(name)->value_mm - clean.find(name)->value_mm); };
+      auto diff = [&](const std::string& name) {
+        return std::abs(b.find(name)->value_mm - clean.find(name)->value_mm);
+      };
       // female_average's elbow bends gently, and where along the arm it bends moved
       // up to 4.5 mm under this noise while the elbow's centre was the bend's cut
       // (3 mm apart); where the axes of upper arm and forearm meet, 2.1 at most.
@@ -602,9 +630,9 @@ TEST(BodyMeasurements, TheBustIsReadAtItsFullestOverABreastAndAtItsPointsOnAMans
     const double apex = b.landmark("bust_point_left")->position.y(), y = bust->plane->point.y();
     const double stature = b.find("stature")->value_mm;
     const BodySlicer slicer(shipped->mesh, apex - 0.02 * stature, apex + 0.02 * stature);
-    const Eigen::Vector3d near(0.5 * (b.landmark("bust_point_left")->position.x() +
-                                      b.landmark("bust_point_right")->position.x()),
-                               apex, b.landmark("bust_point_left")->position.z());
+    const Eigen::Vector3d near(
+        0.5 * (b.landmark("bust_point_left")->position.x() + b.landmark("bust_point_right")->position.x()), apex,
+        b.landmark("bust_point_left")->position.z());
     auto at_apex = slicer.girth(apex, near);
     ASSERT_TRUE(at_apex.ok()) << body;
     if (std::string(body) == "male_average") {
@@ -644,7 +672,8 @@ TEST(BodyMeasurements, TheBustsReachGrowsWithTheCreaseWithoutAJump) {
   ASSERT_TRUE(woman && man);
   EXPECT_GT(woman->measured.find("bust_girth")->plane->point.y(),
             woman->measured.landmark("bust_point_left")->position.y() + 2);
-  EXPECT_EQ(man->measured.find("bust_girth")->plane->point.y(), man->measured.landmark("bust_point_left")->position.y());
+  EXPECT_EQ(man->measured.find("bust_girth")->plane->point.y(),
+            man->measured.landmark("bust_point_left")->position.y());
 }
 
 // Each triangle split into four at its edges' midpoints: the same surface, with
@@ -729,23 +758,21 @@ TEST(BodyMeasurements, AFlatChestsLevelIsTheVertexOverItsWholeTop) {
   // parabola over 17 mm either side put the bust's level at 1138 and 1118 mm (bust
   // girth 0.0 and -5.7 mm off the truth). Over the whole top: within 2 mm.
   const std::vector<double> one = {
-      42.41, 42.27, 42.27, 42.42, 42.75, 42.67, 42.51, 42.70, 42.72, 42.70, 42.71, 42.63, 42.91,
-      43.55, 43.55, 43.55, 43.48, 43.30, 43.18, 43.92, 43.58, 43.49, 43.58, 43.70, 43.77, 43.92,
-      43.81, 43.91, 44.37, 44.18, 43.93, 43.92, 43.93, 43.94, 43.93, 43.92, 43.91, 43.89, 43.83,
-      43.70, 43.86, 43.75, 43.43, 43.33, 43.36, 43.36, 43.36, 43.23, 42.40, 41.97, 41.73, 41.58,
-      41.44, 41.23, 40.91, 40.59, 40.28, 40.01, 39.72, 39.43, 39.27, 39.03, 38.30, 38.03, 37.83,
-      37.50, 37.10, 36.72, 36.15, 35.77, 35.52, 35.18, 34.75, 34.37, 33.94, 33.48, 33.13, 32.73,
-      32.29, 31.97, 31.56, 31.08, 30.79, 30.48, 30.48, 30.96, 31.60, 32.23, 32.95, 33.63, 34.36,
-      34.97, 35.53, 35.89, 36.23, 36.56, 36.85};
+      42.41, 42.27, 42.27, 42.42, 42.75, 42.67, 42.51, 42.70, 42.72, 42.70, 42.71, 42.63, 42.91, 43.55,
+      43.55, 43.55, 43.48, 43.30, 43.18, 43.92, 43.58, 43.49, 43.58, 43.70, 43.77, 43.92, 43.81, 43.91,
+      44.37, 44.18, 43.93, 43.92, 43.93, 43.94, 43.93, 43.92, 43.91, 43.89, 43.83, 43.70, 43.86, 43.75,
+      43.43, 43.33, 43.36, 43.36, 43.36, 43.23, 42.40, 41.97, 41.73, 41.58, 41.44, 41.23, 40.91, 40.59,
+      40.28, 40.01, 39.72, 39.43, 39.27, 39.03, 38.30, 38.03, 37.83, 37.50, 37.10, 36.72, 36.15, 35.77,
+      35.52, 35.18, 34.75, 34.37, 33.94, 33.48, 33.13, 32.73, 32.29, 31.97, 31.56, 31.08, 30.79, 30.48,
+      30.48, 30.96, 31.60, 32.23, 32.95, 33.63, 34.36, 34.97, 35.53, 35.89, 36.23, 36.56, 36.85};
   const std::vector<double> two = {
-      41.98, 41.99, 42.05, 42.16, 42.73, 42.66, 42.32, 42.49, 42.56, 42.56, 42.58, 42.51, 42.85,
-      43.49, 43.68, 44.01, 43.68, 43.18, 43.68, 43.31, 43.37, 43.31, 43.37, 43.51, 43.59, 43.60,
-      43.66, 43.67, 43.66, 43.68, 43.76, 43.79, 43.80, 43.81, 43.80, 43.78, 43.78, 43.73, 43.62,
-      43.44, 43.51, 43.41, 43.33, 43.18, 43.12, 43.47, 43.12, 43.12, 42.11, 41.81, 41.58, 41.45,
-      41.28, 41.03, 40.75, 40.46, 40.13, 39.80, 39.55, 39.31, 39.22, 38.84, 38.16, 37.92, 37.66,
-      37.30, 36.96, 36.58, 35.97, 35.65, 35.40, 34.98, 34.60, 34.22, 33.75, 33.34, 32.99, 32.53,
-      32.15, 31.83, 31.35, 30.93, 30.66, 30.29, 30.36, 30.86, 31.49, 32.13, 32.86, 33.53, 34.27,
-      34.85, 35.44, 35.78, 36.08, 36.46, 36.75};
+      41.98, 41.99, 42.05, 42.16, 42.73, 42.66, 42.32, 42.49, 42.56, 42.56, 42.58, 42.51, 42.85, 43.49,
+      43.68, 44.01, 43.68, 43.18, 43.68, 43.31, 43.37, 43.31, 43.37, 43.51, 43.59, 43.60, 43.66, 43.67,
+      43.66, 43.68, 43.76, 43.79, 43.80, 43.81, 43.80, 43.78, 43.78, 43.73, 43.62, 43.44, 43.51, 43.41,
+      43.33, 43.18, 43.12, 43.47, 43.12, 43.12, 42.11, 41.81, 41.58, 41.45, 41.28, 41.03, 40.75, 40.46,
+      40.13, 39.80, 39.55, 39.31, 39.22, 38.84, 38.16, 37.92, 37.66, 37.30, 36.96, 36.58, 35.97, 35.65,
+      35.40, 34.98, 34.60, 34.22, 33.75, 33.34, 32.99, 32.53, 32.15, 31.83, 31.35, 30.93, 30.66, 30.29,
+      30.36, 30.86, 31.49, 32.13, 32.86, 33.53, 34.27, 34.85, 35.44, 35.78, 36.08, 36.46, 36.75};
   const std::vector<double> y = every_2mm_from(1076.6, one.size());
   ASSERT_EQ(two.size(), one.size());
   const std::optional<double> a = flat_top_vertex(y, one, 1.5, 35), b = flat_top_vertex(y, two, 1.5, 35);
@@ -757,23 +784,21 @@ TEST(BodyMeasurements, AFlatChestsLevelIsTheVertexOverItsWholeTop) {
   // 1.5 mm down, is no flat top; male_muscular's chest rises into the armpits and
   // never falls 1.5 mm above its foremost. Both keep the narrow parabola.
   const std::vector<double> breast = {
-      20.86, 21.04, 21.22, 21.44, 21.68, 21.88, 22.01, 22.17, 22.35, 22.54, 22.76, 22.93, 23.00,
-      23.10, 23.23, 23.38, 23.49, 23.63, 23.87, 23.88, 23.94, 24.16, 24.42, 24.50, 24.61, 24.93,
-      25.09, 24.93, 25.09, 25.18, 25.25, 25.39, 25.38, 25.41, 25.43, 25.53, 25.55, 25.51, 25.43,
-      25.38, 25.38, 25.33, 25.13, 24.89, 24.83, 24.88, 24.91, 24.79, 24.57, 24.42, 24.34, 24.39,
-      24.62, 24.75, 24.83, 24.14, 23.44, 23.21, 23.08, 22.74, 22.53, 22.41, 23.23, 25.48, 27.63,
-      29.40, 30.97, 32.31, 33.45, 34.45, 35.33, 36.03, 36.56, 36.86, 36.98, 36.96, 36.87, 36.63,
-      36.20, 35.47, 34.65, 33.67, 32.71, 31.77, 30.77, 29.65, 29.65, 28.43};
+      20.86, 21.04, 21.22, 21.44, 21.68, 21.88, 22.01, 22.17, 22.35, 22.54, 22.76, 22.93, 23.00, 23.10, 23.23,
+      23.38, 23.49, 23.63, 23.87, 23.88, 23.94, 24.16, 24.42, 24.50, 24.61, 24.93, 25.09, 24.93, 25.09, 25.18,
+      25.25, 25.39, 25.38, 25.41, 25.43, 25.53, 25.55, 25.51, 25.43, 25.38, 25.38, 25.33, 25.13, 24.89, 24.83,
+      24.88, 24.91, 24.79, 24.57, 24.42, 24.34, 24.39, 24.62, 24.75, 24.83, 24.14, 23.44, 23.21, 23.08, 22.74,
+      22.53, 22.41, 23.23, 25.48, 27.63, 29.40, 30.97, 32.31, 33.45, 34.45, 35.33, 36.03, 36.56, 36.86, 36.98,
+      36.96, 36.87, 36.63, 36.20, 35.47, 34.65, 33.67, 32.71, 31.77, 30.77, 29.65, 29.65, 28.43};
   EXPECT_FALSE(flat_top_vertex(every_2mm_from(986.6, breast.size()), breast, 1.5, 35));
   const std::vector<double> rising = {
-      -7.49, -6.06, -6.79, -6.79, -6.79, -7.59, -7.56, -7.74, -8.07, -8.12, -8.09, -8.06, -7.65,
-      -7.07, -4.81, -4.81, -4.81, -6.71, -7.12, -6.88, -6.79, -6.63, -6.42, -6.15, -5.81, -5.53,
-      -5.22, -4.84, -4.47, -4.20, -3.93, -3.20, -3.04, -2.99, -2.85, -2.69, -2.43, -2.08, -1.89,
-      -1.77, -1.68, -1.53, -1.35, -1.17, -1.00, -0.90, -0.79, -0.67, -0.53, -0.42, -0.25, 0.10,
-      0.58, 0.79, 0.93, 0.67, 0.68, 0.80, 1.03, 0.82, 0.88, 0.94, 1.03, 1.13, 1.24, 1.29, 1.27,
-      1.17, 1.06, 1.07, 1.19, 1.17, 1.02, 1.40, 1.81, 1.79, 1.34, 1.20, 1.36, 1.36, 1.96, 1.36,
-      1.52, 1.66, 2.02, 2.58, 3.12, 3.78, 4.48, 5.16, 5.68, 6.28, 6.69, 6.97, 7.26, 7.48, 7.63,
-      7.73, 7.71, 7.65, 7.52, 7.37};
+      -7.49, -6.06, -6.79, -6.79, -6.79, -7.59, -7.56, -7.74, -8.07, -8.12, -8.09, -8.06, -7.65, -7.07, -4.81,
+      -4.81, -4.81, -6.71, -7.12, -6.88, -6.79, -6.63, -6.42, -6.15, -5.81, -5.53, -5.22, -4.84, -4.47, -4.20,
+      -3.93, -3.20, -3.04, -2.99, -2.85, -2.69, -2.43, -2.08, -1.89, -1.77, -1.68, -1.53, -1.35, -1.17, -1.00,
+      -0.90, -0.79, -0.67, -0.53, -0.42, -0.25, 0.10,  0.58,  0.79,  0.93,  0.67,  0.68,  0.80,  1.03,  0.82,
+      0.88,  0.94,  1.03,  1.13,  1.24,  1.29,  1.27,  1.17,  1.06,  1.07,  1.19,  1.17,  1.02,  1.40,  1.81,
+      1.79,  1.34,  1.20,  1.36,  1.36,  1.96,  1.36,  1.52,  1.66,  2.02,  2.58,  3.12,  3.78,  4.48,  5.16,
+      5.68,  6.28,  6.69,  6.97,  7.26,  7.48,  7.63,  7.73,  7.71,  7.65,  7.52,  7.37};
   EXPECT_FALSE(flat_top_vertex(every_2mm_from(1146.1, rising.size()), rising, 1.5, 35));
 }
 
@@ -792,7 +817,8 @@ TEST(BodyMeasurements, TheBustPointsTheBustAndTheUnderBustStayPutUnderSmoothSkin
         EXPECT_LT((b.landmark(name)->position - clean.landmark(name)->position).norm(), male ? 3.0 : 2.0)
             << body << " " << name << ", seed " << seed;
       if (!male) {
-        EXPECT_NEAR(b.find("bust_girth")->value_mm, clean.find("bust_girth")->value_mm, 1.6) << body << ", seed " << seed;
+        EXPECT_NEAR(b.find("bust_girth")->value_mm, clean.find("bust_girth")->value_mm, 1.6)
+            << body << ", seed " << seed;
         EXPECT_NEAR(b.find("underbust_girth")->value_mm, clean.find("underbust_girth")->value_mm, 1.0)
             << body << ", seed " << seed;
       }
@@ -832,7 +858,8 @@ TEST(BodyMeasurements, TheWristIsReadFromTheHandsFlareAndStaysPutUnderSmoothSkin
     under_smooth_skin_noise(body, [&](const BodyMeasurements& b, const BodyMeasurements& noise_free, uint64_t seed) {
       for (const char* side : {"left", "right"}) {
         const std::string arm = std::string("outer_arm_length_") + side;
-        EXPECT_NEAR(b.find(arm)->value_mm, noise_free.find(arm)->value_mm, 2.5) << body << " " << arm << ", seed " << seed;
+        EXPECT_NEAR(b.find(arm)->value_mm, noise_free.find(arm)->value_mm, 2.5)
+            << body << " " << arm << ", seed " << seed;
       }
     });
   }
@@ -946,8 +973,7 @@ TEST(BodyMeasurements, TheThighsTapeIsWhereTheCrotchDoesNotPullIt) {
 // The true male_average with a wall 5 mm thick and 2 * half_length long front to
 // back standing between its thighs at the crotch, from `below` under it to `above`
 // over it, all marked measured (confidence 1); its side walls in `layers` rows.
-TriangleMesh with_crotch_wall(const ShippedBody& body, double half_length, double below, double above,
-                              int layers = 8) {
+TriangleMesh with_crotch_wall(const ShippedBody& body, double half_length, double below, double above, int layers = 8) {
   const Eigen::Vector3d crotch = body.measured.landmark("crotch")->position;
   std::vector<Eigen::Vector2d> wall;
   for (const Eigen::Vector2d& p : testing::circle(1, {0, 0}, 64))

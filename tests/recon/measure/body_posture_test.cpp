@@ -113,7 +113,8 @@ TEST_P(BodyPostureTest, AskForTheScanningPostureAndFlagWhatDependsOnIt) {
     ASSERT_NE(c, nullptr) << part;
     EXPECT_FALSE(c->ok) << part;
   }
-  EXPECT_NE(check(low, "arm_left")->message.find("raise it to 35–50°"), std::string::npos) << check(low, "arm_left")->message;
+  EXPECT_NE(check(low, "arm_left")->message.find("raise it to 35–50°"), std::string::npos)
+      << check(low, "arm_left")->message;
   EXPECT_NE(check(low, "feet")->message.find("300–450 mm apart"), std::string::npos) << check(low, "feet")->message;
   EXPECT_TRUE(check(low, "head")->ok);
   EXPECT_TRUE(check(low, "turn")->ok);
@@ -141,8 +142,15 @@ TEST_P(BodyPostureTest, AskForTheScanningPostureAndFlagWhatDependsOnIt) {
 // point on the skin.
 TEST_P(BodyPostureTest, LandmarksKeepToTheirAnatomicalPointsAcrossArmsAndStances) {
   const Posed& rest = posed(GetParam(), 0, 0);
-  for (const auto& [arms, ankles] : {std::pair{15.0, 0.0}, {20.0, 0.0}, {25.0, 0.0}, {35.0, 0.0}, {45.0, 0.0},
-                                     {0.0, 150.0}, {0.0, 250.0}, {0.0, 300.0}, {0.0, 420.0}}) {
+  for (const auto& [arms, ankles] : {std::pair{15.0, 0.0},
+                                     {20.0, 0.0},
+                                     {25.0, 0.0},
+                                     {35.0, 0.0},
+                                     {45.0, 0.0},
+                                     {0.0, 150.0},
+                                     {0.0, 250.0},
+                                     {0.0, 300.0},
+                                     {0.0, 420.0}}) {
     const Posed& p = posed(GetParam(), arms, ankles);
     for (const BodyLandmark& l : rest.measured.landmarks) {
       if (l.name.rfind("armpit", 0) == 0 || l.name == "neck_level") continue;

@@ -21,7 +21,8 @@ TEST(ConvexHull, KeepsTheCornersCounterClockwise) {
   const auto h = convex_hull(pts);
   ASSERT_EQ(h.size(), 4u);  // the collinear (1, 0) and the inner points go
   double area = 0;
-  for (size_t i = 0; i < h.size(); ++i) area += h[i].x() * h[(i + 1) % h.size()].y() - h[(i + 1) % h.size()].x() * h[i].y();
+  for (size_t i = 0; i < h.size(); ++i)
+    area += h[i].x() * h[(i + 1) % h.size()].y() - h[(i + 1) % h.size()].x() * h[i].y();
   EXPECT_NEAR(area / 2, 4.0, 1e-12);  // positive: counter-clockwise
   EXPECT_NEAR(closed_length(h), 8.0, 1e-12);
   EXPECT_EQ(convex_hull({{1, 1}, {1, 1}}).size(), 1u);
@@ -171,14 +172,15 @@ TEST(MeshArc, FollowsTheTapeTheShorterWayRound) {
   EXPECT_NEAR(a->other_way_mm, 3 * perimeter / 4, 1e-3);
   EXPECT_NEAR(a->girth.value_mm, perimeter, 1e-3);
   ASSERT_GE(a->path.size(), 3u);
-  EXPECT_NEAR((a->path.front() - Eigen::Vector3d(0, 210, 150)).norm(), 0, 1e-3);   // from the first point
-  EXPECT_NEAR((a->path.back() - Eigen::Vector3d(150, 210, 0)).norm(), 0, 1e-3);    // to the second
+  EXPECT_NEAR((a->path.front() - Eigen::Vector3d(0, 210, 150)).norm(), 0, 1e-3);  // from the first point
+  EXPECT_NEAR((a->path.back() - Eigen::Vector3d(150, 210, 0)).norm(), 0, 1e-3);   // to the second
   EXPECT_NEAR(closed_length(a->path) - (a->path.back() - a->path.front()).norm(), a->value_mm, 1e-3);
   // Across the notch of a "C" the arc takes the tape's chord, not the notch.
   std::vector<Eigen::Vector2d> c;
   for (int i = 0; i < 360; ++i) {
     const double ang = 2 * M_PI * i / 360;
-    c.push_back((std::abs(std::remainder(ang, 2 * M_PI)) < 0.3 ? 60 : 100) * Eigen::Vector2d(std::cos(ang), -std::sin(ang)));
+    c.push_back((std::abs(std::remainder(ang, 2 * M_PI)) < 0.3 ? 60 : 100) *
+                Eigen::Vector2d(std::cos(ang), -std::sin(ang)));
   }
   const double deg = M_PI / 180;
   auto across = mesh_arc(prism(c, {0, 0}, 0, 100, 2), horizontal(50),

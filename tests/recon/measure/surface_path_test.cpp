@@ -110,8 +110,7 @@ TEST(SurfacePath, OverACubesEdgesItTakesTheShortestUnfolding) {
   auto c = mesh_surface_path(cube, {50, 60, 40}, {40, 100, 20});
   ASSERT_TRUE(c.ok()) << c.status().message();
   EXPECT_NEAR(c->path_mm, std::hypot(40.0 + 10.0, 20.0), 1e-3);
-  for (const Eigen::Vector3d& x : c->path)
-    EXPECT_GT((x - Eigen::Vector3d(50, 100, 50)).norm(), 1.0);
+  for (const Eigen::Vector3d& x : c->path) EXPECT_GT((x - Eigen::Vector3d(50, 100, 50)).norm(), 1.0);
 }
 
 TEST(SurfacePath, OnASphereItFollowsTheGreatCircle) {
@@ -119,7 +118,8 @@ TEST(SurfacePath, OnASphereItFollowsTheGreatCircle) {
   const TriangleMesh sphere = testing::icosphere(5, r);
   for (double deg : {10.0, 45.0, 90.0, 135.0, 170.0}) {
     const double t = deg * M_PI / 180;
-    const Eigen::Vector3d a(0, r, 0), b(r * std::sin(t) * std::cos(0.3), r * std::cos(t), r * std::sin(t) * std::sin(0.3));
+    const Eigen::Vector3d a(0, r, 0),
+        b(r * std::sin(t) * std::cos(0.3), r * std::cos(t), r * std::sin(t) * std::sin(0.3));
     auto p = mesh_surface_path(sphere, a, b);
     ASSERT_TRUE(p.ok()) << p.status().message();
     // The polyhedron is inscribed: its geodesics run a little short of the sphere's.

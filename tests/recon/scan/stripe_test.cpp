@@ -18,8 +18,8 @@ Image stripe_image(int w, int h, double amplitude, double sigma, uint16_t base, 
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const double d = x - centre(y);
-      im.px[static_cast<size_t>(y) * w + x] =
-          static_cast<uint16_t>(std::min(255.0, std::round(base + amplitude * std::exp(-0.5 * d * d / (sigma * sigma)))));
+      im.px[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(
+          std::min(255.0, std::round(base + amplitude * std::exp(-0.5 * d * d / (sigma * sigma)))));
     }
   return im;
 }
@@ -134,9 +134,9 @@ TEST(StripeSmoothing, ACurvedStripeIsNotPulledToItsInside) {
 TEST(StripeRuns, LoneSamplesAreDroppedAndRunsKept) {
   std::vector<StripeSample> s;
   for (int y = 10; y < 20; ++y) s.push_back({y, 100.0f + 0.5f * (y - 10), 80, false});  // a run of 10
-  s.push_back({20, 120.0f, 30, false});   // continues row 19 but 15.5 px across: alone
-  s.push_back({25, 300.0f, 90, false});   // a gap of rows before and after: alone
-  s.push_back({30, 50.0f, 70, false});    // a run of two
+  s.push_back({20, 120.0f, 30, false});  // continues row 19 but 15.5 px across: alone
+  s.push_back({25, 300.0f, 90, false});  // a gap of rows before and after: alone
+  s.push_back({30, 50.0f, 70, false});   // a run of two
   s.push_back({31, 51.0f, 70, false});
   std::vector<StripeSample> kept = s;
   EXPECT_EQ(drop_short_runs(kept), 2u);

@@ -2,9 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <map>
 #include <random>
 #include <string>
@@ -272,7 +272,8 @@ TEST_F(SubjectSway, AStillBodyIsNotMadeThin) {
   undo_sway(cloud, *sway);
   const double skin_after = signed_mean(cloud, *distance_);
   EXPECT_NEAR(skin_after, skin_before, 0.015) << "the skin moved in by " << skin_before - skin_after << " mm";
-  std::printf("[ still ] every 2nd step: peak %.2f mm, skin %+.3f -> %+.3f mm\n", sway->peak_mm, skin_before, skin_after);
+  std::printf("[ still ] every 2nd step: peak %.2f mm, skin %+.3f -> %+.3f mm\n", sway->peak_mm, skin_before,
+              skin_after);
 }
 
 TEST(SubjectSwayInput, NeedsEachPointsFrameAndLaser) {

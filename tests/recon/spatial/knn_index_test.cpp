@@ -29,9 +29,7 @@ std::vector<Vec3f> random_cloud(size_t n, float extent, uint64_t seed) {
 }
 
 // Squared distance in double: the reference that float results are held to.
-double sq_dist(const Vec3f& a, const Vec3f& b) {
-  return (a.cast<double>() - b.cast<double>()).squaredNorm();
-}
+double sq_dist(const Vec3f& a, const Vec3f& b) { return (a.cast<double>() - b.cast<double>()).squaredNorm(); }
 
 // All points ordered by distance to q (ties by index).
 std::vector<std::pair<double, uint32_t>> brute_sorted(const std::vector<Vec3f>& pts, const Vec3f& q) {

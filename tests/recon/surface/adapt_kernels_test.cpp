@@ -78,9 +78,9 @@ TEST(AdaptKernels, ConfidenceWeightsAndDropsPoints) {
   conf[1] = 3.f;
   AdaptKernelsOptions o;
   const std::vector<Kernel> k = adapt_kernels(g.points, g.frames, std::vector<float>(n, 1.f), nullptr, {}, conf, o);
-  ASSERT_EQ(k.size(), n - 1);                  // confidence 0 takes no part
+  ASSERT_EQ(k.size(), n - 1);  // confidence 0 takes no part
   EXPECT_EQ(k[0].center, g.points[1]);
-  EXPECT_FLOAT_EQ(k[0].weight, 1.f);           // clamped to 1
+  EXPECT_FLOAT_EQ(k[0].weight, 1.f);  // clamped to 1
   EXPECT_FLOAT_EQ(k[1].weight, 0.5f);
 }
 
@@ -88,7 +88,7 @@ TEST(AdaptKernels, BendIsClampedAndNoiseBiasRemovedAlongTheNormal) {
   const Grid g = grid(3, 1.f);
   const size_t n = g.points.size();
   std::vector<ShapeOperator> h(n, ShapeOperator{0.2f, 0.f, 0.2f});
-  h[1] = {50.f, 0.f, 50.f};   // far beyond max_bend / sigma_t
+  h[1] = {50.f, 0.f, 50.f};  // far beyond max_bend / sigma_t
   h[2] = {-50.f, 0.f, -50.f};
   AdaptKernelsOptions o;
   o.sigma_user = 1.f;
@@ -97,7 +97,7 @@ TEST(AdaptKernels, BendIsClampedAndNoiseBiasRemovedAlongTheNormal) {
   const std::vector<Kernel> k = adapt_kernels(g.points, g.frames, std::vector<float>(n, 2.f), nullptr, h, {}, o);
   EXPECT_FLOAT_EQ(k[0].bend1, 0.2f);
   EXPECT_FLOAT_EQ(k[0].bend2, 0.2f);
-  EXPECT_FLOAT_EQ(k[1].bend1, 0.35f);   // 0.7 / sigma_t (2)
+  EXPECT_FLOAT_EQ(k[1].bend1, 0.35f);  // 0.7 / sigma_t (2)
   EXPECT_FLOAT_EQ(k[2].bend2, -0.35f);
   // Noise of 0.5 on a surface of mean curvature 0.2 puts points 0.2 * 0.25 = 0.05
   // outside it on average: the kernel moves back along -n by that much.

@@ -2,8 +2,8 @@
 // cylinders, planes and paraboloids.
 #include "recon/surface/estimate_curvature.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -26,8 +26,7 @@ double percentile(std::vector<double> v, double p) {
 // Samples of a circle of radius r through the origin, tangent to u there, centred at
 // (0, -r) (sign = +1, bending away from the normal +h) or (0, +r) (sign = -1), at
 // angles spread evenly over [-half_angle, half_angle].
-void circle_samples(double r, int sign, double half_angle, int count, std::vector<float>& u,
-                    std::vector<float>& h) {
+void circle_samples(double r, int sign, double half_angle, int count, std::vector<float>& u, std::vector<float>& h) {
   u.clear();
   h.clear();
   for (int i = 0; i < count; ++i) {
@@ -110,8 +109,8 @@ TEST(AngleCurvature, SphereIsOneOverRadius) {
 }
 
 // PCA frames with normals turned to agree with the known outward normals.
-LocalFrames oriented_frames(const std::vector<Vec3f>& pts, const std::vector<Vec3f>& truth,
-                            const KnnIndex& index, const NeighborGraph& g, size_t k) {
+LocalFrames oriented_frames(const std::vector<Vec3f>& pts, const std::vector<Vec3f>& truth, const KnnIndex& index,
+                            const NeighborGraph& g, size_t k) {
   LocalFrames f = estimate_normals(pts, index, g, {.k = k});
   for (size_t i = 0; i < pts.size(); ++i)
     if (f.normals[i].dot(truth[i]) < 0.f) flip_frame(f, i);
@@ -291,7 +290,8 @@ TEST(CorrectNormalTilt, CarriesAnEdgeNormalToItsPointAndKeepsTheInsideTrue) {
   // degree of the truth; in the middle of the band the normals stay within 0.1.
   // Only convex skin is carried (estimate_curvature.hpp).
   const double radius = 90.0, spacing = 4.0;
-  const PointCloud sphere = fibonacci_sphere(static_cast<size_t>(4 * std::numbers::pi * radius * radius / (spacing * spacing)), radius);
+  const PointCloud sphere =
+      fibonacci_sphere(static_cast<size_t>(4 * std::numbers::pi * radius * radius / (spacing * spacing)), radius);
   std::vector<Vec3f> pts, truth;
   for (size_t i = 0; i < sphere.size(); ++i) {
     const double polar = std::acos(static_cast<double>(sphere.normals[i].y())) * 180 / std::numbers::pi;
@@ -362,8 +362,7 @@ struct Patch {
   std::vector<uint32_t> neighbours;
 };
 
-Patch height_field_patch(double a, double b, double c, double noise, uint64_t seed, int half = 3,
-                         float step = 0.1f) {
+Patch height_field_patch(double a, double b, double c, double noise, uint64_t seed, int half = 3, float step = 0.1f) {
   Patch p;
   std::mt19937_64 rng(seed);
   auto gauss = [&] {  // Box-Muller, one value per call

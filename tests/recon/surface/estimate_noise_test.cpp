@@ -67,12 +67,11 @@ TEST_P(EstimateNoiseLevels, WithinFifteenPercentOfTruth) {
 
 INSTANTIATE_TEST_SUITE_P(Levels, EstimateNoiseLevels,
                          ::testing::Values(NoiseCase{"sphere", 0.05}, NoiseCase{"sphere", 0.2},
-                                           NoiseCase{"sphere", 0.5}, NoiseCase{"plane", 0.05},
-                                           NoiseCase{"plane", 0.2}, NoiseCase{"plane", 0.5}),
+                                           NoiseCase{"sphere", 0.5}, NoiseCase{"plane", 0.05}, NoiseCase{"plane", 0.2},
+                                           NoiseCase{"plane", 0.5}),
                          [](const ::testing::TestParamInfo<NoiseCase>& info) {
                            return std::string(info.param.surface) + "_" +
-                                  std::to_string(static_cast<int>(info.param.noise_in_spacings * 100)) +
-                                  "pct";
+                                  std::to_string(static_cast<int>(info.param.noise_in_spacings * 100)) + "pct";
                          });
 
 TEST(EstimateNoise, NoiseFreeIsNearZero) {
@@ -89,7 +88,8 @@ TEST(EstimateNoise, NoiseFreeCubeIsNearZero) {
   // points lie on flat faces, and the median of the fits is meant to be "robust to
   // edges" (estimate_noise.hpp).
   TriangleMesh cube;
-  for (int i = 0; i < 8; ++i) cube.vertices.emplace_back(2 * (i & 1) - 1, 2 * ((i >> 1) & 1) - 1, 2 * ((i >> 2) & 1) - 1);
+  for (int i = 0; i < 8; ++i)
+    cube.vertices.emplace_back(2 * (i & 1) - 1, 2 * ((i >> 1) & 1) - 1, 2 * ((i >> 2) & 1) - 1);
   cube.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                     {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   const PointCloud c = sample_mesh_uniform(cube, 6000, 13, false);

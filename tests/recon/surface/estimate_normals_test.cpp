@@ -62,8 +62,7 @@ TEST(EstimateNormals, KnownCovarianceGivesExactFrameAndEigenvalues) {
   // Point 0 and its six neighbours (±2, 0, 0), (0, ±1, 0), (0, 0, ±0.5): the seven
   // points have mean 0 and covariance diag(8, 2, 0.5) / 7, so at point 0 the
   // eigenvalues are (0.5, 2, 8) / 7, tangent1 = ±x, tangent2 = ±y, normal = ±z.
-  const std::vector<Vec3f> pts = {{0, 0, 0}, {2, 0, 0}, {-2, 0, 0}, {0, 1, 0},
-                                  {0, -1, 0}, {0, 0, 0.5f}, {0, 0, -0.5f}};
+  const std::vector<Vec3f> pts = {{0, 0, 0}, {2, 0, 0}, {-2, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 0.5f}, {0, 0, -0.5f}};
   const KnnIndex index(pts);
   for (size_t graph_k : {size_t{6}, size_t{2}}) {  // from the graph, then from the index
     const NeighborGraph graph = knn_graph(index, pts, graph_k);
@@ -101,8 +100,7 @@ TEST(EstimateNormals, TiltedNoisyPlaneWithinFewDegrees) {
   // sees a tilt of about sigma / spread / sqrt(k) ~ 0.5 degrees; allow 3 degrees
   // at the 99th percentile and 6 at the worst point.
   PointCloud c = random_plane(3000, 50.f, 0.f, 0.f, 8);
-  const Eigen::Matrix3f rot =
-      (Eigen::AngleAxisf(0.7f, Vec3f(1, 2, 3).normalized())).toRotationMatrix();
+  const Eigen::Matrix3f rot = (Eigen::AngleAxisf(0.7f, Vec3f(1, 2, 3).normalized())).toRotationMatrix();
   for (Vec3f& p : c.positions) p = rot * p;
   add_gaussian_noise(c, 0.05, 9);
   const Vec3f truth = rot * Vec3f::UnitZ();

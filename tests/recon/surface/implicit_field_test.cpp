@@ -149,8 +149,8 @@ struct GridCheck {
   double worst = 0;  // largest |grid - evaluate| / (W + |F|)
 };
 
-GridCheck check_grid_against_evaluate(const std::vector<Kernel>& ks, const ImplicitFieldOptions& o,
-                                      size_t samples, uint64_t seed) {
+GridCheck check_grid_against_evaluate(const std::vector<Kernel>& ks, const ImplicitFieldOptions& o, size_t samples,
+                                      uint64_t seed) {
   GridCheck r;
   auto field = build_implicit_field(ks, o);
   EXPECT_TRUE(field.ok()) << field.status().message();
@@ -391,8 +391,7 @@ TEST(ImplicitField, MemoryFollowsTheSurface) {
   // size and voxel: the allocated bricks follow the area (x4), not the volume (x8).
   auto build = [](double radius) {
     const size_t n = static_cast<size_t>(4 * std::numbers::pi * radius * radius);
-    auto f = build_implicit_field(sphere_kernels(n, radius, Vec3f::Zero(), 1.2f, 0.5f, 0.f),
-                                  field_options(0.5f));
+    auto f = build_implicit_field(sphere_kernels(n, radius, Vec3f::Zero(), 1.2f, 0.5f, 0.f), field_options(0.5f));
     EXPECT_TRUE(f.ok());
     return std::move(f).value();
   };

@@ -173,8 +173,7 @@ TEST(MarchingCubesTable, PatchBoundaryLiesOnTheCubeFaces) {
   for (int mask = 1; mask < 255; ++mask) {
     for (const Segment& s : boundary_segments(mask)) {
       bool on_a_face = false;
-      for (int d = 0; d < 3; ++d)
-        on_a_face |= s.first[d] == s.second[d] && (s.first[d] == 0 || s.first[d] == 2);
+      for (int d = 0; d < 3; ++d) on_a_face |= s.first[d] == s.second[d] && (s.first[d] == 0 || s.first[d] == 2);
       EXPECT_TRUE(on_a_face) << "mask " << mask << ": an open edge inside the cube";
     }
   }
@@ -203,8 +202,7 @@ TEST(MarchingCubesTable, NeighbouringCellsCutTheirSharedFaceAlike) {
             b |= 1 << v;  // B's near face = A's far face
           }
         }
-        EXPECT_EQ(on_face(boundary_segments(b), axis, 0), shared)
-            << "axis " << axis << " cells " << a << " | " << b;
+        EXPECT_EQ(on_face(boundary_segments(b), axis, 0), shared) << "axis " << axis << " cells " << a << " | " << b;
       }
     }
   }

@@ -17,8 +17,8 @@ namespace {
 
 // PCA frames with every normal's sign then randomised, so that orientation has to
 // be recovered from scratch.
-LocalFrames scrambled_frames(const std::vector<Vec3f>& pts, const KnnIndex& index,
-                             const NeighborGraph& graph, uint64_t seed) {
+LocalFrames scrambled_frames(const std::vector<Vec3f>& pts, const KnnIndex& index, const NeighborGraph& graph,
+                             uint64_t seed) {
   LocalFrames f = estimate_normals(pts, index, graph);
   std::mt19937_64 rng(seed);
   for (size_t i = 0; i < pts.size(); ++i)

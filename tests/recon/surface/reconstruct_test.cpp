@@ -218,7 +218,8 @@ TEST(ReconstructSurface, AStripedLimbKeepsItsRadiusAcrossAGap) {
       if (deg > gap_lo && deg < gap_hi) continue;
       const double a = deg * std::numbers::pi / 180;
       const Vec3f n(static_cast<float>(std::cos(a)), 0.f, static_cast<float>(std::sin(a)));
-      c.positions.push_back(n * static_cast<float>(radius + 0.2 * gaussian(rng)) + Vec3f(0.f, static_cast<float>(y + 0.2 * gaussian(rng)), 0.f));
+      c.positions.push_back(n * static_cast<float>(radius + 0.2 * gaussian(rng)) +
+                            Vec3f(0.f, static_cast<float>(y + 0.2 * gaussian(rng)), 0.f));
       c.normals.push_back(n);
     }
   }
@@ -230,8 +231,10 @@ TEST(ReconstructSurface, AStripedLimbKeepsItsRadiusAcrossAGap) {
     if (v.y() < 60.f || v.y() > 240.f) continue;
     const double deg = std::fmod(std::atan2(v.z(), v.x()) * 180 / std::numbers::pi + 360, 360);
     const double e = std::hypot(v.x(), v.z()) - radius;
-    if (deg > gap_lo && deg < gap_hi) gap_sum += e, ++gap_n;
-    else rest_sum += e, ++rest_n;
+    if (deg > gap_lo && deg < gap_hi)
+      gap_sum += e, ++gap_n;
+    else
+      rest_sum += e, ++rest_n;
   }
   ASSERT_GT(gap_n, 100u);
   ASSERT_GT(rest_n, 1000u);
@@ -250,12 +253,14 @@ TEST(ReconstructSurface, ACrownSeenOnlyUpItsSidesStandsHalfAsHighWithItsNormalsC
   // 0.86.
   std::mt19937_64 rng(11);
   const double radius = 90, spacing = 6, half_strip = 18, noise = 0.3;
-  const PointCloud sphere = fibonacci_sphere(static_cast<size_t>(4 * std::numbers::pi * radius * radius / (spacing * spacing)), radius);
+  const PointCloud sphere =
+      fibonacci_sphere(static_cast<size_t>(4 * std::numbers::pi * radius * radius / (spacing * spacing)), radius);
   PointCloud c;
   for (const Vec3f& unit : sphere.normals) {
     const Eigen::Vector3d d = unit.cast<double>();
     if (d.y() > 0 && std::abs(d.z()) * radius < half_strip) continue;
-    const Eigen::Vector3d p = d * (radius + noise * gaussian(rng)) + 0.3 * noise * Eigen::Vector3d(gaussian(rng), gaussian(rng), gaussian(rng));
+    const Eigen::Vector3d p = d * (radius + noise * gaussian(rng)) +
+                              0.3 * noise * Eigen::Vector3d(gaussian(rng), gaussian(rng), gaussian(rng));
     c.positions.push_back(p.cast<float>());
   }
   auto top = [&](bool correct) {
@@ -312,7 +317,7 @@ TEST(ReconstructSurface, NoiseFreeCubeIsWatertight) {
   ReconstructOptions open;
   open.close_holes = false;
   EXPECT_GT(analyze_topology(run(c, open).mesh).boundary_edges, 0u) << "the field closes by itself now: "
-                                                                        "make this test harder";
+                                                                       "make this test harder";
   const ReconstructResult r = run(c);
   expect_closed_single(r.mesh, "cube, 20000 points");
   EXPECT_GE(r.stats.holes_filled, 1u);

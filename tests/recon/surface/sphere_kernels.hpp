@@ -10,8 +10,8 @@
 namespace bodyscan::testing {
 
 // n kernels on a sphere of `radius` about `centre`; tangents from the exact normal.
-inline std::vector<Kernel> sphere_kernels(size_t n, double radius, const Vec3f& centre, float sigma_t,
-                                          float sigma_n, float bend) {
+inline std::vector<Kernel> sphere_kernels(size_t n, double radius, const Vec3f& centre, float sigma_t, float sigma_n,
+                                          float bend) {
   const PointCloud c = fibonacci_sphere(n, radius);
   std::vector<Kernel> ks(n);
   for (size_t i = 0; i < n; ++i) {
