@@ -48,7 +48,9 @@ int main(int argc, char** argv) {
   }
   if (rigs.empty()) rigs = hw::shipped_rig_names();  // all of them
   for (const std::string& name : rigs) {
-    auto sim = pipeline::open_simulated_rig(name, {body});
+    pipeline::SimulatedSubject subject;
+    subject.body = body;
+    auto sim = pipeline::open_simulated_rig(name, subject);
     if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
     const hw::RigDescription& desc = (*sim)->description();
     const hw::sim::Scene& scene = (*sim)->scene();

@@ -69,7 +69,9 @@ double g_max_view = -1;
 bool g_keep_sway = false;
 
 int run(const std::string& rig_name, const std::string& body, int every) {
-  auto sim = pipeline::open_simulated_rig(rig_name, {body});
+  pipeline::SimulatedSubject subject;
+  subject.body = body;
+  auto sim = pipeline::open_simulated_rig(rig_name, subject);
   if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
   hw::sim::SimulatedRig& rig = **sim;
   const hw::RigDescription& desc = rig.description();

@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 deploy/install-deps.sh --browser --sanitize --lint
 deploy/install-web.sh
 deploy/check-format.sh
-BUILD_DIR=${BUILD_DIR:-build-test} BUILD_TYPE=RelWithDebInfo deploy/build.sh
+BUILD_DIR=${BUILD_DIR:-build-test} BUILD_TYPE=RelWithDebInfo deploy/build.sh -DBODYSCAN_WERROR=ON
 (cd "${BUILD_DIR:-build-test}" && ctest --output-on-failure -j "$(nproc)" --timeout 600)
 # The same code again under AddressSanitizer and UndefinedBehaviorSanitizer, and
 # each parser's fuzzer for a minute (docs/security.md).

@@ -265,7 +265,7 @@ StatusOr<PosedBody> BodyPoser::pose(const TriangleMesh& rest, const Posture& pos
     const double sign = s == 0 ? 1 : -1;
     const Eigen::Vector3d sh = out.rest.shoulder[s], el = out.rest.elbow[s];
     const std::optional<double> t =
-        solve_rising([&](double t) { return from_down(turned(el, sh, sign * t) - sh); }, -60, 60, want, 1e-5);
+        solve_rising([&](double deg) { return from_down(turned(el, sh, sign * deg) - sh); }, -60, 60, want, 1e-5);
     if (!t) return invalid_argument("an arm's abduction of " + std::to_string(want) + " degrees is out of reach");
     rotations["upperarm01." + std::string(kSide[s])] = {z, sign * *t};
     out.shoulder_rotation_deg[s] = sign * *t;

@@ -224,8 +224,8 @@ void ImplicitField::evaluate(const std::vector<Kernel>& kernels, float epsilon, 
     const double u2 = z1 * z1 * k.sigma_t1 * k.sigma_t1, v2 = z2 * z2 * k.sigma_t2 * k.sigma_t2;
     const double b1 = k.bend1, b2 = k.bend2;
     const double parabola = 0.5 * (b1 * u2 + b2 * v2);
-    const double x = std::min(1.0, b1 * b1 * u2 + b2 * b2 * v2);
-    const double z3 = z3u + parabola * 2.0 / (1.0 + std::sqrt(1.0 - x)) / k.sigma_n;
+    const double bent = std::min(1.0, b1 * b1 * u2 + b2 * b2 * v2);
+    const double z3 = z3u + parabola * 2.0 / (1.0 + std::sqrt(1.0 - bent)) / k.sigma_n;
     const double q = z1 * z1 + z2 * z2 + z3 * z3;
     if (q >= r2 || std::abs(z3u) >= slab) continue;
     const double e = k.weight * std::exp(-0.5 * q);
@@ -380,11 +380,11 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
       for (size_t pi = starts[pc]; pi < starts[pc + 1]; ++pi) {
         const uint32_t ki = pairs[pi].kernel;
         const Prepared& p = prep[ki];
-        const Eigen::Vector3i& lo = klo[ki];
-        const Eigen::Vector3i& hi = khi[ki];
+        const Eigen::Vector3i& node_lo = klo[ki];
+        const Eigen::Vector3i& node_hi = khi[ki];
         // z at the kernel's first node and its steps along x, y, z, all from
         // integer offsets: a node's value does not depend on the brick size.
-        const Vec3f zb = p.m * (field.origin_ + h * lo.cast<double>() - p.center.cast<double>()).cast<float>();
+        const Vec3f zb = p.m * (field.origin_ + h * node_lo.cast<double>() - p.center.cast<double>()).cast<float>();
         const Vec3f dx = p.m.col(0) * static_cast<float>(h);
         const Vec3f dy = p.m.col(1) * static_cast<float>(h);
         const Vec3f dz = p.m.col(2) * static_cast<float>(h);
@@ -396,12 +396,12 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
         const float inv_dxz = std::abs(dx.z()) > 1e-12f ? 1.f / dx.z() : 0.f;
         const float cy = (p.center.y() - static_cast<float>(field.origin_.y())) / static_cast<float>(h);
         const float inv_yy_h = 1.f / (p.yy * static_cast<float>(h));
-        const float t_max = static_cast<float>(hi.x() - lo.x());
-        const int z0i = std::max(lo.z(), z_first), z1i = std::min(hi.z(), z_first + bs - 1);
-        const int y0i = std::max(lo.y(), y_first), y1i = std::min(hi.y(), y_first + bs - 1);
+        const float t_max = static_cast<float>(node_hi.x() - node_lo.x());
+        const int z0i = std::max(node_lo.z(), z_first), z1i = std::min(node_hi.z(), z_first + bs - 1);
+        const int y0i = std::max(node_lo.y(), y_first), y1i = std::min(node_hi.y(), y_first + bs - 1);
         const float r2x2 = 2.f * r2;
         for (int z = z0i; z <= z1i; ++z) {
-          const Vec3f zz = zb + static_cast<float>(z - lo.z()) * dz;
+          const Vec3f zz = zb + static_cast<float>(z - node_lo.z()) * dz;
           // y extent of the bounding ellipsoid in this layer: yy t^2 + 2 yz dzw t + zz dzw^2 <= 2 r^2.
           const float dzw = static_cast<float>(field.origin_.z() + h * z) - p.center.z();
           const float bq_y = p.yz * dzw;
@@ -413,7 +413,7 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
           const int ya = std::max(y0i, static_cast<int>(std::floor(ylo_f)));
           const int yb = std::min(y1i, static_cast<int>(std::ceil(yhi_f)));
           for (int y = ya; y <= yb; ++y) {
-            const Vec3f z0 = zz + static_cast<float>(y - lo.y()) * dy;
+            const Vec3f z0 = zz + static_cast<float>(y - node_lo.y()) * dy;
             // Cylinder: |z0_12 + t dx_12|^2 < r2; slab: |z0_3 + t dx_3| < slab.
             float lo_f = 0.f, hi_f = t_max;
             const float bq = z0.x() * dx.x() + z0.y() * dx.y();
@@ -443,10 +443,10 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
             const int row_offset = (y - y_first) * bs + (z - z_first) * bs * bs;
             // Split the row where it crosses bricks; within a brick widen the
             // segment to whole 8-node chunks when the brick allows.
-            for (int gx = lo.x() + t_lo; gx <= lo.x() + t_hi;) {
+            for (int gx = node_lo.x() + t_lo; gx <= node_lo.x() + t_hi;) {
               const int bx = gx >> bs_shift;
               const int brick_x = bx << bs_shift;
-              const int seg_end = std::min(lo.x() + t_hi, brick_x + bs - 1);
+              const int seg_end = std::min(node_lo.x() + t_hi, brick_x + bs - 1);
               int first = gx - brick_x, last = seg_end - brick_x;
               if (bs % 8 == 0) {
                 first &= ~7;
@@ -455,9 +455,9 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
               const size_t b = static_cast<size_t>(brick_of[bx - xmin]);
               const size_t idx = b * per + static_cast<size_t>(row_offset + first);
               (p.exact ? splat_row_exact : splat_row_series)(field.values_.data() + idx, field.weights_.data() + idx,
-                                                             brick_x + first - lo.x(), last - first + 1, z0.x(), z0.y(),
-                                                             z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.c1, p.c2,
-                                                             p.weight, r2, p.slab * p.slab);
+                                                             brick_x + first - node_lo.x(), last - first + 1, z0.x(),
+                                                             z0.y(), z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.c1,
+                                                             p.c2, p.weight, r2, p.slab * p.slab);
               gx = seg_end + 1;
             }
           }

@@ -165,8 +165,8 @@ StatusOr<PointCloud> ScanProcessor::finish() {
     }
     std::vector<SweepPlane> others;
     for (const LaserState& o : r.others) {
-      const auto it = sweeps.find(o.laser);
-      if (it != sweeps.end()) others.push_back(it->second.plane(o.step));
+      const auto other = sweeps.find(o.laser);
+      if (other != sweeps.end()) others.push_back(other->second.plane(o.step));
     }
     triangulate_samples(cam, plane, *samples, r.full_scale, {static_cast<int>(r.camera), r.laser, r.frame},
                         options_.triangulate, others, &parts[i]);

@@ -126,8 +126,8 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
     } else {
       storage::DracoOptions keep;
       keep.max_error_mm = kArchivedMeshErrorMm;
-      ASSIGN_OR_RETURN(storage::DracoEncoded drc, storage::encode_mesh_drc(r.mesh, keep));
-      f.results[kArchivedMeshFile] = std::move(drc.bytes);
+      ASSIGN_OR_RETURN(storage::DracoEncoded mesh_drc, storage::encode_mesh_drc(r.mesh, keep));
+      f.results[kArchivedMeshFile] = std::move(mesh_drc.bytes);
     }
     ASSIGN_OR_RETURN(storage::DracoEncoded e, storage::encode_glb(r.mesh));
     glb = {{"bytes", e.bytes.size()}, {"position_bits", e.position_bits}, {"max_error_mm", e.max_error_mm}};

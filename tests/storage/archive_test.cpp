@@ -482,9 +482,9 @@ TEST(ArchiveCrash, SigkillAtRandomPointsLosesNoCompletedScan) {
         EXPECT_TRUE(fs::exists(fs::path(dir) / "scans" / r.id / "manifest.json"));
         EXPECT_EQ(r.raw.size(), 1u) << r.id;
         ASSERT_FALSE(r.versions.empty()) << r.id;
-        for (const ScanVersion& v : r.versions) {
-          ASSERT_EQ(v.files.size(), 3u) << r.id << " v" << v.version;
-          auto glb = (*a)->file_path(r.id, v.version, "mesh.glb");
+        for (const ScanVersion& version : r.versions) {
+          ASSERT_EQ(version.files.size(), 3u) << r.id << " v" << version.version;
+          auto glb = (*a)->file_path(r.id, version.version, "mesh.glb");
           ASSERT_TRUE(glb.ok()) << glb.status().message();
           EXPECT_EQ(fs::file_size(*glb), 50000u);
         }

@@ -67,8 +67,12 @@ TEST(BodyPoser, TurnsTheArmsToTheAskedAngleAndCarriesTheForearmRigidly) {
     EXPECT_NEAR(posed->posed.arm_abduction_deg(0), want, 0.01);
     EXPECT_NEAR(posed->posed.arm_abduction_deg(1), want - 5, 0.01);
     // The left arm turns about +Z by a negative angle to come down, the right by a positive one.
-    if (want < rest.rest.arm_abduction_deg(0)) EXPECT_LT(posed->shoulder_rotation_deg[0], 0);
-    if (want - 5 < rest.rest.arm_abduction_deg(1)) EXPECT_GT(posed->shoulder_rotation_deg[1], 0);
+    if (want < rest.rest.arm_abduction_deg(0)) {
+      EXPECT_LT(posed->shoulder_rotation_deg[0], 0);
+    }
+    if (want - 5 < rest.rest.arm_abduction_deg(1)) {
+      EXPECT_GT(posed->shoulder_rotation_deg[1], 0);
+    }
     // A vertex near the wrist joint moves with the whole arm: it keeps its distance
     // from the shoulder joint (to the skinning's blend) and turns about it.
     const Eigen::Vector3d sh = posed->rest.shoulder[0], wr = posed->rest.wrist[0];

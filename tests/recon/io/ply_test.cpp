@@ -136,7 +136,9 @@ TEST_P(PlyRoundTrip, CloudThroughDiskOverwritesOldFile) {
 }
 
 INSTANTIATE_TEST_SUITE_P(PlyFormats, PlyRoundTrip, ::testing::Values(PlyFormat::kBinaryLittleEndian, PlyFormat::kAscii),
-                         [](const auto& info) { return info.param == PlyFormat::kAscii ? "Ascii" : "Binary"; });
+                         [](const auto& param_info) {
+                           return param_info.param == PlyFormat::kAscii ? "Ascii" : "Binary";
+                         });
 
 TEST(PlyTest, EncodesTheDocumentedHeader) {
   PointCloud cloud;

@@ -234,9 +234,9 @@ INSTANTIATE_TEST_SUITE_P(Spheres, MeanCurvatureSphere,
                          // of the noisy cases are bounded at 20%.
                          ::testing::Values(SphereCase{1.0, 0.0, 0.02, 0.04}, SphereCase{50.0, 0.0, 0.02, 0.04},
                                            SphereCase{1.0, 0.2, 0.05, 0.2}, SphereCase{50.0, 0.2, 0.05, 0.2}),
-                         [](const ::testing::TestParamInfo<SphereCase>& info) {
-                           return "R" + std::to_string(static_cast<int>(info.param.radius)) +
-                                  (info.param.noise_in_spacings > 0 ? "_noisy" : "_clean");
+                         [](const ::testing::TestParamInfo<SphereCase>& param_info) {
+                           return "R" + std::to_string(static_cast<int>(param_info.param.radius)) +
+                                  (param_info.param.noise_in_spacings > 0 ? "_noisy" : "_clean");
                          });
 
 TEST(EstimateShapeOperators, ASparseCylinderKeepsItsCurvatureAcrossTheAxis) {

@@ -69,9 +69,9 @@ INSTANTIATE_TEST_SUITE_P(Levels, EstimateNoiseLevels,
                          ::testing::Values(NoiseCase{"sphere", 0.05}, NoiseCase{"sphere", 0.2},
                                            NoiseCase{"sphere", 0.5}, NoiseCase{"plane", 0.05}, NoiseCase{"plane", 0.2},
                                            NoiseCase{"plane", 0.5}),
-                         [](const ::testing::TestParamInfo<NoiseCase>& info) {
-                           return std::string(info.param.surface) + "_" +
-                                  std::to_string(static_cast<int>(info.param.noise_in_spacings * 100)) + "pct";
+                         [](const ::testing::TestParamInfo<NoiseCase>& param_info) {
+                           return std::string(param_info.param.surface) + "_" +
+                                  std::to_string(static_cast<int>(param_info.param.noise_in_spacings * 100)) + "pct";
                          });
 
 TEST(EstimateNoise, NoiseFreeIsNearZero) {
