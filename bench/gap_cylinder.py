@@ -3,7 +3,7 @@
 170 mm girth), 300 mm long along Y, sampled every 1.5 mm round and along, with a
 strip of GAP degrees round it left unseen over Y in [-40, 40] but for a stray
 point every 16 mm along and 6 mm round (as the tiered rig leaves the right wrist:
-docs/benchmarks.md §7, session 31). Each cloud is made into a closed surface by
+docs/benchmarks.md §7). Each cloud is made into a closed surface by
 `bodyscan reconstruct --body` (normals from the points, as a scan's), then
 measured by `bodyscan measure --girth-y 0`.
 

@@ -1,7 +1,7 @@
 // Z-order (Morton) sorting: points near in space end up near in memory, so the
 // neighbour queries, normal fits and field splatting that walk the cloud in order
-// stay in cache. On a million body points in sampling order this makes the k-NN
-// graph 3.6x and the whole reconstruction 1.6x faster (docs/benchmarks.md).
+// stay in cache: a cloud in sampling (scan) order scatters its neighbours
+// across memory.
 #pragma once
 
 #include <cstdint>
