@@ -288,11 +288,11 @@ int run(const std::string& rig_name, const std::string& body, int every) {
         for (size_t b = 0; b + 1 < edges.size(); ++b) {
           std::vector<double> in;
           double bias = 0;
-          for (size_t k = 0; k < key.size(); ++k)
-            if (key[k] >= edges[b] && key[k] < edges[b + 1]) in.push_back(err[k]), bias += signed_err[k];
-          const Quantiles q = quantiles(in);
+          for (size_t j = 0; j < key.size(); ++j)
+            if (key[j] >= edges[b] && key[j] < edges[b + 1]) in.push_back(err[j]), bias += signed_err[j];
+          const Quantiles bucket = quantiles(in);
           std::printf("    %s %4.2f-%4.2f %8zu points within 5 mm: mean %.3f mm, p95 %.3f, signed mean %+.3f\n", label,
-                      edges[b], std::floor(edges[b + 1] * 100) / 100, in.size(), q.mean, q.p95,
+                      edges[b], std::floor(edges[b + 1] * 100) / 100, in.size(), bucket.mean, bucket.p95,
                       bias / static_cast<double>(std::max<size_t>(in.size(), 1)));
         }
       };
@@ -317,10 +317,10 @@ int run(const std::string& rig_name, const std::string& body, int every) {
             const double e = l.plane_normal(st).dot(p) - l.plane_offset(st);
             if (std::abs(e) < std::abs(best)) best = e, bn = l.plane_normal(st);
           }
-          const Eigen::Vector3d q = p - best * bn;
+          const Eigen::Vector3d on_plane = p - best * bn;
           // Signed: + where the plane error moves the point out of the body.
           const ClosestPoint cp = distance.closest_point(cloud.positions[i]);
-          const ClosestPoint cq = distance.closest_point(q.cast<float>());
+          const ClosestPoint cq = distance.closest_point(on_plane.cast<float>());
           on_body[li] += cp.signed_distance;
           plane_corrected[li] += cq.signed_distance;
           plane_off[li] += cp.signed_distance - cq.signed_distance;
@@ -372,9 +372,9 @@ int run(const std::string& rig_name, const std::string& body, int every) {
               if (std::abs(den) < 0.17) continue;  // under 10 degrees: no triangulation
               const Eigen::Vector3d t =
                   model.centre() + ((l.plane_offset(st) - l.plane_normal(st).dot(model.centre())) / den) * ray;
-              const Eigen::Vector3d q =
+              const Eigen::Vector3d seen =
                   plane.triangulate(cc, cc.lens.correct(*raw), TriangulationMethod::kLaserHomography);
-              const double e = (q - t).dot(vn[v].cast<double>().normalized());
+              const double e = (seen - t).dot(vn[v].cast<double>().normalized());
               sum += e, sum_abs += std::abs(e), ++n;
             }
           }
@@ -401,7 +401,7 @@ int run(const std::string& rig_name, const std::string& body, int every) {
     }
     std::printf("coverage within 5 mm: %.1f %% of the body's area; uncovered:", 100.0 * covered / samples.size());
     std::vector<std::pair<size_t, std::string>> by_size;
-    for (const auto& [k, v] : holes) by_size.emplace_back(v, k);
+    for (const auto& [region, count] : holes) by_size.emplace_back(count, region);
     std::sort(by_size.rbegin(), by_size.rend());
     for (size_t i = 0; i < std::min<size_t>(6, by_size.size()); ++i)
       std::printf("%s %s %.1f %%", i ? "," : "", by_size[i].second.c_str(), 100.0 * by_size[i].first / samples.size());

@@ -402,8 +402,8 @@ int main(int argc, char** argv) {
                 double s0 = 0, s1 = 0, s2 = 0, t0 = 0, t1 = 0;
                 for (size_t j : in) {
                   pk.push_back(raw[j].peak);
-                  const double r = raw[j].row - raw[i].row, c = raw[j].column;
-                  s0 += 1, s1 += r, s2 += r * r, t0 += c, t1 += r * c;
+                  const double r = raw[j].row - raw[i].row, col = raw[j].column;
+                  s0 += 1, s1 += r, s2 += r * r, t0 += col, t1 += r * col;
                 }
                 std::sort(pk.begin(), pk.end());
                 const double med = 0.5 * (pk[2] + pk[3]);
