@@ -48,20 +48,6 @@ nlohmann::json scan_json(const storage::ScanRecord& r) {
 
 }  // namespace
 
-nlohmann::json measurement_json(const storage::MeasurementRecord& m) {
-  return {{"id", m.id},
-          {"version", m.version},
-          {"source", m.source},
-          {"name", m.name},
-          {"label", m.label},
-          {"kind", m.kind},
-          {"iso_clause", m.iso_clause},
-          {"value_mm", m.value_mm},
-          {"geometry", m.geometry},
-          {"created_by", m.created_by},
-          {"created_at", m.created_at}};
-}
-
 // A scan's result file, served from the archive. The current version revalidates
 // (a reprocess changes it); a named version never changes.
 HttpResponse scan_file(Workstation& ws, const std::string& scan_id, const std::string& name,
@@ -250,7 +236,7 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
            ASSIGN_OR_RETURN(storage::ScanRecord r, ws.archive().scan(id));
            ASSIGN_OR_RETURN(std::vector<storage::MeasurementRecord> ms, ws.archive().measurements(id));
            nlohmann::json out = nlohmann::json::array();
-           for (const auto& m : ms) out.push_back(measurement_json(m));
+           for (const auto& m : ms) out.push_back(storage::to_json(m));
            // How the customer stood, as the measurements read it (scan.json).
            nlohmann::json posture = nullptr;
            if (auto path = ws.archive().file_path(id, 0, "scan.json"); path.ok())
@@ -311,9 +297,9 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
                        auto all = ws.archive().measurements(id);
                        if (all.ok())
                          for (const auto& x : *all)
-                           if (x.id == *saved) return json_response(201, measurement_json(x));
+                           if (x.id == *saved) return json_response(201, storage::to_json(x));
                        rec.id = *saved;
-                       return json_response(201, measurement_json(rec));
+                       return json_response(201, storage::to_json(rec));
                      }});
   routes->push_back(
       {"DELETE", "/api/scans/{id}/measurements/{mid}", kTailor | kAdmin, [](Workstation& ws, const Call& call) {

@@ -1,5 +1,5 @@
-// What the scan routes and the share routes both send: a stored measurement as
-// JSON, and a scan's result file with its ETag.
+// What the scan routes and the share routes both send: a scan's result file with
+// its ETag (a stored measurement's JSON is storage::to_json).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -11,8 +11,6 @@
 #include "storage/archive/archive.hpp"
 
 namespace bodyscan::server {
-
-nlohmann::json measurement_json(const storage::MeasurementRecord& m);
 
 // A scan's result file from the archive ("" version: the current one, which
 // revalidates; a named version is immutable), 304 on a matching If-None-Match.

@@ -87,7 +87,7 @@ void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options
          nlohmann::json shown = nlohmann::json::array();
          for (const auto& m : *ms)
            if (std::find(link.measurements.begin(), link.measurements.end(), m.name) != link.measurements.end()) {
-             nlohmann::json j = measurement_json(m);
+             nlohmann::json j = storage::to_json(m);
              j.erase("created_by");  // staff names stay in the shop
              j.erase("id");
              shown.push_back(j);

@@ -111,6 +111,20 @@ nlohmann::json file_json(const ArchivedFile& f) {
 
 }  // namespace
 
+nlohmann::json to_json(const MeasurementRecord& m) {
+  return {{"id", m.id},
+          {"version", m.version},
+          {"source", m.source},
+          {"name", m.name},
+          {"label", m.label},
+          {"kind", m.kind},
+          {"iso_clause", m.iso_clause},
+          {"value_mm", m.value_mm},
+          {"geometry", m.geometry},
+          {"created_by", m.created_by},
+          {"created_at", m.created_at}};
+}
+
 struct Archive::Impl {
   fs::path dir;
   int lock_fd = -1;
@@ -889,18 +903,7 @@ Status Archive::export_customer(const std::string& id, const std::string& dest, 
       for (const ScanVersion& v : r.versions) {
         ASSIGN_OR_RETURN(std::vector<MeasurementRecord> ms, measurements(r.id, v.version));
         for (const MeasurementRecord& m : ms)
-          if (m.version == v.version)
-            s["measurements"].push_back({{"id", m.id},
-                                         {"version", m.version},
-                                         {"source", m.source},
-                                         {"name", m.name},
-                                         {"label", m.label},
-                                         {"kind", m.kind},
-                                         {"iso_clause", m.iso_clause},
-                                         {"value_mm", m.value_mm},
-                                         {"geometry", m.geometry},
-                                         {"created_by", m.created_by},
-                                         {"created_at", m.created_at}});
+          if (m.version == v.version) s["measurements"].push_back(to_json(m));
       }
       std::error_code ec;
       fs::copy(impl_->scan_dir(r.id), out / "scans" / r.id,

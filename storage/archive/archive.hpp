@@ -82,6 +82,10 @@ struct MeasurementRecord {
   std::string created_by, created_at;
 };
 
+// A measurement as the API serves it and a customer's export holds it: every
+// field but scan_id.
+nlohmann::json to_json(const MeasurementRecord& m);
+
 struct AuditEntry {
   int64_t id = 0;
   std::string at, actor, action, target_kind, target_id, detail;
