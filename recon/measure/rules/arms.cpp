@@ -8,8 +8,6 @@
 #include <tuple>
 #include <utility>
 
-#include <Eigen/Eigenvalues>
-
 #include "recon/measure/profile.hpp"
 
 namespace bodyscan::rules {
@@ -210,15 +208,7 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> square_cut_axis(const
   const double n = static_cast<double>(centres.size()), taper = n / 3;
   std::vector<double> weights(centres.size());
   for (size_t i = 0; i < centres.size(); ++i) weights[i] = std::min(1.0, (n - static_cast<double>(i)) / taper);
-  double total = 0;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < centres.size(); ++i) mean += weights[i] * centres[i], total += weights[i];
-  mean /= total;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < centres.size(); ++i) cov += weights[i] * (centres[i] - mean) * (centres[i] - mean).transpose();
-  Eigen::Vector3d d = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(2);
-  if (d.y() < 0) d = -d;
-  return std::make_pair(mean, d);
+  return fit_line(centres, 0, centres.size(), nullptr, &weights);
 }
 
 // Where the upper arm's axis passes closest to the forearm's; c_e's place on the

@@ -181,12 +181,14 @@ Eigen::Vector3d loop_centre(const std::vector<Eigen::Vector3d>& loop) {
 }
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Vector3d>& p, size_t b, size_t e,
-                                                     double* residual) {
+                                                     double* residual, const std::vector<double>* weights) {
+  const auto w = [&](size_t i) { return weights ? (*weights)[i] : 1.0; };
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (size_t i = b; i < e; ++i) c += p[i];
-  c /= static_cast<double>(e - b);
+  double total = 0;
+  for (size_t i = b; i < e; ++i) c += w(i) * p[i], total += w(i);
+  c /= total;
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (size_t i = b; i < e; ++i) cov += (p[i] - c) * (p[i] - c).transpose();
+  for (size_t i = b; i < e; ++i) cov += w(i) * (p[i] - c) * (p[i] - c).transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
   Eigen::Vector3d d = es.eigenvectors().col(2);
   if (d.y() < 0) d = -d;

@@ -136,9 +136,11 @@ Eigen::Vector3d loop_centre(const std::vector<Eigen::Vector3d>& loop);
 
 // A least-squares line through points [b, e): (centre, unit direction with y >= 0);
 // `residual`, when given, receives the spread off the line (the two smaller
-// eigenvalues' sum).
+// eigenvalues' sum). `weights`, when given, weigh each point (indexed as p; their
+// sum over [b, e) must be positive).
 std::pair<Eigen::Vector3d, Eigen::Vector3d> fit_line(const std::vector<Eigen::Vector3d>& p, size_t b, size_t e,
-                                                     double* residual = nullptr);
+                                                     double* residual = nullptr,
+                                                     const std::vector<double>* weights = nullptr);
 
 // Whether a loop in the plane with normal n winds round p (the loop is the limb's
 // own, not a neighbour's that the nearest-loop rule fell back to).
