@@ -1,6 +1,6 @@
-// The rig: its status, calibrating it, starting a scan, following the job,
-// answering its prompts and cancelling it. One job at a time: a second gets 409
-// with what the rig is busy with.
+// The rig: its status, calibrating it, checking how the customer stands, starting
+// a scan, following the job, answering its prompts and cancelling it. One job at a
+// time: a second gets 409 with what the rig is busy with.
 #include "server/api/api.hpp"
 
 namespace bodyscan::server {
@@ -20,6 +20,13 @@ void add_rig_routes(std::vector<Api::Route>* routes) {
       {"GET", "/api/rig", kStaff, [](Workstation& ws, const Call&) { return json_response(200, ws.rig_status()); }});
   routes->push_back({"POST", "/api/rig/calibrate", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
                        auto j = ws.start_calibration(call.actor());
+                       if (!j.ok()) return error_response(j.status());
+                       return accepted(*j);
+                     }});
+  // A quick coarse sweep before the scan: how the customer stands, in the job's
+  // posture_check when it completes. Nothing is stored.
+  routes->push_back({"POST", "/api/rig/posture-check", kOperator | kAdmin, [](Workstation& ws, const Call& call) {
+                       auto j = ws.start_posture_check(call.actor());
                        if (!j.ok()) return error_response(j.status());
                        return accepted(*j);
                      }});

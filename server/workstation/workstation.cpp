@@ -21,6 +21,7 @@
 #include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/pipeline/archive_scan.hpp"
+#include "server/pipeline/posture_sweep.hpp"
 #include "server/pipeline/rig_backend.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/scan_recording.hpp"
@@ -34,6 +35,7 @@ const char* to_string(JobKind k) {
     case JobKind::kCalibrate: return "calibrate";
     case JobKind::kScan: return "scan";
     case JobKind::kReprocess: return "reprocess";
+    case JobKind::kPostureCheck: return "posture_check";
   }
   return "?";
 }
@@ -57,6 +59,7 @@ nlohmann::json to_json(const JobInfo& j) {
   if (!j.error.empty()) out["error"] = j.error;
   if (!j.finished_at.empty()) out["finished_at"] = j.finished_at;
   if (j.version > 0) out["version"] = j.version;
+  if (!j.posture_check.is_null()) out["posture_check"] = j.posture_check;
   if (j.prompt) {
     const JobPrompt& p = *j.prompt;
     out["prompt"] = {{"id", p.id}, {"kind", p.kind}, {"text", p.text}, {"asked_at", p.asked_at}};
@@ -288,6 +291,10 @@ struct Workstation::Impl {
   Status do_calibrate();
   Status do_scan(int every);
   Status do_reprocess(const std::string& scan_id, const std::string& actor);
+  Status do_posture_check();
+  std::function<void(const pipeline::Shot&)> preview_fn();
+  // The rig's calibration, made first (and kept) when there is none yet.
+  StatusOr<pipeline::RigCalibration> calibration_or_calibrate(const std::string& actor);
 };
 
 Workstation::Workstation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -453,46 +460,10 @@ Status Workstation::Impl::do_calibrate() {
   return save_calibration(cal, actor);
 }
 
-Status Workstation::Impl::do_scan(int every) {
-  std::string scan_id, actor;
-  std::optional<pipeline::RigCalibration> cal;
-  {
-    std::lock_guard lock(mutex);
-    scan_id = job->scan_id;
-    actor = job->actor;
-    cal = calibration;
-  }
-  auto fail = [&](const Status& st) {
-    const bool cancelled = st.code() == StatusCode::kCancelled || cancel;
-    std::string reason;
-    {
-      std::lock_guard lock(mutex);
-      reason = cancelled && !cancel_reason.empty() ? cancel_reason : st.message();
-    }
-    archive->end_scan(scan_id, cancelled ? storage::ScanStatus::kCancelled : storage::ScanStatus::kFailed, reason);
-    return st;
-  };
-  if (!cal) {  // the first scan on a new rig calibrates it first
-    StatusOr<pipeline::RigCalibration> made = pipeline::calibrate_rig(rig, {}, progress_fn());
-    if (!made.ok()) return fail(made.status());
-    const Status kept = save_calibration(*made, actor);
-    if (!kept.ok()) return fail(kept);
-    cal = std::move(*made);
-  }
-  {
-    std::string cal_id;
-    {
-      std::lock_guard lock(mutex);
-      cal_id = calibration_id;
-    }
-    if (!cal_id.empty()) archive->set_scan_calibration(scan_id, cal_id);
-  }
-  pipeline::ScanJobOptions o;
-  o.every = every;
-  o.progress = progress_fn();
-  // Previews: a small image per camera now and then, and the frame count.
+// Previews: a small image per camera now and then, and the frame count.
+std::function<void(const pipeline::Shot&)> Workstation::Impl::preview_fn() {
   auto last_preview = std::make_shared<std::map<size_t, std::chrono::steady_clock::time_point>>();
-  o.on_scan_shot = [this, last_preview](const pipeline::Shot& shot) {
+  return [this, last_preview](const pipeline::Shot& shot) {
     std::string job_id;
     {
       std::lock_guard lock(mutex);
@@ -513,6 +484,50 @@ Status Workstation::Impl::do_scan(int every) {
              {"frame_id", shot.frame.frame_id},
              {"png_base64", base64(*png)}});
   };
+}
+
+StatusOr<pipeline::RigCalibration> Workstation::Impl::calibration_or_calibrate(const std::string& actor) {
+  {
+    std::lock_guard lock(mutex);
+    if (calibration) return *calibration;
+  }
+  // The first scan (or posture check) on a new rig calibrates it first.
+  ASSIGN_OR_RETURN(pipeline::RigCalibration made, pipeline::calibrate_rig(rig, {}, progress_fn()));
+  RETURN_IF_ERROR(save_calibration(made, actor));
+  return made;
+}
+
+Status Workstation::Impl::do_scan(int every) {
+  std::string scan_id, actor;
+  {
+    std::lock_guard lock(mutex);
+    scan_id = job->scan_id;
+    actor = job->actor;
+  }
+  auto fail = [&](const Status& st) {
+    const bool cancelled = st.code() == StatusCode::kCancelled || cancel;
+    std::string reason;
+    {
+      std::lock_guard lock(mutex);
+      reason = cancelled && !cancel_reason.empty() ? cancel_reason : st.message();
+    }
+    archive->end_scan(scan_id, cancelled ? storage::ScanStatus::kCancelled : storage::ScanStatus::kFailed, reason);
+    return st;
+  };
+  StatusOr<pipeline::RigCalibration> cal = calibration_or_calibrate(actor);
+  if (!cal.ok()) return fail(cal.status());
+  {
+    std::string cal_id;
+    {
+      std::lock_guard lock(mutex);
+      cal_id = calibration_id;
+    }
+    if (!cal_id.empty()) archive->set_scan_calibration(scan_id, cal_id);
+  }
+  pipeline::ScanJobOptions o;
+  o.every = every;
+  o.progress = progress_fn();
+  o.on_scan_shot = preview_fn();
   StatusOr<pipeline::ScanJobResult> result = pipeline::run_scan_job(rig, std::move(*cal), o);
   // The scan is over: nothing left for the lasers to do while the surface is built
   // (run_scan_job's acquisition already switched them off; this is belt and braces).
@@ -532,6 +547,31 @@ Status Workstation::Impl::do_reprocess(const std::string& scan_id, const std::st
   std::lock_guard lock(mutex);
   job->version = version;
   return Status::Ok();
+}
+
+Status Workstation::Impl::do_posture_check() {
+  std::string actor;
+  {
+    std::lock_guard lock(mutex);
+    actor = job->actor;
+  }
+  ASSIGN_OR_RETURN(pipeline::RigCalibration cal, calibration_or_calibrate(actor));
+  pipeline::PostureSweepOptions o;
+  o.progress = progress_fn();
+  o.on_scan_shot = preview_fn();
+  ASSIGN_OR_RETURN(pipeline::PostureSweep sweep, pipeline::sweep_posture(rig, std::move(cal), o));
+  std::lock_guard lock(mutex);
+  job->posture_check = pipeline::to_json(sweep);
+  return Status::Ok();
+}
+
+StatusOr<JobInfo> Workstation::start_posture_check(const std::string& actor) {
+  Impl& s = *impl_;
+  s.reap();
+  std::lock_guard lock(s.mutex);
+  ASSIGN_OR_RETURN(JobInfo j, s.begin(JobKind::kPostureCheck, actor));
+  s.run(j, [&s]() { return s.do_posture_check(); });
+  return j;
 }
 
 StatusOr<JobInfo> Workstation::start_calibration(const std::string& actor) {

@@ -43,7 +43,7 @@ struct WorkstationOptions {
   double operator_timeout_s = 900;
 };
 
-enum class JobKind { kCalibrate, kScan, kReprocess };
+enum class JobKind { kCalibrate, kScan, kReprocess, kPostureCheck };
 enum class JobState { kRunning, kComplete, kFailed, kCancelled };
 const char* to_string(JobKind k);
 const char* to_string(JobState s);
@@ -71,6 +71,8 @@ struct JobInfo {
   std::string started_at, finished_at;  // ISO 8601 UTC
   int version = 0;                      // a reprocess's new version
   std::optional<JobPrompt> prompt;      // what the job waits for a person to do
+  // A posture check's result (pipeline::to_json(PostureSweep)), once complete.
+  nlohmann::json posture_check;
 };
 nlohmann::json to_json(const JobInfo& job);
 
@@ -102,6 +104,10 @@ class Workstation {
   StatusOr<JobInfo> start_calibration(const std::string& actor);
   StatusOr<JobInfo> start_scan(const ScanRequest& request);
   StatusOr<JobInfo> start_reprocess(const std::string& scan_id, const std::string& actor);
+  // A quick coarse sweep that reads how the customer stands (pipeline/posture_sweep.hpp),
+  // before the full scan; nothing is stored. The result is in the job's
+  // `posture_check` when it completes.
+  StatusOr<JobInfo> start_posture_check(const std::string& actor);
   // Asks the job to stop (it stops at the next frame or stage, lasers off).
   Status cancel(const std::string& job_id, const std::string& actor);
   // The person has done what the job's prompt asked: not_found for another job,

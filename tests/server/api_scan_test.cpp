@@ -203,6 +203,38 @@ TEST(ApiScan, CancelStopsTheScanAndTurnsTheLasersOff) {
   EXPECT_EQ(op.post("/api/jobs/j_unknown/cancel").status, 404);
 }
 
+// The posture check before a scan: an operator starts it, the rig is busy with it
+// meanwhile, and the finished job carries the posture the sweep read (the demo
+// body stands in the scanning posture, so every part passes). Nothing is stored
+// and the lasers are off after it.
+TEST(ApiScan, PostureCheckReadsHowTheCustomerStandsAndStoresNothing) {
+  ServerUnderTest s(12);
+  Client op = s.as("op");
+  const size_t scans_before = parse(op.get("/api/scans"))["scans"].size();
+  EXPECT_EQ(s.as("tailor").post("/api/rig/posture-check").status, 403);
+  const HttpReply started = op.post("/api/rig/posture-check");
+  ASSERT_EQ(started.status, 202) << started.body;
+  const nlohmann::json job = parse(started)["job"];
+  EXPECT_EQ(job["kind"], "posture_check");
+  EXPECT_EQ(op.post("/api/scans", R"({"customer": {"name": "Next"}})").status, 409);
+  const nlohmann::json done = wait_job(op, job["id"]);
+  ASSERT_EQ(done["state"], "complete") << done.dump();
+  const nlohmann::json& check = done["posture_check"];
+  ASSERT_TRUE(check.is_object()) << done.dump();
+  EXPECT_TRUE(check["ok"].get<bool>()) << check.dump();
+  EXPECT_GT(check["frames"].get<int64_t>(), 100);
+  const nlohmann::json& posture = check["posture"];
+  ASSERT_EQ(posture["checks"].size(), 4u) << posture.dump();
+  for (int side = 0; side < 2; ++side) {
+    ASSERT_TRUE(posture["arm_abduction_deg"][side].is_number()) << posture.dump();
+    EXPECT_NEAR(posture["arm_abduction_deg"][side].get<double>(), 44, 6) << "the demo body's A-pose";
+  }
+  EXPECT_NEAR(posture["turn_deg"].get<double>(), 0, 1);
+  EXPECT_EQ(parse(op.get("/api/scans"))["scans"].size(), scans_before);
+  for (int i = 0; i < s.ws->simulated_rig()->controller().num_lasers(); ++i)
+    EXPECT_FALSE(s.ws->simulated_rig()->controller().laser_on(i)) << "laser " << i;
+}
+
 // Calibration asking the person at the rig to hold the dot grid (training mode on
 // the simulated rig, as for real cameras): the job and its events carry the
 // prompt, an operator answers it by id; a tailor may not, a stale id is refused.

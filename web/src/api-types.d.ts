@@ -462,6 +462,56 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/rig/posture-check": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Check how the customer stands: a quick coarse sweep (every 4th laser step) whose surface gives the arms, the feet and the turn, checked against the scanning posture; the result is the job's posture_check when it completes, and nothing is stored */
+        post: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description started */
+                202: {
+                    headers: {
+                        Location?: string;
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": {
+                            job?: components["schemas"]["Job"];
+                        };
+                    };
+                };
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+                /** @description the rig is busy with another job */
+                409: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+            };
+        };
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/scans": {
         parameters: {
             query?: never;
@@ -1744,7 +1794,7 @@ export interface components {
         Job: {
             id?: string;
             /** @enum {string} */
-            kind?: "calibrate" | "scan" | "reprocess";
+            kind?: "calibrate" | "scan" | "reprocess" | "posture_check";
             /** @enum {string} */
             state?: "running" | "complete" | "failed" | "cancelled";
             stage?: string;
@@ -1759,6 +1809,18 @@ export interface components {
             version?: number;
             /** @description what the job waits for a person to do; null when nothing */
             prompt?: components["schemas"]["JobPrompt"] | null;
+            /** @description a posture check's result, once it completes */
+            posture_check?: {
+                posture?: components["schemas"]["Posture"];
+                /** @description the arms, the feet and the turn inside the scanning posture (the head is left to the scan) */
+                ok?: boolean;
+                /** @description camera frames the sweep took, all cameras */
+                frames?: number;
+                points?: number;
+                acquisition_seconds?: number;
+                /** @description cloud, surface and posture after the last frame */
+                processing_seconds?: number;
+            };
         };
         RigStatus: {
             rig?: string;

@@ -218,6 +218,9 @@ const getRig = () => get(at('/api/rig'));
 /** @returns {Promise<Answer<'/api/rig/calibrate', 'post', 202>>} */
 const calibrate = () => post(at('/api/rig/calibrate'), {});
 
+/** @returns {Promise<Answer<'/api/rig/posture-check', 'post', 202>>} */
+const checkPosture = () => post(at('/api/rig/posture-check'), {});
+
 /**
  * @param {Body<'/api/scans', 'post'>} scan
  * @returns {Promise<Answer<'/api/scans', 'post', 202>>}
@@ -349,6 +352,7 @@ export const api = {
   deleteAccount,
   getRig,
   calibrate,
+  checkPosture,
   startScan,
   answerPrompt,
   cancelJob,

@@ -21,7 +21,7 @@ const SPANS = [
 const BY_STAGE = new Map(SPANS.map(([stage, a, b, text]) => [stage, { a, b, text }]));
 
 // The share of the whole job in [a, b] that `kind` covers.
-const KIND_RANGE = { scan: [0, 1], calibrate: [0, 0.1], reprocess: [0.7, 1] };
+const KIND_RANGE = { scan: [0, 1], calibrate: [0, 0.1], reprocess: [0.7, 1], posture_check: [0, 1] };
 
 export function overallFraction(kind, stage, fraction) {
   const s = BY_STAGE.get(stage);

@@ -5,7 +5,7 @@
 import { api, enc } from '../api.js';
 import { overallFraction, stageText } from '../progress.js';
 import { ago, clear, errorText, h, toast, when } from '../ui/dom.js';
-import { wantedPostureCard } from '../viewer/posture.js';
+import { postureCheckCard, wantedPostureCard } from '../viewer/posture.js';
 
 /** @typedef {import('../api.js').Job} Job */
 /** @typedef {import('../api.js').RigStatus} RigStatus */
@@ -102,6 +102,8 @@ export async function mount(container, _params, ctx) {
   const search = h('input', { type: 'search', placeholder: 'Search by name, contact or id', 'aria-label': 'Search customers' });
   const results = h('div', { class: 'pick-list', role: 'listbox', 'aria-label': 'Customers' });
   const startButton = h('button', { class: 'primary big', type: 'submit', id: 'start-scan' }, 'Start scan');
+  // A quick sweep that reads how the customer stands, before the scan.
+  const checkButton = h('button', { type: 'button', id: 'check-posture', onclick: checkPosture }, 'Check posture');
   const modeNew = h('div', { class: 'mode-new' }, h('label', { class: 'field' }, h('span', {}, 'Name'), name), h('label', { class: 'field' }, h('span', {}, 'Contact'), contact));
   const modeExisting = h('div', { class: 'mode-existing', hidden: true }, search, results);
   let searchTimer = null;
@@ -210,12 +212,27 @@ export async function mount(container, _params, ctx) {
       modeExisting,
       wantedPostureCard(),
       h('p', { class: 'muted small' }, 'Ask the customer to stand on the marks like the picture and to hold still for about two minutes.'),
+      checkButton,
       startButton,
     ),
   );
 
+  async function checkPosture() {
+    checkButton.disabled = true;
+    try {
+      const { job } = await api.checkPosture();
+      state.myJob = job.id;
+      startedJob(job);
+    } catch (e) {
+      toast(errorText(e), 'error');
+    } finally {
+      renderForm();
+    }
+  }
+
   function renderForm() {
     const busy = (state.rig && state.rig.busy) || (state.job && state.job.state === 'running');
+    checkButton.disabled = !!busy;
     startButton.disabled = !!busy;
     startButton.textContent = busy ? 'The rig is busy' : 'Start scan';
   }
@@ -256,13 +273,14 @@ export async function mount(container, _params, ctx) {
     let prompt = null;
     clear(
       jobBox,
-      h('h2', {}, j.kind === 'calibrate' ? 'Calibration' : j.kind === 'reprocess' ? 'Reprocessing' : 'Scan'),
+      h('h2', {}, { calibrate: 'Calibration', reprocess: 'Reprocessing', posture_check: 'Posture check' }[j.kind] || 'Scan'),
       h('p', { class: `job-state ${j.state}`, dataset: { state: j.state, stage: j.stage || '', job: j.id } }, running ? `${stageText(j.stage)}…` : { complete: 'Done', failed: 'Failed', cancelled: 'Cancelled' }[j.state] || j.state),
       h('progress', { max: 100, value: pct, 'aria-label': 'Progress' }),
       h('p', { class: 'muted small' }, `${pct} %${j.frames ? ` · ${j.frames} frames` : ''}`),
       j.error ? h('p', { class: 'form-error' }, j.error) : null,
       running && j.prompt ? (prompt = promptBox(j)) : null,
-      j.kind === 'scan' ? previewGrid : null,
+      j.kind === 'posture_check' && j.state === 'complete' ? postureCheckCard(j.posture_check) : null,
+      j.kind === 'scan' || j.kind === 'posture_check' ? previewGrid : null,
       running ? h('button', { type: 'button', class: 'danger', onclick: () => cancel(j) }, 'Cancel') : null,
       !running && j.scan_id && j.state === 'complete' ? h('a', { class: 'button primary', href: `/scans/${enc(j.scan_id)}` }, 'Open the result') : null,
     );

@@ -97,30 +97,49 @@ export function wantedPostureCard() {
   );
 }
 
+// The figure as the customer stood (their arms' mean angle) beside the lines.
+function postureHead(posture, label, title) {
+  const lines = postureLines(posture);
+  const arms = posture.arm_abduction_deg || [];
+  const meanArm = arms.filter((x) => typeof x === 'number');
+  return h('div', { class: 'posture-head' },
+    postureFigure({
+      arms: meanArm.length ? meanArm.reduce((s, x) => s + x, 0) / meanArm.length : 42,
+      ankles: posture.ankle_distance_mm ?? 375,
+      label,
+    }),
+    h(
+      'div',
+      {},
+      h('h2', {}, title),
+      h('ul', { class: 'posture-lines' }, lines.map((l) => h('li', { class: l.ok ? 'ok' : 'warn', dataset: { part: l.part } }, l.text, l.ok ? null : h('small', {}, ` — ${l.message}`)))),
+    ),
+  );
+}
+
+// The station's card after a posture check (the job's posture_check): how the
+// customer stands now, and what to ask of them before the scan.
+export function postureCheckCard(check) {
+  if (!check?.posture) return null;
+  const p = check.posture;
+  const seconds = (check.acquisition_seconds || 0) + (check.processing_seconds || 0);
+  return h(
+    'div',
+    { class: `posture-card posture-check ${check.ok ? 'ok' : 'warn'}`, id: 'posture-check', dataset: { ok: check.ok ? 'true' : 'false' } },
+    postureHead(p, 'How the customer stands', check.ok ? 'Ready to scan' : 'Ask the customer to change how they stand, then check again'),
+    h('p', { class: 'muted small' }, `From a quick sweep (${check.frames} frames, ${seconds.toFixed(1)} s). The head is checked by the scan.`),
+  );
+}
+
 // The viewer's card: how the customer stood and what was outside the posture,
 // with the measurements that depend on it.
 export function postureCard(posture, measurements = []) {
   if (!posture) return null;
-  const lines = postureLines(posture);
   const flagged = measurements.filter((m) => m.geometry?.outside_posture).map((m) => m.label || m.name);
-  const arms = posture.arm_abduction_deg || [];
-  const meanArm = arms.filter((x) => typeof x === 'number');
   return h(
     'div',
     { class: `card posture-card ${posture.ok ? 'ok' : 'warn'}`, id: 'posture', dataset: { ok: posture.ok ? 'true' : 'false' } },
-    h('div', { class: 'posture-head' },
-      postureFigure({
-        arms: meanArm.length ? meanArm.reduce((s, x) => s + x, 0) / meanArm.length : 42,
-        ankles: posture.ankle_distance_mm ?? 375,
-        label: 'How the customer stood',
-      }),
-      h(
-        'div',
-        {},
-        h('h2', {}, posture.ok ? 'Posture: as the measurements assume' : 'Posture: check before trusting the flagged values'),
-        h('ul', { class: 'posture-lines' }, lines.map((l) => h('li', { class: l.ok ? 'ok' : 'warn', dataset: { part: l.part } }, l.text, l.ok ? null : h('small', {}, ` — ${l.message}`)))),
-      ),
-    ),
+    postureHead(posture, 'How the customer stood', posture.ok ? 'Posture: as the measurements assume' : 'Posture: check before trusting the flagged values'),
     flagged.length
       ? h('p', { class: 'posture-flagged' }, `⚑ ${flagged.length} value${flagged.length > 1 ? 's' : ''} taken outside the posture ${flagged.length > 1 ? 'their definitions assume' : 'its definition assumes'}: ${flagged.join(', ')}. Scan again in the posture shown at the station for the standard's values.`)
       : null,

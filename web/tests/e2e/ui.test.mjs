@@ -211,7 +211,7 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await logout(page);
   });
 
-  it('calibrates the rig from the station, and cancels a scan with the lasers left off', async () => {
+  it('calibrates the rig from the station, checks the posture, and cancels a scan with the lasers left off', async () => {
     await login(page, server.url, ...OPERATOR);
     const ageBefore = await page.locator('#calibration-age').innerText();
     await page.click('#rig-status button:has-text("Calibrate")');
@@ -222,6 +222,20 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.match(await page.locator('#calibration-age').innerText(), /Calibrated (just now|\d+ s ago)/);
     assert.match(await page.locator('#rig-status table').innerText(), /\d\.\d{3} px/);
     await shot(page, 'station-calibrated');
+
+    // The posture check before a scan: a quick sweep reads how the demo body
+    // stands (its A-pose, inside the scanning posture) and says so in a picture
+    // and a line a part.
+    await page.click('#check-posture');
+    await page.locator('#job .job-state[data-state=running]').waitFor({ timeout: 30000 });
+    assert.match(await page.locator('#job h2').innerText(), /Posture check/);
+    await page.locator('#posture-check').waitFor({ timeout: 180000 });
+    assert.equal(await page.locator('#posture-check').getAttribute('data-ok'), 'true');
+    const checked = await page.locator('#posture-check').innerText();
+    assert.match(checked, /Ready to scan/);
+    assert.match(checked, /Left arm \d+° from the body/);
+    assert.match(checked, /Ankles \d+ cm apart/);
+    await shot(page, 'station-posture-checked');
 
     await page.fill('input[name=name]', 'Grace Hopper');
     await page.click('#start-scan');

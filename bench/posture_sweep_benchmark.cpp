@@ -1,0 +1,148 @@
+// The posture check before a scan (server/pipeline/posture_sweep.hpp), judged on the
+// simulated rig: for each posture the subject is posed in, the posture the quick
+// sweep reads against the one the full automatic set reads on the posed true mesh,
+// whether the two agree on every check the sweep makes (arms, feet, turn), and how
+// long the sweep takes.
+//
+//   posture_sweep_benchmark [--rig thesis|tiered|R.json] [--body X.ply] [--every N]
+//                           [ARMS,FEET,TURN ...]
+//
+// Default postures: the scanning posture, turned and not, and the ways customers
+// stand outside it (arms low, feet close, turned past 30 degrees). The time of a
+// real rig's sweep is the frames each camera takes at the description's frame rate
+// (the simulator renders slower than a camera records).
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "hw/rig_description.hpp"
+#include "hw/sim/sim_rig.hpp"
+#include "recon/io/ply.hpp"
+#include "recon/measure/body_measurements.hpp"
+#include "server/pipeline/posture_sweep.hpp"
+#include "server/pipeline/rig_backend.hpp"
+
+namespace {
+using namespace bodyscan;
+
+struct Case {
+  double arms = 0, feet = 0, turn = 0;
+};
+
+std::string angle(const std::optional<double>& a) {
+  char b[32];
+  if (!a) return "-";
+  std::snprintf(b, sizeof b, "%.1f", *a);
+  return b;
+}
+
+// "read / truth" per part: arms left and right (deg), ankles (mm), turn (deg).
+std::string pair(const std::optional<double>& sweep, const std::optional<double>& truth) {
+  return angle(sweep) + " / " + angle(truth);
+}
+
+int run(const std::string& rig_name, const std::string& body, int every, const std::vector<Case>& cases) {
+  std::string path = rig_name;
+  if (rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos) {
+    StatusOr<std::string> p = hw::shipped_rig_path(rig_name);
+    if (!p.ok()) return std::fprintf(stderr, "%s\n", p.status().message().c_str()), 1;
+    path = *p;
+  }
+  StatusOr<hw::RigDescription> loaded = hw::load_rig_description(path);
+  if (!loaded.ok()) return std::fprintf(stderr, "%s\n", loaded.status().message().c_str()), 1;
+  TriangleMesh subject;
+  if (!body.empty()) {
+    StatusOr<TriangleMesh> m = read_ply_mesh(body);
+    if (!m.ok()) return std::fprintf(stderr, "%s\n", m.status().message().c_str()), 1;
+    subject = std::move(*m);
+  }
+  std::printf("rig %s, body %s, every %d laser steps\n\n", rig_name.c_str(),
+              body.empty() ? "(the rig's)" : body.c_str(), every);
+  std::printf(
+      "| posed: arms, ankles, turn | sweep / truth: arm left (deg) | arm right (deg) | ankles (mm) | turn (deg) "
+      "| checks agree | frames per camera | at the frame rate (s) | processing (s) |\n");
+  std::printf("|---|---|---|---|---|---|---:|---:|---:|\n");
+  std::optional<pipeline::RigCalibration> calibration;
+  int disagreements = 0;
+  for (const Case& c : cases) {
+    pipeline::SimulatedSubject s;
+    s.posture.arm_abduction_deg = {c.arms, c.arms};
+    s.posture.ankle_distance_mm = c.feet;
+    s.turn_deg = c.turn;
+    const hw::RigDescription desc = s.applied_to(*loaded);
+    StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> sim =
+        body.empty() ? hw::sim::SimulatedRig::create(desc) : hw::sim::SimulatedRig::create(desc, subject);
+    if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
+    const pipeline::Rig rig = pipeline::rig_handle(**sim);
+    if (!calibration) {  // the rig, not the subject: calibrated once
+      StatusOr<pipeline::RigCalibration> cal = pipeline::calibrate_rig(rig);
+      if (!cal.ok()) return std::fprintf(stderr, "%s\n", cal.status().message().c_str()), 1;
+      calibration = std::move(*cal);
+    }
+    pipeline::PostureSweepOptions o;
+    o.every = every;
+    StatusOr<pipeline::PostureSweep> sweep = pipeline::sweep_posture(rig, *calibration, o);
+    BodyMeasureOptions mo;
+    mo.floor_y = -0.5 * desc.frame.tube;
+    StatusOr<BodyMeasurements> truth = measure_body((*sim)->scene().subject(), mo);
+    std::printf("| %g, %g, %+g | ", c.arms, c.feet, c.turn);
+    if (!sweep.ok() || !truth.ok()) {
+      std::printf("%s |\n", (!sweep.ok() ? sweep.status() : truth.status()).message().c_str());
+      ++disagreements;
+      continue;
+    }
+    const BodyPosture &p = sweep->posture, &t = truth->posture;
+    // The parts whose check the sweep and the truth decide differently.
+    std::string differ;
+    size_t checked = 0;
+    for (const PostureCheck& tc : truth->posture_checks) checked += tc.part == "head" ? 0 : 1;
+    for (const PostureCheck& sc : sweep->checks) {
+      bool same = false;
+      for (const PostureCheck& tc : truth->posture_checks) same = same || (tc.part == sc.part && tc.ok == sc.ok);
+      if (!same)
+        differ += (differ.empty() ? "" : ", ") + sc.part + (sc.ok ? " (sweep ok)" : " (sweep: " + sc.message + ")");
+    }
+    const bool agree = differ.empty() && sweep->checks.size() == checked;
+    disagreements += agree ? 0 : 1;
+    const double per_camera = static_cast<double>(sweep->frames) / static_cast<double>(desc.cameras.size());
+    std::printf("%s | %s | %s | %s | %s | %.0f | %.1f | %.2f |\n",
+                pair(p.arm_abduction_deg[0], t.arm_abduction_deg[0]).c_str(),
+                pair(p.arm_abduction_deg[1], t.arm_abduction_deg[1]).c_str(),
+                pair(p.ankle_distance_mm, t.ankle_distance_mm).c_str(), pair(p.turn_deg, t.turn_deg).c_str(),
+                agree ? "yes" : ("no: " + differ).c_str(), per_camera, per_camera / desc.simulation.frame_rate_hz,
+                sweep->processing_seconds);
+    std::fflush(stdout);
+  }
+  std::printf("\n%d of %zu postures where the sweep's checks and the truth's disagree\n", disagreements, cases.size());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string rig = "thesis", body;
+  int every = bodyscan::pipeline::kPostureSweepEvery;
+  std::vector<Case> cases;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    Case c;
+    char end = 0;
+    if (a == "--rig" && i + 1 < argc)
+      rig = argv[++i];
+    else if (a == "--body" && i + 1 < argc)
+      body = argv[++i];
+    else if (a == "--every" && i + 1 < argc && (every = std::atoi(argv[++i])) > 0)
+      continue;
+    else if (std::sscanf(a.c_str(), "%lf,%lf,%lf%c", &c.arms, &c.feet, &c.turn, &end) == 3)
+      cases.push_back(c);
+    else {
+      std::fprintf(stderr,
+                   "usage: posture_sweep_benchmark [--rig R] [--body X.ply] [--every N] [ARMS,FEET,TURN ...]\n");
+      return 2;
+    }
+  }
+  if (cases.empty())
+    cases = {{42, 380, 0}, {40, 350, 20}, {45, 420, -25}, {20, 300, 0}, {30, 250, 10}, {42, 150, 0}, {42, 380, 40}};
+  return run(rig, body, every, cases);
+}
