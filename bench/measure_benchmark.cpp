@@ -26,7 +26,7 @@
 // The truth is then the posed body exactly as the simulator rendered it (posture,
 // turn and place), and --save keeps that one.
 // --noise-study N measures each body's own mesh N times under smooth skin noise
-// (recon/geometry/skin_noise.hpp: fields at 40 and 10 mm, each --noise-rms RMS, default
+// (tests/support/skin_noise.hpp: fields at 40 and 10 mm, each --noise-rms RMS, default
 // 0.25 mm) and ranks the measurements and landmarks by how far they move: no scan,
 // a few seconds a body. --noisy-out DIR also writes each noisy mesh there
 // (noisyN.ply, N the field's seed), to look at one with `bodyscan measure`.
@@ -51,12 +51,12 @@
 #include <vector>
 
 #include "hw/sim/scene.hpp"
-#include "recon/geometry/skin_noise.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_measurements.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "server/pipeline/rig_backend.hpp"
 #include "server/pipeline/scan_job.hpp"
+#include "tests/support/skin_noise.hpp"
 
 using namespace bodyscan;
 using Clock = std::chrono::steady_clock;

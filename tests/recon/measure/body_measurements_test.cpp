@@ -11,7 +11,6 @@
 #include <random>
 #include <tuple>
 
-#include "recon/geometry/skin_noise.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_slicer.hpp"
 #include "recon/measure/girth.hpp"
@@ -19,6 +18,7 @@
 #include "recon/measure/rules/legs.hpp"
 #include "recon/measure/rules/trunk.hpp"
 #include "tests/shapes.hpp"
+#include "tests/support/skin_noise.hpp"
 #include "tests/test_meshes.hpp"
 
 namespace bodyscan {
@@ -580,7 +580,7 @@ TEST(BodyMeasurements, TheSettledVertexMovesWithTheProfileNotWithItsSamples) {
 }
 
 TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNoise) {
-  // A scan's surface errs in gentle swells (recon/geometry/skin_noise.hpp): here two
+  // A scan's surface errs in gentle swells (tests/support/skin_noise.hpp): here two
   // fields, at 40 and 10 mm, each 0.25 mm RMS, eight seeds. The elbow's outer point
   // was the middle of the flattest stretch of the cut's outer side, and slid round
   // the arm: up to 5.9 mm on male_average, taking the outer arm length up to 4.7 mm

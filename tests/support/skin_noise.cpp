@@ -1,4 +1,4 @@
-#include "recon/geometry/skin_noise.hpp"
+#include "tests/support/skin_noise.hpp"
 
 #include <cmath>
 
