@@ -16,9 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "hw/rig_description.hpp"
 #include "hw/sim/sim_rig.hpp"
-#include "recon/io/ply.hpp"
 #include "recon/measure/body_measurements.hpp"
 #include "server/pipeline/posture_sweep.hpp"
 #include "server/pipeline/rig_backend.hpp"
@@ -43,20 +41,6 @@ std::string pair(const std::optional<double>& sweep, const std::optional<double>
 }
 
 int run(const std::string& rig_name, const std::string& body, int every, const std::vector<Case>& cases) {
-  std::string path = rig_name;
-  if (rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos) {
-    StatusOr<std::string> p = hw::shipped_rig_path(rig_name);
-    if (!p.ok()) return std::fprintf(stderr, "%s\n", p.status().message().c_str()), 1;
-    path = *p;
-  }
-  StatusOr<hw::RigDescription> loaded = hw::load_rig_description(path);
-  if (!loaded.ok()) return std::fprintf(stderr, "%s\n", loaded.status().message().c_str()), 1;
-  TriangleMesh subject;
-  if (!body.empty()) {
-    StatusOr<TriangleMesh> m = read_ply_mesh(body);
-    if (!m.ok()) return std::fprintf(stderr, "%s\n", m.status().message().c_str()), 1;
-    subject = std::move(*m);
-  }
   std::printf("rig %s, body %s, every %d laser steps\n\n", rig_name.c_str(),
               body.empty() ? "(the rig's)" : body.c_str(), every);
   std::printf(
@@ -67,13 +51,13 @@ int run(const std::string& rig_name, const std::string& body, int every, const s
   int disagreements = 0;
   for (const Case& c : cases) {
     pipeline::SimulatedSubject s;
+    s.body = body;
     s.posture.arm_abduction_deg = {c.arms, c.arms};
     s.posture.ankle_distance_mm = c.feet;
     s.turn_deg = c.turn;
-    const hw::RigDescription desc = s.applied_to(*loaded);
-    StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> sim =
-        body.empty() ? hw::sim::SimulatedRig::create(desc) : hw::sim::SimulatedRig::create(desc, subject);
+    StatusOr<std::unique_ptr<hw::sim::SimulatedRig>> sim = pipeline::open_simulated_rig(rig_name, s);
     if (!sim.ok()) return std::fprintf(stderr, "%s\n", sim.status().message().c_str()), 1;
+    const hw::RigDescription& desc = (*sim)->description();
     const pipeline::Rig rig = pipeline::rig_handle(**sim);
     if (!calibration) {  // the rig, not the subject: calibrated once
       StatusOr<pipeline::RigCalibration> cal = pipeline::calibrate_rig(rig);

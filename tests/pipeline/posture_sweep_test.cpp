@@ -22,16 +22,13 @@ Posed posed_rig(double arms, double feet, double turn, Eigen::Vector2d at) {
   s.posture.ankle_distance_mm = feet;
   s.turn_deg = turn;
   s.position_mm = at;
-  StatusOr<hw::RigDescription> desc = hw::load_rig_description(*hw::shipped_rig_path("thesis"));
-  EXPECT_TRUE(desc.ok()) << desc.status().message();
-  const hw::RigDescription posed = s.applied_to(*desc);
-  auto rig = hw::sim::SimulatedRig::create(posed);
+  auto rig = open_simulated_rig("thesis", s);
   EXPECT_TRUE(rig.ok()) << rig.status().message();
   Posed out;
   if (!rig.ok()) return out;
   out.rig = std::move(rig).value();
   BodyMeasureOptions mo;
-  mo.floor_y = -0.5 * posed.frame.tube;
+  mo.floor_y = -0.5 * out.rig->description().frame.tube;
   StatusOr<BodyMeasurements> truth = measure_body(out.rig->scene().subject(), mo);
   EXPECT_TRUE(truth.ok()) << truth.status().message();
   if (truth.ok()) out.truth = std::move(*truth);
