@@ -39,11 +39,11 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 if ((!fuzz_only)); then
   # Left out: the test that runs the server out of descriptors (UBSan's type
   # check opens a pipe to probe an object's memory, and without one reports every
-  # type it checks as invalid), and the two that scan a whole body and
-  # reconstruct it (tens of minutes under the sanitizers, past their waits); the
-  # other scan tests stop mid-scan.
+  # type it checks as invalid), and the three that scan a whole body and
+  # reconstruct it, the posture check's sweep among them (tens of minutes under
+  # the sanitizers, past their waits); the other scan tests stop mid-scan.
   (cd "$BUILD_DIR" && ctest --output-on-failure -j "$(nproc)" --timeout 900 -L 'storage|hw|server' \
-    -E 'ServeCli.RunningOutOfDescriptorsBacksOffAndRecovers|ServeCli.SigtermMidScanCancelsTheScanAndStopsCleanly|ApiScan.SimulatedScanThroughTheApiWithLiveEvents')
+    -E 'ServeCli.RunningOutOfDescriptorsBacksOffAndRecovers|ServeCli.SigtermMidScanCancelsTheScanAndStopsCleanly|ApiScan.SimulatedScanThroughTheApiWithLiveEvents|ApiScan.PostureCheckReadsHowTheCustomerStandsAndStoresNothing')
 fi
 
 findings="$BUILD_DIR/fuzz-findings"
