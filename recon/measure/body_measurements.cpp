@@ -63,16 +63,19 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
     rules::PerSide<std::optional<rules::ArmAxes>> arm_axes;
     for (Side side : kBothSides) arm_axes[side] = rules::find_arm_axes(cuts, sheet, arms[side].apart_y, crotch_y, side);
     for (Side side : kBothSides) {
-      // An arm lost against the flank borrows the other's axis, mirrored (customers
-      // hold both arms alike; the other's axis is steadier than an outer side that a
-      // heavy arm's bulges bend); with both lost, each is read from its outer side.
+      // An arm lost against the flank is read from its outer side, whose slope a
+      // heavy arm's bulges tilt outward. It touches the flank, and so hangs no
+      // farther out than the other arm where that one is followed clear of the body:
+      // the steeper of its outer side and the other's axis, mirrored.
       std::optional<Eigen::Vector3d> upper_arm;
       if (arm_axes[side]) {
         upper_arm = arm_axes[side]->upper_dir;
-      } else if (const auto& other = arm_axes[rules::opposite(side)]) {
-        upper_arm = Eigen::Vector3d(-other->upper_dir.x(), other->upper_dir.y(), other->upper_dir.z());
       } else {
         upper_arm = rules::outer_side_axis(cuts, arms[side].apart_y, side);
+        if (const auto& other = arm_axes[rules::opposite(side)]) {
+          const Eigen::Vector3d mirrored(-other->upper_dir.x(), other->upper_dir.y(), other->upper_dir.z());
+          if (!upper_arm || std::abs(mirrored.y()) > std::abs(upper_arm->y())) upper_arm = mirrored;
+        }
       }
       RETURN_IF_ERROR(rules::find_shoulder_point(cuts, sheet, arms[side].apart_y, upper_arm, side));
     }

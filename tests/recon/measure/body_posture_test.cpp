@@ -21,9 +21,11 @@ struct Posed {
   BodyMeasurements measured;
 };
 
-const Posed& posed(const std::string& file, double arms, double ankles) {
+// arms: both arms' abduction, or {left, right}; 0 keeps the rest pose's.
+const Posed& posed(const std::string& file, std::pair<double, double> arms, double ankles) {
   static std::map<std::string, Posed> cache;
-  const std::string key = file + "/" + std::to_string(arms) + "/" + std::to_string(ankles);
+  const std::string key =
+      file + "/" + std::to_string(arms.first) + "," + std::to_string(arms.second) + "/" + std::to_string(ankles);
   auto it = cache.find(key);
   if (it == cache.end()) {
     auto rest = read_ply_mesh(BODYSCAN_SOURCE_DIR "/hw/sim/bodies/" + file);
@@ -31,7 +33,7 @@ const Posed& posed(const std::string& file, double arms, double ankles) {
     auto poser = hw::sim::BodyPoser::shipped();
     EXPECT_TRUE(poser.ok());
     hw::SubjectPosture p;
-    if (arms > 0) p.arm_abduction_deg = {arms, arms};
+    if (arms.first > 0) p.arm_abduction_deg = {arms.first, arms.second};
     if (ankles > 0) p.ankle_distance_mm = ankles;
     auto body = (*poser)->pose(*rest, p);
     EXPECT_TRUE(body.ok()) << body.status().message();
@@ -40,6 +42,10 @@ const Posed& posed(const std::string& file, double arms, double ankles) {
     it = cache.emplace(key, Posed{std::move(*body), measured.ok() ? *measured : BodyMeasurements{}}).first;
   }
   return it->second;
+}
+
+const Posed& posed(const std::string& file, double arms, double ankles) {
+  return posed(file, std::pair{arms, arms}, ankles);
 }
 
 const PostureCheck* check(const BodyMeasurements& b, const std::string& part) {
@@ -183,6 +189,31 @@ TEST(HeavyBodyPosture, ElbowsAndShouldersKeepToTheirSkin) {
     }
   }
   EXPECT_GE(against, 2);  // the rule for an arm against the flank is exercised
+}
+
+// One arm lowered against the flank, the other held out: the lowered arm's
+// shoulder point keeps to its skin whatever the other does. The arm against the
+// body cannot be followed; its slope is read from its outer side, which a heavy
+// arm's bulges tilt outward, or from the other arm mirrored, which hangs no
+// closer in than one touching the flank. male_heavy's arm at 18 degrees lies
+// against the flank; taking the other's 30 degrees put its shoulder point 19 mm
+// out along the skin, and its outer side alone (36 degrees at 15) 32 mm.
+TEST(HeavyBodyPosture, AnArmAgainstTheFlankKeepsItsShoulderWhateverTheOtherDoes) {
+  const Posed& rest = posed("male_heavy.ply", 0, 0);
+  int one_against = 0;
+  for (const double ankles : {0.0, 220.0}) {
+    for (const auto& [lowered, other] : {std::pair{15.0, 15.0}, {18.0, 25.0}, {18.0, 30.0}, {18.0, 40.0}}) {
+      const Posed& p = posed("male_heavy.ply", std::pair{lowered, other}, ankles);
+      const auto& against = p.measured.posture.arm_against_body;
+      one_against += against[0] != against[1] ? 1 : 0;
+      for (const int side : {0, 1}) {
+        const std::string sd = side == 0 ? "left" : "right";
+        EXPECT_LT(drift(rest, p, "shoulder_point_" + sd), 10)
+            << sd << ", arms " << lowered << "/" << other << ", ankles " << ankles;
+      }
+    }
+  }
+  EXPECT_GE(one_against, 2);  // the rule for one arm against the flank is exercised
 }
 
 // Feet 150 mm apart: the thighs come close under the crotch (on heavier bodies
