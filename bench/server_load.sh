@@ -102,7 +102,7 @@ job_line() {  # "state stage fraction"
 
 start_scan() {  # EVERY; sets job_id and scan_id
   local out
-  out="$(api POST /api/scans "{\"customer\":{\"name\":\"Bench\"},\"every\":$1}")"
+  out="$(api POST /api/scans "{\"customer\":{\"name\":\"Bench\"},\"consent\":true,\"every\":$1}")"
   [[ "$(status)" == 202 ]] || { log "POST /api/scans (every=$1): HTTP $(status): $out"; exit 1; }
   scan_id="$(jget 'j["job"]["scan_id"]' <<<"$out")"
   job_id="$(jget 'j["job"]["id"]' <<<"$out")"
@@ -219,7 +219,7 @@ start_scan 1
 long_job="$job_id"
 log "scan $scan_id (job $long_job, every=1) started"
 sleep 2  # past the job's first moments
-out="$(api POST /api/scans '{"customer":{"name":"Bench (should be refused)"},"every":12}')"
+out="$(api POST /api/scans '{"customer":{"name":"Bench (should be refused)"},"consent":true,"every":12}')"
 busy_check="a second POST /api/scans while it runs: HTTP $(status)"
 [[ "$(status)" == 409 ]] || busy_check+=" (expected 409): $out"
 notes+=("- $busy_check")

@@ -50,6 +50,8 @@ void usage(FILE* out) {
                "%s"
                "  --every N          scans use every Nth laser step unless asked otherwise\n"
                "                     (default 1)\n"
+               "  --retention-days N erase scans that started more than N days ago, at start\n"
+               "                     and hourly (logged in the audit); default: keep them\n"
                "  --operator-dot-grid\n"
                "                     calibration asks a person to hold the lens board before\n"
                "                     the simulated cameras too, as it does before real ones\n"
@@ -138,6 +140,10 @@ int run_serve(int argc, char** argv) {
       auto n = number(1, 1000);
       if (!n) return 2;
       wo.default_every = *n;
+    } else if (a == "--retention-days") {
+      auto n = number(1, 36500);
+      if (!n) return 2;
+      wo.retention_days = *n;
     } else if (a == "--web")
       ao.web_root = v;
     else if (a == "--trusted-proxy")

@@ -20,7 +20,11 @@ nlohmann::json customer_json(const storage::Customer& c) {
   return {{"id", c.id},
           {"name", c.name ? nlohmann::json(*c.name) : nlohmann::json()},
           {"contact", c.contact ? nlohmann::json(*c.contact) : nlohmann::json()},
-          {"created_at", c.created_at}};
+          {"created_at", c.created_at},
+          {"consent", c.consent ? nlohmann::json{{"given_at", c.consent->given_at},
+                                                 {"recorded_by", c.consent->recorded_by},
+                                                 {"terms", c.consent->terms}}
+                                : nlohmann::json()}};
 }
 
 nlohmann::json scan_json(const storage::ScanRecord& r) {
@@ -144,6 +148,10 @@ HttpResponse sheet(Workstation& ws, const Call& call, const std::string& format)
 }  // namespace
 
 void add_scan_routes(std::vector<Api::Route>* routes) {
+  // What a customer agrees to before their first scan, for the station to show.
+  routes->push_back({"GET", "/api/consent", kStaff, [](Workstation& ws, const Call&) {
+                       return json_response(200, {{"terms", ws.consent_terms()}});
+                     }});
   routes->push_back({"GET", "/api/customers", kStaff, [](Workstation& ws, const Call& call) {
                        auto list = ws.archive().customers(call.request.param("q"));
                        if (!list.ok()) return error_response(list.status());

@@ -6,6 +6,8 @@
 
 #include "server/api/api.hpp"
 #include "server/api/scan_views.hpp"
+#include "server/pipeline/share_model.hpp"
+#include "storage/formats/draco_files.hpp"
 
 namespace bodyscan::server {
 
@@ -20,7 +22,8 @@ nlohmann::json share_json(const ShareLink& s) {
           {"created_by", s.created_by},
           {"created_at", s.created_at},
           {"expires_at", s.expires_at},
-          {"revoked", s.revoked}};
+          {"revoked", s.revoked},
+          {"include_head", s.include_head}};
 }
 
 std::string link_base(const ApiOptions& o, const HttpRequest& r) {
@@ -40,7 +43,7 @@ void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options
                        if (!r.ok()) return error_response(r.status());
                        if (r->current_version == 0)
                          return error_response(409, "scan " + id + " has no results to share");
-                       const nlohmann::json days = body->value("days", nlohmann::json(30));
+                       const nlohmann::json days = body->value("days", nlohmann::json(7));
                        if (!days.is_number() || !(days.get<double>() > 0) || days.get<double>() > 365)
                          return error_response(400, "'days' is how long the link works: more than 0, at most 365");
                        std::vector<std::string> names;
@@ -52,8 +55,11 @@ void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options
                            names.push_back(n);
                          }
                        }
+                       const nlohmann::json head = body->value("include_head", nlohmann::json(false));
+                       if (!head.is_boolean())
+                         return error_response(400, "'include_head' is true to show the head (default: left out)");
                        const int64_t seconds = std::max<int64_t>(1, std::llround(days.get<double>() * kDay));
-                       auto made = ws.auth().create_share(id, names, seconds, call.actor());
+                       auto made = ws.auth().create_share(id, names, seconds, call.actor(), head.get<bool>());
                        if (!made.ok()) return error_response(made.status());
                        ws.archive().log(call.actor(), "share scan", "scan", id, made->link.id);
                        nlohmann::json out = share_json(made->link);
@@ -99,12 +105,34 @@ void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options
          out.set("Referrer-Policy", "no-referrer");
          return out;
        }});
-  routes->push_back({"GET", "/api/share/{token}/mesh.glb", kShareLink, [](Workstation& ws, const Call& call) {
-                       HttpResponse out =
-                           scan_file(ws, call.share->scan_id, "mesh.glb", "", call.request.header("if-none-match"));
-                       out.set("Referrer-Policy", "no-referrer");
-                       return out;
-                     }});
+  routes->push_back(
+      {"GET", "/api/share/{token}/mesh.glb", kShareLink, [](Workstation& ws, const Call& call) {
+         const std::string& scan = call.share->scan_id;
+         HttpResponse out;
+         if (call.share->include_head) {
+           out = scan_file(ws, scan, "mesh.glb", "", call.request.header("if-none-match"));
+         } else {
+           // Made once per change of the archive and kept, as the
+           // measurements are: the cut and the Draco encoding take a second.
+           auto text = ws.cached_text("headless.glb/" + scan, [&]() -> StatusOr<std::string> {
+             ASSIGN_OR_RETURN(std::vector<storage::MeasurementRecord> ms, ws.archive().measurements(scan));
+             ASSIGN_OR_RETURN(const double cut, pipeline::head_cut_height(ms));
+             ASSIGN_OR_RETURN(std::shared_ptr<const TriangleMesh> mesh, ws.surface(scan));
+             ASSIGN_OR_RETURN(storage::DracoEncoded glb, storage::encode_glb(pipeline::below_height(*mesh, cut)));
+             return std::move(glb.bytes);
+           });
+           if (!text.ok()) return error_response(text.status());
+           out.set("Content-Type", "model/gltf-binary");
+           out.set("Cache-Control", "private, no-cache");
+           out.set("ETag", (*text)->etag);
+           if (call.request.header("if-none-match") == (*text)->etag)
+             out.status = 304;
+           else
+             out.body = (*text)->body;
+         }
+         out.set("Referrer-Policy", "no-referrer");
+         return out;
+       }});
 }
 
 }  // namespace bodyscan::server

@@ -301,9 +301,17 @@ struct AuthStore::Impl {
         created_at TEXT NOT NULL,
         created_at_s INTEGER NOT NULL,
         expires_at INTEGER NOT NULL,
-        revoked INTEGER NOT NULL DEFAULT 0);
+        revoked INTEGER NOT NULL DEFAULT 0,
+        include_head INTEGER NOT NULL DEFAULT 0);
       CREATE INDEX IF NOT EXISTS shares_by_scan ON shares(scan_id);
     )sql"));
+    // Links made before the head could be left out showed it: they keep doing so.
+    {
+      ASSIGN_OR_RETURN(Statement cols,
+                       db.prepare("SELECT 1 FROM pragma_table_info('shares') WHERE name = 'include_head'"));
+      ASSIGN_OR_RETURN(bool has, cols.step());
+      if (!has) RETURN_IF_ERROR(db.exec("ALTER TABLE shares ADD COLUMN include_head INTEGER NOT NULL DEFAULT 1"));
+    }
     ASSIGN_OR_RETURN(Statement ins, db.prepare("INSERT OR IGNORE INTO meta(key, value) VALUES ('schema_version', ?)"));
     RETURN_IF_ERROR(ins.bind(1, std::to_string(kSchemaVersion)).run());
     ASSIGN_OR_RETURN(Statement st, db.prepare("SELECT value FROM meta WHERE key = 'schema_version'"));
@@ -416,11 +424,12 @@ struct AuthStore::Impl {
   }
 
   static StatusOr<ShareLink> read_share(const Statement& st) {
-    // Columns: id, scan_id, measurements, created_by, created_at, expires_at, revoked.
+    // Columns: id, scan_id, measurements, created_by, created_at, expires_at, revoked, include_head.
     ShareLink l;
     l.id = st.text(0), l.scan_id = st.text(1), l.created_by = st.text(3), l.created_at = st.text(4);
     l.expires_at = st.integer(5);
     l.revoked = st.integer(6) != 0;
+    l.include_head = st.integer(7) != 0;
     const auto j = parse_json(st.text(2));
     if (!j.is_array()) return internal_error("accounts: share " + l.id + " has damaged measurements");
     for (const auto& m : j) {
@@ -684,7 +693,7 @@ void AuthStore::unwatch_sessions(int id) {
 // --- share links ---------------------------------------------------------------
 
 StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id, const std::vector<std::string>& measurements,
-                                           int64_t valid_for_s, const std::string& created_by) {
+                                           int64_t valid_for_s, const std::string& created_by, bool include_head) {
   if (scan_id.empty() || scan_id.size() > kMaxScanId) return invalid_argument("share: bad scan id");
   if (valid_for_s <= 0 || valid_for_s > kMaxShareValidity)
     return invalid_argument("share: validity must be more than 0 seconds and at most 365 days");
@@ -707,12 +716,13 @@ StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id, const std
   l.created_by = created_by;
   l.created_at = storage::iso8601_utc(now);
   l.expires_at = now + valid_for_s;
+  l.include_head = include_head;
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Statement st,
-                   impl_->db.prepare("INSERT INTO shares(id, token_hash, scan_id, measurements, created_by, "
-                                     "created_at, created_at_s, expires_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?)"));
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("INSERT INTO shares(id, token_hash, scan_id, measurements, "
+                                                   "created_by, created_at, created_at_s, expires_at, include_head) "
+                                                   "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)"));
   st.bind(1, l.id).bind(2, token_hash(out.token)).bind(3, l.scan_id).bind(4, names_json).bind(5, l.created_by);
-  RETURN_IF_ERROR(st.bind(6, l.created_at).bind(7, now).bind(8, l.expires_at).run());
+  RETURN_IF_ERROR(st.bind(6, l.created_at).bind(7, now).bind(8, l.expires_at).bind(9, include_head ? 1 : 0).run());
   return out;
 }
 
@@ -722,12 +732,12 @@ std::optional<ShareLink> AuthStore::share_by_token(const std::string& token) {
   const int64_t now = impl_->now();
   std::lock_guard lock(impl_->mu);
   auto st = impl_->db.prepare(
-      "SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked, token_hash "
+      "SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked, include_head, token_hash "
       "FROM shares WHERE token_hash = ?");
   if (!st.ok()) return std::nullopt;
   st->bind(1, hash);
   const auto row = st->step();
-  if (!row.ok() || !*row || !same_hash(st->text(7), hash)) return std::nullopt;
+  if (!row.ok() || !*row || !same_hash(st->text(8), hash)) return std::nullopt;
   auto link = Impl::read_share(*st);
   if (!link.ok() || link->revoked || now >= link->expires_at) return std::nullopt;
   return std::move(*link);
@@ -736,8 +746,8 @@ std::optional<ShareLink> AuthStore::share_by_token(const std::string& token) {
 StatusOr<std::vector<ShareLink>> AuthStore::shares(const std::string& scan_id) const {
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Statement st,
-                   impl_->db.prepare("SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked "
-                                     "FROM shares WHERE scan_id = ? ORDER BY created_at_s, rowid"));
+                   impl_->db.prepare("SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked, "
+                                     "include_head FROM shares WHERE scan_id = ? ORDER BY created_at_s, rowid"));
   st.bind(1, scan_id);
   std::vector<ShareLink> out;
   for (;;) {

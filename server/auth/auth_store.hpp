@@ -59,6 +59,8 @@ struct ShareLink {
   std::string created_by, created_at;     // created_at: ISO 8601 UTC
   int64_t expires_at = 0;                 // unix seconds
   bool revoked = false;
+  // Staff chose to show the head; otherwise the model the link serves has none.
+  bool include_head = false;
 };
 
 // token: 128-bit random, base64url (22 chars). Returned once; only its hash is kept.
@@ -146,7 +148,7 @@ class AuthStore {
 
   // Share links. valid_for_s in (0, 365 days].
   StatusOr<NewShare> create_share(const std::string& scan_id, const std::vector<std::string>& measurements,
-                                  int64_t valid_for_s, const std::string& created_by);
+                                  int64_t valid_for_s, const std::string& created_by, bool include_head = false);
   std::optional<ShareLink> share_by_token(const std::string& token);          // unexpired and not revoked
   StatusOr<std::vector<ShareLink>> shares(const std::string& scan_id) const;  // all, oldest first
   Status revoke_share(const std::string& share_id);                           // not_found if unknown

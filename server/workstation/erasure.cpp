@@ -22,4 +22,18 @@ Status erase_scan(storage::Archive& archive, AuthStore* accounts, const std::str
   return archive.delete_scan(scan_id, actor);
 }
 
+StatusOr<std::vector<std::string>> erase_scans_started_before(storage::Archive& archive, AuthStore* accounts,
+                                                              const std::string& before, const std::string& actor) {
+  storage::ScanQuery q;
+  q.limit = 1 << 30;
+  ASSIGN_OR_RETURN(std::vector<storage::ScanRecord> scans, archive.scans(q));
+  std::vector<std::string> erased;
+  for (const storage::ScanRecord& s : scans) {
+    if (s.status == storage::ScanStatus::kRunning || !(s.started_at < before)) continue;
+    RETURN_IF_ERROR(erase_scan(archive, accounts, s.id, actor));
+    erased.push_back(s.id);
+  }
+  return erased;
+}
+
 }  // namespace bodyscan::server

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "recon/core/status.hpp"
 #include "server/auth/auth_store.hpp"
@@ -17,5 +18,9 @@ namespace bodyscan::server {
 Status erase_customer(storage::Archive& archive, AuthStore* accounts, const std::string& customer_id,
                       const std::string& actor);
 Status erase_scan(storage::Archive& archive, AuthStore* accounts, const std::string& scan_id, const std::string& actor);
+// A shop's retention period: erases every scan that started before `before`
+// (ISO 8601 UTC) and is not running, as erase_scan does. Returns the ids erased.
+StatusOr<std::vector<std::string>> erase_scans_started_before(storage::Archive& archive, AuthStore* accounts,
+                                                              const std::string& before, const std::string& actor);
 
 }  // namespace bodyscan::server

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <list>
@@ -25,6 +26,7 @@
 #include "server/pipeline/rig_backend.hpp"
 #include "server/pipeline/scan_job.hpp"
 #include "server/pipeline/scan_recording.hpp"
+#include "server/workstation/erasure.hpp"
 #include "server/workstation/preview.hpp"
 #include "storage/archive/ids.hpp"
 
@@ -105,6 +107,7 @@ constexpr const char* kCalibrationFile = "calibration-record.json";  // in DATA/
 
 struct Workstation::Impl {
   WorkstationOptions options;
+  std::string consent_terms;  // options.consent_terms or the default
   std::unique_ptr<storage::Archive> archive;
   std::unique_ptr<AuthStore> auth;
   std::unique_ptr<hw::DeviceRig> devices;
@@ -121,6 +124,8 @@ struct Workstation::Impl {
   std::atomic<bool> cancel{false};
   std::string cancel_reason;
   std::thread worker;
+  std::thread retention;  // erases expired scans hourly (options.retention_days)
+  std::condition_variable retention_cv;
   std::vector<std::thread> retired;  // finished jobs' threads, joined at shutdown
   bool stopped = false;
   std::condition_variable prompt_cv;  // a prompt answered, a job cancelled
@@ -304,6 +309,7 @@ StatusOr<std::unique_ptr<Workstation>> Workstation::open(const WorkstationOption
   if (sodium_init() < 0) return internal_error("libsodium failed to start");
   auto impl = std::make_unique<Impl>();
   impl->options = options;
+  impl->consent_terms = options.consent_terms.empty() ? default_consent_terms() : options.consent_terms;
   std::error_code ec;
   std::filesystem::create_directories(options.data_dir, ec);
   if (ec) return io_error(options.data_dir + ": cannot create the data folder: " + ec.message());
@@ -319,7 +325,34 @@ StatusOr<std::unique_ptr<Workstation>> Workstation::open(const WorkstationOption
   RETURN_IF_ERROR(impl->rig.controller->all_lasers_off());
   impl->load_calibration();
   impl->load_calibration_from_archive();
-  return std::unique_ptr<Workstation>(new Workstation(std::move(impl)));
+  auto ws = std::unique_ptr<Workstation>(new Workstation(std::move(impl)));
+  if (options.retention_days > 0) {
+    RETURN_IF_ERROR(ws->erase_expired_scans(unix_now()).status());
+    Workstation* w = ws.get();
+    ip->retention = std::thread([w, ip]() {
+      std::unique_lock lock(ip->mutex);
+      while (!ip->retention_cv.wait_for(lock, std::chrono::hours(1), [ip] { return ip->stopped; })) {
+        lock.unlock();
+        // A failure (a full disk) is retried in an hour; the scans stay meanwhile.
+        if (StatusOr<size_t> n = w->erase_expired_scans(unix_now()); !n.ok())
+          std::fprintf(stderr, "bodyscan: retention: %s\n", n.status().message().c_str());
+        lock.lock();
+      }
+    });
+  }
+  return ws;
+}
+
+StatusOr<size_t> Workstation::erase_expired_scans(int64_t now) {
+  const int days = impl_->options.retention_days;
+  if (days <= 0) return size_t{0};
+  const std::string before = storage::iso8601_utc(now - int64_t{days} * 86400);
+  ASSIGN_OR_RETURN(std::vector<std::string> erased,
+                   erase_scans_started_before(*impl_->archive, impl_->auth.get(), before,
+                                              "retention (" + std::to_string(days) + " days)"));
+  if (!erased.empty())
+    std::fprintf(stderr, "bodyscan: retention: erased %zu scan(s) started before %s\n", erased.size(), before.c_str());
+  return erased.size();
 }
 
 storage::Archive& Workstation::archive() { return *impl_->archive; }
@@ -583,14 +616,33 @@ StatusOr<JobInfo> Workstation::start_calibration(const std::string& actor) {
   return j;
 }
 
+std::string default_consent_terms() {
+  return "The shop keeps your name and contact, a 3-D model of your body's shape as the scanner sees it, your body "
+         "measurements, and the scanner's recordings (from which the model and measurements can be made again). "
+         "It keeps them until you ask the shop to erase them, which you may do at any time: everything about you is "
+         "then erased. The shop's staff see them on the shop's workstation; you see your model and the "
+         "measurements the staff choose through a private link the shop gives you. Nothing leaves the shop "
+         "otherwise.";
+}
+
+const std::string& Workstation::consent_terms() const { return impl_->consent_terms; }
+
 StatusOr<JobInfo> Workstation::start_scan(const ScanRequest& request) {
   Impl& s = *impl_;
   s.reap();
   const int every = request.every > 0 ? request.every : s.options.default_every;
   if (every > 1000) return invalid_argument("'every' must be between 1 and 1000");
   ASSIGN_OR_RETURN(storage::Customer customer, s.archive->customer(request.customer_id));
+  if (!customer.consent && !request.consent_given)
+    return failed_precondition("customer " + customer.id +
+                               " has not consented to be scanned: record their consent first (GET /api/consent "
+                               "gives the terms)");
   std::lock_guard lock(s.mutex);
   ASSIGN_OR_RETURN(JobInfo j, s.begin(JobKind::kScan, request.actor));
+  // Recorded once the rig is known to be free, so that a refused start records nothing.
+  if (request.consent_given) {
+    RETURN_IF_ERROR(s.archive->record_consent(customer.id, s.consent_terms, request.actor).status());
+  }
   ASSIGN_OR_RETURN(j.scan_id, s.archive->begin_scan(customer.id, request.actor, s.rig_json, s.calibration_id));
   j.customer_id = customer.id;
   s.run(j, [&s, every]() { return s.do_scan(every); });
@@ -727,6 +779,8 @@ void Workstation::shutdown(const std::string& reason) {
     }
   }
   s.prompt_cv.notify_all();
+  s.retention_cv.notify_all();
+  if (s.retention.joinable()) s.retention.join();
   std::vector<std::thread> threads;
   {
     std::lock_guard lock(s.mutex);

@@ -34,7 +34,15 @@ struct WorkstationOptions {
   int default_every = 1;  // scan every Nth laser step unless a request says
   // Live camera previews during a scan: at most one per camera this often, this wide.
   double preview_interval_s = 1.0;
-  int preview_width = 160;
+  int preview_width = 320;
+  // What a customer agrees to before their first scan (what is stored, for how
+  // long, who sees it), shown by the station and kept word for word with the
+  // consent; empty: default_consent_terms().
+  std::string consent_terms;
+  // Scans that started longer ago than this are erased by the workstation, at
+  // open and every hour after (audit: "delete scan" by "retention"); 0 keeps
+  // them until staff erase them.
+  int retention_days = 0;
   // Calibration asks a person to hold the lens dot-grid board before every real
   // camera (JobInfo::prompt). With this, before the simulated ones too: staff
   // training on the simulated rig (and the tests of the prompt).
@@ -80,7 +88,13 @@ struct ScanRequest {
   std::string customer_id;  // an existing customer
   int every = 0;            // 0: the workstation's default
   std::string actor;
+  // The customer has just agreed to the workstation's consent terms: recorded,
+  // with the time and the actor, before the scan starts.
+  bool consent_given = false;
 };
+
+// The terms a customer agrees to unless the shop sets its own.
+std::string default_consent_terms();
 
 class Workstation {
  public:
@@ -98,9 +112,17 @@ class Workstation {
   // Cameras, lasers, the calibration (age, residuals), the job running.
   nlohmann::json rig_status() const;
 
+  // The consent terms customers agree to (options().consent_terms or the default).
+  const std::string& consent_terms() const;
+  // Erases the scans older than options().retention_days at `now` (unix seconds;
+  // nothing when the period is 0). Returns how many went.
+  StatusOr<size_t> erase_expired_scans(int64_t now);
+
   // A job, started when the rig is free; failed_precondition ("the rig is busy
   // with ...") when another runs. The scan is in the archive, as running, before
   // this returns (so a crash leaves a scan marked failed, never a silent gap).
+  // A scan starts only for a customer whose consent is on record or given with
+  // the request (failed_precondition otherwise, nothing stored).
   StatusOr<JobInfo> start_calibration(const std::string& actor);
   StatusOr<JobInfo> start_scan(const ScanRequest& request);
   StatusOr<JobInfo> start_reprocess(const std::string& scan_id, const std::string& actor);

@@ -185,6 +185,11 @@ struct Archive::Impl {
         id INTEGER PRIMARY KEY, at TEXT NOT NULL, actor TEXT NOT NULL, action TEXT NOT NULL,
         target_kind TEXT NOT NULL, target_id TEXT NOT NULL, detail TEXT NOT NULL);
       CREATE INDEX IF NOT EXISTS audit_target ON audit(target_id);
+      CREATE TABLE IF NOT EXISTS consents(
+        id INTEGER PRIMARY KEY,
+        customer_id TEXT NOT NULL REFERENCES customers(id) ON DELETE CASCADE,
+        given_at TEXT NOT NULL, recorded_by TEXT NOT NULL, terms TEXT NOT NULL);
+      CREATE INDEX IF NOT EXISTS consents_customer ON consents(customer_id);
     )sql"));
     ASSIGN_OR_RETURN(Statement get, db.prepare("SELECT value FROM meta WHERE key = 'schema'"));
     ASSIGN_OR_RETURN(bool row, get.step());
@@ -463,7 +468,7 @@ StatusOr<std::unique_ptr<Archive>> Archive::open(const std::string& dir_in) {
 StatusOr<Customer> Archive::add_customer(const std::optional<std::string>& name,
                                          const std::optional<std::string>& contact, const std::string& actor) {
   std::lock_guard lock(impl_->mu);
-  Customer c{"c_" + random_hex(8), name, contact, now_iso()};
+  Customer c{"c_" + random_hex(8), name, contact, now_iso(), std::nullopt};
   ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
   ASSIGN_OR_RETURN(Statement st,
                    impl_->db.prepare("INSERT INTO customers(id, name, contact, created_at) VALUES (?, ?, ?, ?)"));
@@ -474,12 +479,37 @@ StatusOr<Customer> Archive::add_customer(const std::optional<std::string>& name,
 }
 
 namespace {
-Customer read_customer(const Statement& st) { return {st.text(0), st.maybe_text(1), st.maybe_text(2), st.text(3)}; }
+// The customer's columns and their latest consent's, as read_customer reads them.
+constexpr const char* kCustomerColumns =
+    "SELECT c.id, c.name, c.contact, c.created_at, k.given_at, k.recorded_by, k.terms FROM customers c "
+    "LEFT JOIN consents k ON k.id = (SELECT max(id) FROM consents WHERE customer_id = c.id) ";
+
+Customer read_customer(const Statement& st) {
+  Customer c{st.text(0), st.maybe_text(1), st.maybe_text(2), st.text(3), std::nullopt};
+  if (std::optional<std::string> at = st.maybe_text(4)) c.consent = Consent{*at, st.text(5), st.text(6)};
+  return c;
+}
 }  // namespace
+
+StatusOr<Consent> Archive::record_consent(const std::string& customer_id, const std::string& terms,
+                                          const std::string& actor) {
+  if (terms.empty()) return invalid_argument("archive: a consent needs the terms the customer agreed to");
+  std::lock_guard lock(impl_->mu);
+  Consent k{now_iso(), actor, terms};
+  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+  ASSIGN_OR_RETURN(std::vector<std::string> found, impl_->ids("SELECT id FROM customers WHERE id = ?", customer_id));
+  if (found.empty()) return not_found("archive: no customer '" + customer_id + "'");
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("INSERT INTO consents(customer_id, given_at, recorded_by, terms) "
+                                                   "VALUES (?, ?, ?, ?)"));
+  RETURN_IF_ERROR(st.bind(1, customer_id).bind(2, k.given_at).bind(3, k.recorded_by).bind(4, k.terms).run());
+  RETURN_IF_ERROR(impl_->log(actor, "record consent", "customer", customer_id, ""));
+  RETURN_IF_ERROR(tx.commit());
+  return k;
+}
 
 StatusOr<Customer> Archive::customer(const std::string& id) const {
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("SELECT id, name, contact, created_at FROM customers WHERE id = ?"));
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare(std::string(kCustomerColumns) + "WHERE c.id = ?"));
   st.bind(1, id);
   ASSIGN_OR_RETURN(bool row, st.step());
   if (!row) return not_found("archive: no customer '" + id + "'");
@@ -489,9 +519,10 @@ StatusOr<Customer> Archive::customer(const std::string& id) const {
 StatusOr<std::vector<Customer>> Archive::customers(const std::string& text) const {
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Statement st,
-                   impl_->db.prepare("SELECT id, name, contact, created_at FROM customers WHERE ?1 = '' OR "
-                                     "instr(lower(id), lower(?1)) OR instr(lower(IFNULL(name, '')), lower(?1)) OR "
-                                     "instr(lower(IFNULL(contact, '')), lower(?1)) ORDER BY created_at DESC"));
+                   impl_->db.prepare(std::string(kCustomerColumns) +
+                                     "WHERE ?1 = '' OR instr(lower(c.id), lower(?1)) OR "
+                                     "instr(lower(IFNULL(c.name, '')), lower(?1)) OR "
+                                     "instr(lower(IFNULL(c.contact, '')), lower(?1)) ORDER BY c.created_at DESC"));
   st.bind(1, text);
   std::vector<Customer> out;
   for (;;) {
@@ -878,7 +909,11 @@ Status Archive::export_customer(const std::string& id, const std::string& dest, 
                          {{"id", c.id},
                           {"name", c.name ? nlohmann::json(*c.name) : nlohmann::json()},
                           {"contact", c.contact ? nlohmann::json(*c.contact) : nlohmann::json()},
-                          {"created_at", c.created_at}}},
+                          {"created_at", c.created_at},
+                          {"consent", c.consent ? nlohmann::json{{"given_at", c.consent->given_at},
+                                                                 {"recorded_by", c.consent->recorded_by},
+                                                                 {"terms", c.consent->terms}}
+                                                : nlohmann::json()}}},
                         {"scans", nlohmann::json::array()},
                         {"audit", nlohmann::json::array()}};
   const fs::path out(dest);

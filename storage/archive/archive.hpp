@@ -37,10 +37,19 @@
 
 namespace bodyscan::storage {
 
+// A customer's consent to be scanned and kept: the terms they agreed to, word
+// for word (what is stored, for how long, who sees it), when, and the staff
+// member who recorded it.
+struct Consent {
+  std::string given_at;  // ISO 8601 UTC
+  std::string recorded_by, terms;
+};
+
 struct Customer {
   std::string id;  // pseudonymous, random ("c_" + 16 hex digits)
   std::optional<std::string> name, contact;
-  std::string created_at;  // ISO 8601 UTC
+  std::string created_at;          // ISO 8601 UTC
+  std::optional<Consent> consent;  // the latest recorded; none: no scan may start
 };
 
 enum class ScanStatus { kRunning, kComplete, kFailed, kCancelled };
@@ -126,6 +135,9 @@ class Archive {
                                   const std::string& actor);
   StatusOr<Customer> customer(const std::string& id) const;
   StatusOr<std::vector<Customer>> customers(const std::string& text = "") const;
+  // Records that the customer agreed to `terms` now; the latest consent is the
+  // customer's. Erasing the customer erases it.
+  StatusOr<Consent> record_consent(const std::string& customer_id, const std::string& terms, const std::string& actor);
   // Everything derived from the customer goes: records, files, audit entries
   // naming them or their scans (one entry says a customer was erased, and by whom).
   Status delete_customer(const std::string& id, const std::string& actor);

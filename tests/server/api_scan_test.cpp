@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -48,14 +49,14 @@ TEST(ApiScan, SimulatedScanThroughTheApiWithLiveEvents) {
                         "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\nCookie: " +
                         op.cookie + "\r\n\r\n"));
 
-  const HttpReply started = op.post("/api/scans", R"({"customer": {"name": "Walk-in"}})");
+  const HttpReply started = op.post("/api/scans", R"({"customer": {"name": "Walk-in"}, "consent": true})");
   ASSERT_EQ(started.status, 202) << started.body;
   const nlohmann::json job = parse(started)["job"];
   const std::string job_id = job["id"], scan_id = job["scan_id"];
   EXPECT_EQ(started.header("location"), "/api/jobs/" + job_id);
   // The archive has it as running before the rig moves.
   EXPECT_EQ(parse(op.get("/api/scans/" + scan_id))["status"], "running");
-  const HttpReply second = op.post("/api/scans", R"({"customer": {"name": "Next"}})");
+  const HttpReply second = op.post("/api/scans", R"({"customer": {"name": "Next"}, "consent": true})");
   EXPECT_EQ(second.status, 409);
   EXPECT_NE(second.body.find("busy"), std::string::npos) << second.body;
   EXPECT_EQ(op.post("/api/rig/calibrate").status, 409);
@@ -203,6 +204,135 @@ TEST(ApiScan, CancelStopsTheScanAndTurnsTheLasersOff) {
   EXPECT_EQ(op.post("/api/jobs/j_unknown/cancel").status, 404);
 }
 
+// No scan starts, and no customer record is made, without the customer's
+// consent: given with the scan, it is recorded with the terms the station
+// showed, the time and the operator; once on record, later scans need no more.
+TEST(ApiScan, NoScanStartsWithoutTheCustomersConsent) {
+  ServerUnderTest s(12);
+  Client op = s.as("op");
+  const nlohmann::json terms = parse(op.get("/api/consent"));
+  ASSERT_TRUE(terms["terms"].is_string());
+  EXPECT_NE(terms["terms"].get<std::string>().find("erase"), std::string::npos) << terms.dump();
+  const size_t customers_before = parse(op.get("/api/customers"))["customers"].size();
+  const size_t scans_before = parse(op.get("/api/scans"))["scans"].size();
+  HttpReply r = op.post("/api/scans", R"({"customer": {"name": "Unasked"}})");
+  EXPECT_EQ(r.status, 409);
+  EXPECT_NE(r.body.find("consent"), std::string::npos) << r.body;
+  EXPECT_EQ(op.post("/api/scans", R"({"customer": {"name": "Unasked"}, "consent": false})").status, 409);
+  EXPECT_EQ(op.post("/api/scans", R"({"customer": {"name": "Unasked"}, "consent": "yes"})").status, 400);
+  EXPECT_EQ(parse(op.get("/api/customers"))["customers"].size(), customers_before);
+
+  // A customer added on their own has no consent on record: their scan waits for it.
+  const nlohmann::json added = parse(op.post("/api/customers", R"({"name": "Walk-in"})"));
+  ASSERT_TRUE(added["id"].is_string()) << added.dump();
+  EXPECT_TRUE(added["consent"].is_null()) << added.dump();
+  const std::string id = added["id"];
+  r = op.post("/api/scans", "{\"customer_id\": \"" + id + "\"}");
+  EXPECT_EQ(r.status, 409);
+  EXPECT_NE(r.body.find("consent"), std::string::npos) << r.body;
+  EXPECT_EQ(parse(op.get("/api/scans"))["scans"].size(), scans_before);
+
+  r = op.post("/api/scans", "{\"customer_id\": \"" + id + "\", \"consent\": true}");
+  ASSERT_EQ(r.status, 202) << r.body;
+  EXPECT_EQ(op.post("/api/jobs/" + parse(r)["job"]["id"].get<std::string>() + "/cancel").status, 202);
+  wait_job(op, parse(r)["job"]["id"]);
+  const nlohmann::json c = parse(op.get("/api/customers/" + id));
+  ASSERT_TRUE(c["consent"].is_object()) << c.dump();
+  EXPECT_EQ(c["consent"]["terms"], terms["terms"]);
+  EXPECT_EQ(c["consent"]["recorded_by"], "op");
+  EXPECT_TRUE(c["consent"]["given_at"].is_string());
+
+  r = op.post("/api/scans", "{\"customer_id\": \"" + id + "\"}");
+  ASSERT_EQ(r.status, 202) << r.body;
+  op.post("/api/jobs/" + parse(r)["job"]["id"].get<std::string>() + "/cancel");
+  wait_job(op, parse(r)["job"]["id"]);
+  EXPECT_EQ(parse(op.get("/api/scans"))["scans"].size(), scans_before + 2);
+}
+
+// A customer's link shows a body, not a face: the model it serves stops at the
+// neck girth's lowest point, unless staff chose to include the head. The bytes
+// themselves are checked: no vertex above the neck leaves the server.
+TEST(ApiScan, AShareLinkServesTheModelWithoutTheHeadUnlessStaffIncludeIt) {
+  ServerUnderTest s;
+  Client op = s.as("op");
+  const std::string base = "/api/scans/" + s.scan_id;
+  const HttpReply plain = op.post(base + "/shares", "{}");
+  ASSERT_EQ(plain.status, 201) << plain.body;
+  EXPECT_FALSE(parse(plain)["include_head"].get<bool>());
+  const HttpReply with_head = op.post(base + "/shares", R"({"include_head": true})");
+  ASSERT_EQ(with_head.status, 201) << with_head.body;
+  EXPECT_EQ(op.post(base + "/shares", R"({"include_head": "yes"})").status, 400);
+
+  const HttpReply headless_glb =
+      http(s.port, "GET", "/api/share/" + parse(plain)["token"].get<std::string>() + "/mesh.glb");
+  ASSERT_EQ(headless_glb.status, 200);
+  EXPECT_EQ(headless_glb.header("content-type"), "model/gltf-binary");
+  auto headless = storage::decode_glb(headless_glb.body);
+  auto whole = storage::decode_glb(
+      http(s.port, "GET", "/api/share/" + parse(with_head)["token"].get<std::string>() + "/mesh.glb").body);
+  ASSERT_TRUE(headless.ok() && whole.ok());
+  auto top = [](const TriangleMesh& m) {
+    float y = -1e9f;
+    for (const Vec3f& v : m.vertices) y = std::max(y, v.y());
+    return y;
+  };
+  // The neck girth's lowest point on the true body the scan holds.
+  auto measured = measure_body(s.body);
+  ASSERT_TRUE(measured.ok());
+  const BodyMeasurement* neck = measured->find("neck_girth");
+  ASSERT_NE(neck, nullptr);
+  double neck_low = 1e9;
+  for (const Eigen::Vector3d& p : neck->loop.empty() ? neck->path : neck->loop) neck_low = std::min(neck_low, p.y());
+  const float stature = top(s.body);
+  EXPECT_NEAR(top(*whole), stature, 1.0);
+  EXPECT_LE(top(*headless), neck_low + 0.5) << "Draco moves a vertex at most 0.5 mm";
+  EXPECT_LT(neck_low, stature - 200) << "the whole head and the chin lie above the cut";
+  // The body stays: as many triangles as the true body has wholly below the cut
+  // (within 1 %: the archived surface's vertices are quantised by up to 0.5 mm).
+  size_t below = 0;
+  for (const Triangle& t : s.body.triangles) {
+    bool under = true;
+    for (uint32_t v : t) under = under && s.body.vertices[v].y() <= neck_low;
+    below += under ? 1 : 0;
+  }
+  EXPECT_NEAR(static_cast<double>(headless->triangles.size()), static_cast<double>(below), 0.01 * below);
+  // Cached with an ETag, as the staff's model is.
+  const std::string etag = headless_glb.header("etag");
+  ASSERT_FALSE(etag.empty());
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + parse(plain)["token"].get<std::string>() + "/mesh.glb",
+                 {{"If-None-Match", etag}})
+                .status,
+            304);
+}
+
+// A shop's retention period: the workstation erases the scans that started
+// longer ago (with their share links), logs who did it, and keeps the rest and
+// the customer. It runs at open and hourly; here it is asked at chosen times.
+TEST(ApiScan, TheWorkstationErasesScansOlderThanTheRetentionPeriod) {
+  ServerUnderTest s(12, {}, [](server::WorkstationOptions& o) { o.retention_days = 30; });
+  Client admin = s.as("admin");
+  const HttpReply made = admin.post("/api/scans/" + s.scan_id + "/shares", R"({"measurements": ["waist_girth"]})");
+  ASSERT_EQ(made.status, 201) << made.body;
+  const std::string token = parse(made)["token"];
+  const int64_t now = std::time(nullptr);
+  ASSERT_TRUE(s.ws->erase_expired_scans(now).ok());
+  EXPECT_EQ(*s.ws->erase_expired_scans(now), 0u);  // the seeded scan is new
+  EXPECT_EQ(*s.ws->erase_expired_scans(now + 29 * 86400), 0u);
+  EXPECT_EQ(admin.get("/api/scans/" + s.scan_id).status, 200);
+  EXPECT_EQ(*s.ws->erase_expired_scans(now + 31 * 86400), 1u);
+  EXPECT_EQ(admin.get("/api/scans/" + s.scan_id).status, 404);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/" + token).status, 404);
+  EXPECT_EQ(admin.get("/api/customers/" + s.customer_id).status, 200);
+  auto log = s.ws->archive().audit();
+  ASSERT_TRUE(log.ok());
+  EXPECT_EQ(log->front().action, "delete scan");
+  EXPECT_EQ(log->front().actor, "retention (30 days)");
+  // Without a period nothing is ever erased.
+  ServerUnderTest keep(12);
+  EXPECT_EQ(*keep.ws->erase_expired_scans(now + 3650 * 86400), 0u);
+  EXPECT_EQ(keep.as("admin").get("/api/scans/" + keep.scan_id).status, 200);
+}
+
 // The posture check before a scan: an operator starts it, the rig is busy with it
 // meanwhile, and the finished job carries the posture the sweep read (the demo
 // body stands in the scanning posture, so every part passes). Nothing is stored
@@ -216,7 +346,7 @@ TEST(ApiScan, PostureCheckReadsHowTheCustomerStandsAndStoresNothing) {
   ASSERT_EQ(started.status, 202) << started.body;
   const nlohmann::json job = parse(started)["job"];
   EXPECT_EQ(job["kind"], "posture_check");
-  EXPECT_EQ(op.post("/api/scans", R"({"customer": {"name": "Next"}})").status, 409);
+  EXPECT_EQ(op.post("/api/scans", R"({"customer": {"name": "Next"}, "consent": true})").status, 409);
   const nlohmann::json done = wait_job(op, job["id"]);
   ASSERT_EQ(done["state"], "complete") << done.dump();
   const nlohmann::json& check = done["posture_check"];

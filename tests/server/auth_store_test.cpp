@@ -470,6 +470,27 @@ TEST_F(AuthStoreTest, ProtectsTheLastAdmin) {
   EXPECT_FALSE(store->session(r.token));
 }
 
+// A database from before the head could be left out: its links showed the head,
+// and keep doing so after the column is added.
+TEST_F(AuthStoreTest, LinksMadeBeforeTheHeadCouldBeLeftOutKeepShowingIt) {
+  std::string token;
+  {
+    auto store = open();
+    ASSERT_TRUE(store);
+    token = store->create_share("s_1", {}, 3600, "anna")->token;
+  }
+  {
+    auto db = storage::Database::open(path_);
+    ASSERT_TRUE(db.ok());
+    ASSERT_TRUE(db->exec("ALTER TABLE shares DROP COLUMN include_head").ok());
+  }
+  auto store = open();
+  ASSERT_TRUE(store);
+  ASSERT_TRUE(store->share_by_token(token));
+  EXPECT_TRUE(store->share_by_token(token)->include_head);
+  EXPECT_FALSE(store->share_by_token(store->create_share("s_1", {}, 3600, "anna")->token)->include_head);
+}
+
 TEST_F(AuthStoreTest, ShareLinks) {
   auto store = open();
   ASSERT_TRUE(store);
@@ -492,6 +513,11 @@ TEST_F(AuthStoreTest, ShareLinks) {
   EXPECT_EQ(found->scan_id, "s_1");
   EXPECT_EQ(found->measurements, (std::vector<std::string>{"waist_girth", "Hüftumfang"}));
   EXPECT_FALSE(found->revoked);
+  EXPECT_FALSE(found->include_head) << "the head is left out unless staff include it";
+  auto headed = store->create_share("s_9", {}, 60, "anna", true);
+  ASSERT_TRUE(headed.ok());
+  EXPECT_TRUE(store->share_by_token(headed->token)->include_head);
+  EXPECT_TRUE(store->shares("s_9")->back().include_head);
 
   // Tokens and ids are unique.
   std::set<std::string> tokens{share.token}, ids{share.link.id};

@@ -97,7 +97,7 @@ TEST(ServeCli, SigtermMidScanCancelsTheScanAndStopsCleanly) {
   ASSERT_GT(port, 0) << log;
   Client admin = login(port, "admin", password);
   ASSERT_FALSE(admin.cookie.empty());
-  const HttpReply started = admin.post("/api/scans", R"({"customer": {"name": "Interrupted"}})");
+  const HttpReply started = admin.post("/api/scans", R"({"customer": {"name": "Interrupted"}, "consent": true})");
   ASSERT_EQ(started.status, 202) << started.body;
   const nlohmann::json job = nlohmann::json::parse(started.body)["job"];
   const std::string scan_id = job["scan_id"];

@@ -85,6 +85,8 @@ struct ServerUnderTest {
     auto c = ws->archive().add_customer(std::string("Demo Customer"), std::nullopt, "test");
     if (!c.ok()) throw std::runtime_error(c.status().message());
     customer_id = c->id;
+    auto consented = ws->archive().record_consent(customer_id, ws->consent_terms(), "test");
+    if (!consented.ok()) throw std::runtime_error(consented.status().message());
     auto id = ws->archive().begin_scan(customer_id, "test", nlohmann::json::object(), "");
     if (!id.ok()) throw std::runtime_error(id.status().message());
     scan_id = *id;

@@ -287,7 +287,9 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
   const Customer keep = *ar.add_customer("Kept Person", "kept@example.com", "op");
   const std::string kept_scan = *ar.begin_scan(keep.id, "op", kRig, "");
   ASSERT_TRUE(ar.complete_scan(kept_scan, results(5)).ok());
+  ASSERT_TRUE(ar.record_consent(keep.id, "the shop's terms", "op").ok());
   const Customer gone = *ar.add_customer("Zora Quintrell", "zora.q@example.org", "op");
+  ASSERT_TRUE(ar.record_consent(gone.id, "ZORA-TERMS: as agreed with Zora", "op").ok());
   std::vector<std::string> scans;
   for (int i = 0; i < 3; ++i) {
     scans.push_back(*ar.begin_scan(gone.id, "op", kRig, ""));
@@ -306,6 +308,8 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
   const nlohmann::json doc = nlohmann::json::parse(slurp(fs::path(out) / "customer.json"));
   EXPECT_EQ(doc["customer"]["name"], "Zora Quintrell");
   EXPECT_EQ(doc["customer"]["contact"], "zora.q@example.org");
+  EXPECT_EQ(doc["customer"]["consent"]["terms"], "ZORA-TERMS: as agreed with Zora");
+  EXPECT_EQ(doc["customer"]["consent"]["recorded_by"], "op");
   ASSERT_EQ(doc["scans"].size(), 3u);
   size_t user_lines = 0, audit_for_scans = 0;
   for (const auto& s : doc["scans"])
@@ -327,11 +331,13 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
   // Not one byte of theirs anywhere in the archive's folder: the database, its
   // write-ahead log, the files.
   const std::string all = everything(dir);
-  for (const std::string& needle : {std::string("Zora Quintrell"), std::string("zora.q@example.org"), gone.id, scans[0],
-                                    scans[1], scans[2], std::string("ZORA-RAW-"), std::string("zora_special")})
+  for (const std::string& needle :
+       {std::string("Zora Quintrell"), std::string("zora.q@example.org"), gone.id, scans[0], scans[1], scans[2],
+        std::string("ZORA-RAW-"), std::string("zora_special"), std::string("ZORA-TERMS")})
     EXPECT_EQ(all.find(needle), std::string::npos) << needle;
   // The others are untouched, and the log says an erasure happened, by whom.
   EXPECT_EQ(ar.scan(kept_scan)->status, ScanStatus::kComplete);
+  ASSERT_TRUE(ar.customer(keep.id)->consent.has_value());
   EXPECT_NE(all.find("Kept Person"), std::string::npos);
   auto log = ar.audit();
   ASSERT_TRUE(log.ok());
@@ -339,6 +345,35 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
   EXPECT_EQ(log->front().actor, "admin");
   EXPECT_TRUE(ar.verify().ok()) << ar.verify().message();
   EXPECT_EQ(ar.delete_customer(gone.id, "admin").code(), StatusCode::kNotFound);
+}
+
+// A customer's consent: the terms word for word, when, and who recorded it; the
+// latest is the customer's, in the list as in the record.
+TEST(Archive, KeepsEachCustomersConsent) {
+  const std::string dir = testing::temp_dir();
+  auto a = Archive::open(dir);
+  ASSERT_TRUE(a.ok());
+  Archive& ar = **a;
+  const Customer c = *ar.add_customer("Ada Lovelace", std::nullopt, "op");
+  EXPECT_FALSE(c.consent.has_value());
+  EXPECT_FALSE(ar.customer(c.id)->consent.has_value());
+  EXPECT_EQ(ar.record_consent("c_0000000000000000", "terms", "op").status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(ar.record_consent(c.id, "", "op").status().code(), StatusCode::kInvalidArgument);
+  auto first = ar.record_consent(c.id, "terms one", "olivia");
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_EQ(first->recorded_by, "olivia");
+  EXPECT_TRUE(first->given_at.rfind("20", 0) == 0 && first->given_at.back() == 'Z') << first->given_at;  // ISO, UTC
+  ASSERT_TRUE(ar.record_consent(c.id, "terms two", "oscar").ok());
+  const std::optional<Consent> k = ar.customer(c.id)->consent;
+  ASSERT_TRUE(k.has_value());
+  EXPECT_EQ(k->terms, "terms two");
+  EXPECT_EQ(k->recorded_by, "oscar");
+  auto listed = ar.customers("Lovelace");
+  ASSERT_TRUE(listed.ok());
+  ASSERT_EQ(listed->size(), 1u);
+  ASSERT_TRUE((*listed)[0].consent.has_value());
+  EXPECT_EQ((*listed)[0].consent->terms, "terms two");
+  EXPECT_EQ(ar.audit(c.id)->front().action, "record consent");
 }
 
 TEST(Archive, AFullDiskGivesAClearErrorAndLosesNothing) {

@@ -574,6 +574,8 @@ export interface paths {
                         };
                         /** @description scan every Nth laser step (default: the server's --every) */
                         every?: number;
+                        /** @description the customer has just agreed to the terms of GET /api/consent: recorded with the time and the operator. Required for a new customer and for one with no consent on record */
+                        consent?: boolean;
                     };
                 };
             };
@@ -602,7 +604,7 @@ export interface paths {
                         "application/json": components["schemas"]["Error"];
                     };
                 };
-                /** @description the rig is busy with another job */
+                /** @description the rig is busy with another job, or the customer's consent is not on record and not given */
                 409: {
                     headers: {
                         [name: string]: unknown;
@@ -768,6 +770,46 @@ export interface paths {
                 };
             };
         };
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/consent": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The terms a customer agrees to before their first scan: what is stored, for how long, who sees it */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description the terms */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": {
+                            terms?: string;
+                        };
+                    };
+                };
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+            };
+        };
+        put?: never;
+        post?: never;
         delete?: never;
         options?: never;
         head?: never;
@@ -1538,10 +1580,15 @@ export interface paths {
             requestBody: {
                 content: {
                     "application/json": {
-                        /** @default 30 */
+                        /** @default 7 */
                         days?: number;
                         /** @description names of the measurements the customer sees */
                         measurements?: string[];
+                        /**
+                         * @description show the head in the model the link serves; by default the model is cut below the neck girth's lowest point
+                         * @default false
+                         */
+                        include_head?: boolean;
                     };
                 };
             };
@@ -1675,7 +1722,7 @@ export interface paths {
             path?: never;
             cookie?: never;
         };
-        /** The customer's model */
+        /** The customer's model: without the head (cut below the neck girth) unless the link includes it */
         get: {
             parameters: {
                 query?: never;
@@ -1845,6 +1892,8 @@ export interface components {
             name?: string | null;
             contact?: string | null;
             created_at?: string;
+            /** @description the latest consent recorded; null: no scan may start until one is */
+            consent?: components["schemas"]["Consent"] | null;
             scans?: components["schemas"]["Scan"][];
         };
         Scan: {
@@ -1921,6 +1970,7 @@ export interface components {
             created_at?: string;
             expires_at?: number;
             revoked?: boolean;
+            include_head?: boolean;
         };
         NewShare: components["schemas"]["Share"] & {
             token?: string;
@@ -1965,6 +2015,12 @@ export interface components {
                 message?: string;
             }[];
         } | null;
+        /** @description the terms the customer agreed to, word for word, when, and who recorded it */
+        Consent: {
+            given_at?: string;
+            recorded_by?: string;
+            terms?: string;
+        };
     };
     responses: {
         /** @description malformed request */

@@ -18,6 +18,7 @@
 /** @typedef {Schemas['JobPrompt']} JobPrompt */
 /** @typedef {Schemas['RigStatus']} RigStatus */
 /** @typedef {Schemas['Customer']} Customer */
+/** @typedef {Schemas['Consent']} Consent */
 /** @typedef {Schemas['Scan']} Scan */
 /** @typedef {Schemas['MeasureRequest']} MeasureRequest */
 /** @typedef {Schemas['Measurement']} Measurement */
@@ -243,6 +244,12 @@ const cancelJob = (id) => post(at('/api/jobs/{id}/cancel', { id }), {});
 // ---- customers and scans
 
 /**
+ * The terms a customer agrees to before their first scan.
+ * @returns {Promise<Answer<'/api/consent', 'get', 200>>}
+ */
+const getConsent = () => get(at('/api/consent'));
+
+/**
  * @param {Query<'/api/customers', 'get'>} [params]
  * @returns {Promise<Answer<'/api/customers', 'get', 200>>}
  */
@@ -356,6 +363,7 @@ export const api = {
   startScan,
   answerPrompt,
   cancelJob,
+  getConsent,
   findCustomers,
   getCustomer,
   eraseCustomer,

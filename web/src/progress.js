@@ -36,3 +36,18 @@ export function stageText(stage) {
   const s = BY_STAGE.get(stage);
   return s ? s.text : stage || 'Working';
 }
+
+// The time left, from the bar's position and the time the job has run: the bar's
+// spans are shares of a typical job's time, so the rest takes as long again per
+// share. Null (nothing to show) until the bar has moved 5 %, or without a clock.
+/**
+ * @param {number} fraction the bar's position, 0-1
+ * @param {number} elapsedSeconds since the job started
+ * @returns {string | null}
+ */
+export function timeLeftText(fraction, elapsedSeconds) {
+  if (!(fraction >= 0.05) || !(elapsedSeconds > 0) || fraction >= 1) return null;
+  const left = (elapsedSeconds * (1 - fraction)) / fraction;
+  if (left < 60) return `about ${Math.max(5, Math.round(left / 5) * 5)} s left`;
+  return `about ${Math.round(left / 60)} min left`;
+}

@@ -1,5 +1,6 @@
-// A customer: their scans, two of them compared side by side, and (admin) the
-// customer erased with everything stored about them.
+// A customer: their consent (the terms they agreed to, when, recorded by whom),
+// their scans, two of them compared side by side, and (admin) the customer
+// erased with everything stored about them.
 import { api, enc } from '../api.js';
 import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 
@@ -59,6 +60,14 @@ export async function mount(container, { id }, ctx) {
       h('p', {}, h('a', { href: '/archive' }, '← Archive')),
       h('h1', {}, customer.name),
       h('p', { class: 'muted' }, `${customer.contact ? `${customer.contact} · ` : ''}customer since ${when(customer.created_at)} · ${customer.id}`),
+      customer.consent
+        ? h(
+            'details',
+            { class: 'consent-record', id: 'consent-record' },
+            h('summary', {}, `Consent given ${when(customer.consent.given_at)}, recorded by ${customer.consent.recorded_by}`),
+            h('p', { class: 'consent-terms' }, customer.consent.terms),
+          )
+        : h('p', { class: 'form-error', id: 'consent-record' }, 'No consent on record: the next scan asks for it.'),
       scans.length
         ? h('table', { class: 'list' }, h('thead', {}, h('tr', {}, h('th', {}, h('span', { class: 'sr-only' }, 'Compare')), h('th', {}, 'Taken'), h('th', {}, 'Status'), h('th', {}, 'Operator'))), h('tbody', {}, rows))
         : h('p', { class: 'muted' }, 'No scans yet.'),
@@ -68,7 +77,7 @@ export async function mount(container, { id }, ctx) {
             'div',
             { class: 'danger-zone' },
             h('h2', {}, 'Erase this customer'),
-            h('p', { class: 'muted' }, 'Removes the customer, every scan, model, measurement and share link, and the audit entries naming them (a customer’s right to erasure).'),
+            h('p', { class: 'muted' }, 'Removes the customer, their consent, every scan, model, measurement and share link, and the audit entries naming them (a customer’s right to erasure).'),
             h(
               'button',
               {

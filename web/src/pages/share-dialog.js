@@ -13,17 +13,20 @@ import { clear, errorText, h, toast, when } from '../ui/dom.js';
 export async function shareDialog(scanId, measurements, unit) {
   const list = h('div', { class: 'share-list' });
   const checks = measurements.map((m) =>
-    h('label', { class: 'check' }, h('input', { type: 'checkbox', name: 'measurement', value: m.name, checked: m.source === 'user' || m.kind === 'girth' || m.kind === 'height' }), ` ${m.label || m.name} `, h('small', { class: 'muted' }, formatLength(m.value_mm, unit))),
+    h('label', { class: 'check' }, h('input', { type: 'checkbox', name: 'measurement', value: m.name, checked: false }), ` ${m.label || m.name} `, h('small', { class: 'muted' }, formatLength(m.value_mm, unit))),
   );
-  const days = h('input', { type: 'number', name: 'days', min: 1, max: 365, value: '30', required: true, class: 'short' });
+  const days = h('input', { type: 'number', name: 'days', min: 1, max: 365, value: '7', required: true, class: 'short' });
+  // The head is left out of the model the link serves unless staff include it.
+  const head = h('input', { type: 'checkbox', name: 'include_head' });
   const made = h('div', { class: 'share-made', hidden: true });
   const form = h(
     'form',
     { class: 'share-form' },
     h('h2', {}, 'Share with the customer'),
-    h('p', { class: 'muted' }, 'The customer sees the model and the measurements ticked here, nothing else, until the link expires or is withdrawn.'),
+    h('p', { class: 'muted' }, 'The customer sees the model without the head and the measurements ticked here, nothing else, until the link expires or is withdrawn.'),
     h('div', { class: 'row' }, h('button', { type: 'button', onclick: () => checks.forEach((c) => (c.querySelector('input').checked = true)) }, 'All'), h('button', { type: 'button', onclick: () => checks.forEach((c) => (c.querySelector('input').checked = false)) }, 'None')),
     h('div', { class: 'check-list' }, checks),
+    h('label', { class: 'check' }, head, h('span', {}, 'Show the head in the model (the customer asked for it)')),
     h('label', { class: 'field inline' }, h('span', {}, 'Valid for (days)'), days),
     h('div', { class: 'row end' }, h('button', { type: 'button', value: 'close', onclick: () => dialog.close() }, 'Close'), h('button', { class: 'primary', type: 'submit' }, 'Make link')),
     made,
@@ -80,7 +83,7 @@ export async function shareDialog(scanId, measurements, unit) {
     e.preventDefault();
     const names = checks.map((c) => c.querySelector('input')).filter((i) => i.checked).map((i) => i.value);
     try {
-      const share = await api.makeShare(scanId, { days: Number(days.value), measurements: names });
+      const share = await api.makeShare(scanId, { days: Number(days.value), measurements: names, include_head: head.checked });
       const url = share.url && /^https?:/.test(share.url) ? share.url : `${location.origin}/s/${share.token}`;
       const field = h('input', { readonly: true, value: url, class: 'share-url', 'aria-label': 'Share link', onfocus: (ev) => ev.target.select() });
       clear(

@@ -1,10 +1,15 @@
 // The operator's page: the rig at a glance, calibration, a scan for a new or
 // returning customer, its progress live over the WebSocket (stage, progress,
-// the cameras' previews, what the job asks the operator to do), cancel, and the
-// result opening by itself when done.
+// the time left, the cameras' previews, what the job asks the operator to do),
+// cancel, and the result opening by itself when done.
+//
+// The scan goes to the customer named on the Start button, and the rig moves
+// only after the operator confirms that name. A returning customer's pick is
+// dropped whenever the search changes or the list is drawn again, so a tap on a
+// row the list is about to replace never files a scan under someone else.
 import { api, enc } from '../api.js';
-import { overallFraction, stageText } from '../progress.js';
-import { ago, clear, errorText, h, toast, when } from '../ui/dom.js';
+import { overallFraction, stageText, timeLeftText } from '../progress.js';
+import { ago, clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 import { postureCheckCard, wantedPostureCard } from '../viewer/posture.js';
 
 /** @typedef {import('../api.js').Job} Job */
@@ -25,7 +30,9 @@ export async function mount(container, _params, ctx) {
     /** @type {Job | null} */ job: null,
     connection: 'connecting',
     customerMode: 'new',
-    /** @type {string | null} */ customerId: null,
+    /** @type {{ id: string, name: string, consent: import('../api.js').Consent | null } | null} the returning customer picked */ picked: null,
+    /** the newest customer search sent; older answers are dropped */ searchSeq: 0,
+    /** @type {Map<string, string>} customer id to name, for the job card */ names: new Map(),
     /** @type {Map<string, HTMLImageElement>} */ previews: new Map(),
     /** @type {string | null} the job this page started */ myJob: null,
   };
@@ -34,14 +41,13 @@ export async function mount(container, _params, ctx) {
   const formBox = h('div', { class: 'card scan-card' });
   const recentBox = h('div', { class: 'card recent-card' });
   const conn = h('span', { class: 'conn' });
-  container.append(
-    h(
-      'section',
-      { class: 'page station-page' },
-      h('div', { class: 'page-head' }, h('h1', {}, 'Scan station'), conn),
-      h('div', { class: 'station-grid' }, h('div', { class: 'col' }, formBox, jobBox), h('div', { class: 'col' }, rigBox, recentBox)),
-    ),
+  const page = h(
+    'section',
+    { class: 'page station-page' },
+    h('div', { class: 'page-head' }, h('h1', {}, 'Scan station'), conn),
+    h('div', { class: 'station-grid' }, h('div', { class: 'col' }, formBox, jobBox), h('div', { class: 'col' }, rigBox, recentBox)),
   );
+  container.append(page);
 
   // ---- rig status
   function renderRig() {
@@ -53,14 +59,29 @@ export async function mount(container, _params, ctx) {
     const cal = rig.calibration;
     const calByCamera = new Map(/** @type {CalibratedCamera[]} */ (cal?.cameras || []).map((c) => [c.id, c]));
     const busy = rig.busy || (state.job && state.job.state === 'running');
+    const faulty = /** @type {RigCamera[]} */ (rig.cameras).filter((c) => c.error);
+    // One state up front; the engineering figures stay one tap away.
+    const [readiness, ready] = faulty.length
+      ? [`Not ready: camera ${faulty.map((c) => c.id).join(', ')} has a fault`, 'fault']
+      : busy
+        ? ['Busy', 'busy']
+        : cal
+          ? ['Rig ready', 'ready']
+          : ['Ready: the first scan calibrates first', 'ready'];
+    const details = h('details', { class: 'rig-details', open: state.rigDetailsOpen || undefined, ontoggle: () => (state.rigDetailsOpen = details.open) }, h('summary', {}, 'Cameras and lasers'));
     clear(
       rigBox,
       h('h2', {}, `Rig: ${rig.rig}`, rig.simulated ? h('span', { class: 'badge' }, 'simulated') : null),
+      h('p', { class: `rig-readiness ${ready}`, id: 'rig-readiness', dataset: { state: ready } }, h('span', { class: `dot ${ready === 'fault' ? 'bad' : 'good'}` }), ` ${readiness}`),
       h(
         'p',
-        { class: cal ? '' : 'form-error', id: 'calibration-age' },
+        { class: cal ? 'muted small' : 'form-error', id: 'calibration-age' },
         cal ? `Calibrated ${ago(cal.age_s)} (${when(new Date(cal.calibrated_at * 1000).toISOString())})` : 'Not calibrated: the first scan calibrates first, or calibrate now.',
       ),
+      details,
+      h('button', { type: 'button', disabled: busy, onclick: calibrate }, 'Calibrate'),
+    );
+    details.append(
       h(
         'table',
         { class: 'compact' },
@@ -82,7 +103,6 @@ export async function mount(container, _params, ctx) {
         ),
       ),
       h('p', { class: 'lasers' }, 'Lasers: ', rig.lasers.map((l) => h('span', { class: `laser ${l.on === null ? 'job' : l.on ? 'on' : 'off'}`, title: l.on === null ? 'switched by the job' : l.on ? 'on' : 'off' }, `${l.id}: ${l.on === null ? 'job' : l.on ? 'ON' : 'off'}`))),
-      h('button', { type: 'button', disabled: busy, onclick: calibrate }, 'Calibrate'),
     );
   }
 
@@ -101,20 +121,65 @@ export async function mount(container, _params, ctx) {
   const contact = h('input', { name: 'contact', autocomplete: 'off', placeholder: 'Phone or e-mail (optional)', maxlength: 200 });
   const search = h('input', { type: 'search', placeholder: 'Search by name, contact or id', 'aria-label': 'Search customers' });
   const results = h('div', { class: 'pick-list', role: 'listbox', 'aria-label': 'Customers' });
-  const startButton = h('button', { class: 'primary big', type: 'submit', id: 'start-scan' }, 'Start scan');
+  const startButton = h('button', { class: 'primary big start-scan', type: 'submit', id: 'start-scan' });
   // A quick sweep that reads how the customer stands, before the scan.
   const checkButton = h('button', { type: 'button', id: 'check-posture', onclick: checkPosture }, 'Check posture');
   const modeNew = h('div', { class: 'mode-new' }, h('label', { class: 'field' }, h('span', {}, 'Name'), name), h('label', { class: 'field' }, h('span', {}, 'Contact'), contact));
   const modeExisting = h('div', { class: 'mode-existing', hidden: true }, search, results);
+  // Consent before a customer's first scan: the terms to read with them, and a
+  // box the operator ticks once they agree. No scan starts without it; the
+  // server records it with the time and the operator.
+  const consentTerms = h('p', { class: 'consent-terms', id: 'consent-terms' }, 'Reading the terms…');
+  const consentGiven = h('input', { type: 'checkbox', id: 'consent-given', name: 'consent' });
+  const consentBox = h(
+    'fieldset',
+    { class: 'consent' },
+    h('legend', {}, 'Consent'),
+    consentTerms,
+    h('label', { class: 'check' }, consentGiven, h('span', {}, 'The customer has read this and agrees')),
+  );
+  const consentOnRecord = h('p', { class: 'muted small consent-on-record', id: 'consent-on-record', hidden: true });
+  api
+    .getConsent()
+    .then(({ terms }) => (consentTerms.textContent = terms))
+    .catch((e) => (consentTerms.textContent = `The terms could not be read: ${errorText(e)}`));
+  consentGiven.addEventListener('change', renderForm);
+
+  // A consent to ask for: a new customer, or a returning one with none on record.
+  function consentNeeded() {
+    return state.customerMode === 'new' || !state.picked || !state.picked.consent;
+  }
   let searchTimer = null;
   search.addEventListener('input', () => {
+    dropPick();
     clearTimeout(searchTimer);
     searchTimer = setTimeout(findCustomers, 200);
   });
+  name.addEventListener('input', renderForm);
+
+  // A consent ticked is for the person it was ticked for: it goes with the pick.
+  function dropPick() {
+    state.picked = null;
+    consentGiven.checked = false;
+    for (const b of results.children) b.setAttribute('aria-selected', 'false');
+    renderForm();
+  }
+
+  // Who the scan goes to, as the form stands: null until named or picked.
+  function subject() {
+    if (state.customerMode === 'new') return name.value.trim() || null;
+    return state.picked ? state.picked.name : null;
+  }
 
   async function findCustomers() {
+    const seq = ++state.searchSeq;
+    const q = search.value.trim();
     try {
-      const { customers } = await api.findCustomers({ q: search.value.trim() });
+      const { customers } = await api.findCustomers({ q });
+      if (seq !== state.searchSeq) return;  // a newer search is on its way
+      // The list changes under the operator's finger: nothing stays picked.
+      dropPick();
+      results.dataset.query = q;
       clear(
         results,
         customers.length
@@ -125,10 +190,15 @@ export async function mount(container, _params, ctx) {
                   type: 'button',
                   role: 'option',
                   class: 'pick',
-                  'aria-selected': state.customerId === c.id ? 'true' : 'false',
-                  onclick: () => {
-                    state.customerId = c.id;
-                    for (const b of results.children) b.setAttribute('aria-selected', b === document.activeElement ? 'true' : 'false');
+                  'aria-selected': 'false',
+                  dataset: { customer: c.id },
+                  onclick: (/** @type {MouseEvent} */ e) => {
+                    const row = /** @type {HTMLElement} */ (e.currentTarget);
+                    state.picked = { id: c.id, name: c.name, consent: c.consent || null };
+                    consentGiven.checked = false;
+                    state.names.set(c.id, c.name);
+                    for (const b of results.children) b.setAttribute('aria-selected', b === row ? 'true' : 'false');
+                    renderForm();
                   },
                 },
                 h('strong', {}, c.name),
@@ -138,6 +208,8 @@ export async function mount(container, _params, ctx) {
           : h('p', { class: 'muted' }, 'No customer matches.'),
       );
     } catch (e) {
+      if (seq !== state.searchSeq) return;
+      dropPick();
       clear(results, h('p', { class: 'form-error' }, errorText(e)));
     }
   }
@@ -160,6 +232,7 @@ export async function mount(container, _params, ctx) {
             for (const b of e.target.parentElement.children) b.setAttribute('aria-checked', b === e.target ? 'true' : 'false');
             modeNew.hidden = v !== 'new';
             modeExisting.hidden = v !== 'existing';
+            dropPick();
             if (v === 'existing') {
               findCustomers();
               search.focus();
@@ -186,19 +259,44 @@ export async function mount(container, _params, ctx) {
             }
             body.customer = { name: name.value.trim(), ...(contact.value.trim() ? { contact: contact.value.trim() } : {}) };
           } else {
-            if (!state.customerId) {
+            if (!state.picked) {
               toast('Pick the customer from the list.', 'error');
               return;
             }
-            body.customer_id = state.customerId;
+            body.customer_id = state.picked.id;
+          }
+          if (consentNeeded()) {
+            if (!consentGiven.checked) {
+              toast('Read the terms with the customer and tick their consent first.', 'error');
+              consentGiven.focus();
+              return;
+            }
+            body.consent = true;
+          }
+          const who = subject();
+          const isNew = state.customerMode === 'new';
+          // Named once more before the rig moves; the pick may not change meanwhile.
+          const picked = state.picked;
+          const sure = await confirmDialog(`${isNew ? 'A new customer' : 'A returning customer'}: ${who}${isNew && contact.value.trim() ? ` (${contact.value.trim()})` : ''}. The lasers and cameras start when you confirm.`, {
+            title: `Scanning: ${who}`,
+            confirm: `Scan ${who}`,
+          });
+          if (!sure) return;
+          if (!isNew && state.picked !== picked) {
+            toast('The pick changed; pick the customer again.', 'error');
+            return;
           }
           startButton.disabled = true;
           try {
             const { job } = await api.startScan(body);
             state.myJob = job.id;
+            // The job's events may have come first and drawn the card without the name.
+            if (job.customer_id) state.names.set(job.customer_id, who);
             startedJob(job);
+            renderJob();
             name.value = '';
             contact.value = '';
+            consentGiven.checked = false;
           } catch (err) {
             toast(errorText(err), 'error');
           } finally {
@@ -210,6 +308,8 @@ export async function mount(container, _params, ctx) {
       modeSwitch,
       modeNew,
       modeExisting,
+      consentOnRecord,
+      consentBox,
       wantedPostureCard(),
       h('p', { class: 'muted small' }, 'Ask the customer to stand on the marks like the picture and to hold still for about two minutes.'),
       checkButton,
@@ -232,9 +332,18 @@ export async function mount(container, _params, ctx) {
 
   function renderForm() {
     const busy = (state.rig && state.rig.busy) || (state.job && state.job.state === 'running');
+    const who = subject();
+    const picked = state.customerMode === 'existing' ? state.picked : null;
+    consentBox.hidden = !consentNeeded() || (state.customerMode === 'existing' && !picked);
+    consentOnRecord.hidden = !(picked && picked.consent);
+    if (picked && picked.consent) consentOnRecord.textContent = `Consent given ${when(picked.consent.given_at)}, recorded by ${picked.consent.recorded_by}.`;
     checkButton.disabled = !!busy;
     startButton.disabled = !!busy;
-    startButton.textContent = busy ? 'The rig is busy' : 'Start scan';
+    clear(
+      startButton,
+      busy ? 'The rig is busy' : 'Start scan',
+      h('small', { class: 'scan-subject', id: 'scan-subject' }, who ? `Scanning: ${who}` : state.customerMode === 'new' ? 'Give the customer’s name' : 'Pick the customer from the list'),
+    );
   }
 
   // ---- the job
@@ -266,27 +375,48 @@ export async function mount(container, _params, ctx) {
       return;
     }
     const running = j.state === 'running';
+    page.classList.toggle('job-running', running);
     const overall = overallFraction(j.kind, j.stage, j.fraction);
     // A stage the bar does not know keeps the last position rather than jumping.
     if (overall !== null) state.lastFraction = running ? Math.max(state.lastFraction || 0, overall) : overall;
     const pct = j.state === 'complete' ? 100 : Math.round((state.lastFraction || 0) * 100);
+    const left = running ? timeLeftText(state.lastFraction || 0, (Date.now() - Date.parse(j.started_at || '')) / 1000) : null;
     let prompt = null;
     clear(
       jobBox,
       h('h2', {}, { calibrate: 'Calibration', reprocess: 'Reprocessing', posture_check: 'Posture check' }[j.kind] || 'Scan'),
+      j.kind === 'scan' && j.customer_id ? h('p', { class: 'job-subject', id: 'job-subject' }, `Scanning: ${customerName(j.customer_id)}`) : null,
       h('p', { class: `job-state ${j.state}`, dataset: { state: j.state, stage: j.stage || '', job: j.id } }, running ? `${stageText(j.stage)}…` : { complete: 'Done', failed: 'Failed', cancelled: 'Cancelled' }[j.state] || j.state),
       h('progress', { max: 100, value: pct, 'aria-label': 'Progress' }),
-      h('p', { class: 'muted small' }, `${pct} %${j.frames ? ` · ${j.frames} frames` : ''}`),
+      h('p', { class: 'muted small', id: 'job-figures' }, `${pct} %${j.frames ? ` · ${j.frames} frames` : ''}${left ? ` · ${left}` : ''}`),
       j.error ? h('p', { class: 'form-error' }, j.error) : null,
       running && j.prompt ? (prompt = promptBox(j)) : null,
       j.kind === 'posture_check' && j.state === 'complete' ? postureCheckCard(j.posture_check) : null,
       j.kind === 'scan' || j.kind === 'posture_check' ? previewGrid : null,
-      running ? h('button', { type: 'button', class: 'danger', onclick: () => cancel(j) }, 'Cancel') : null,
+      // The lasers' stop stays in view wherever the page is scrolled.
+      running ? h('div', { class: 'cancel-bar' }, h('button', { type: 'button', class: 'danger big', id: 'cancel-job', onclick: () => cancel(j) }, 'Cancel')) : null,
       !running && j.scan_id && j.state === 'complete' ? h('a', { class: 'button primary', href: `/scans/${enc(j.scan_id)}` }, 'Open the result') : null,
     );
     // A new request to the person at the rig comes into view, wherever the page was.
     if (prompt && state.shownPrompt !== j.prompt.id) prompt.scrollIntoView({ block: 'center', behavior: 'smooth' });
     state.shownPrompt = prompt ? j.prompt.id : null;
+  }
+
+  // The name of the customer a job scans; looked up once when this page did not
+  // start it (another station, or a reload).
+  /** @param {string} id */
+  function customerName(id) {
+    const known = state.names.get(id);
+    if (known) return known;
+    state.names.set(id, '…');
+    api
+      .getCustomer(id)
+      .then((customer) => {
+        state.names.set(id, customer.name || id);
+        renderJob();
+      })
+      .catch(() => state.names.set(id, id));
+    return '…';
   }
 
   // What the job waits for a person to do: hold the lens board before a camera,
@@ -338,9 +468,13 @@ export async function mount(container, _params, ctx) {
   function showPreview(p) {
     let img = state.previews.get(p.camera);
     if (!img) {
-      img = h('img', { alt: `Camera ${p.camera}`, width: 160, dataset: { camera: p.camera } });
+      img = h('img', { alt: `Camera ${p.camera}`, dataset: { camera: p.camera } });
       state.previews.set(p.camera, img);
-      previewGrid.append(h('figure', {}, img, h('figcaption', {}, p.camera)));
+      // A tap enlarges a preview to the card's width (to see how the customer
+      // stands); another shrinks it.
+      const figure = h('figure', {}, img, h('figcaption', {}, p.camera));
+      figure.addEventListener('click', () => figure.classList.toggle('enlarged'));
+      previewGrid.append(figure);
     }
     img.src = `data:image/png;base64,${p.png_base64}`;
   }

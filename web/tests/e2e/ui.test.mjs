@@ -31,13 +31,23 @@ async function addAccount(name, role, password) {
   await page.locator(`tr[data-user="${name}"]`).waitFor();
 }
 
-// The scan the station started, through to the result opening by itself.
-async function runScanFromStation(label) {
+// Start, and confirm the customer the dialog names: the rig moves only then.
+async function startScanFor(who) {
+  assert.equal(await page.locator('#scan-subject').innerText(), `Scanning: ${who}`);
+  await page.click('#start-scan');
+  const dialog = page.locator('dialog[open]');
+  assert.equal(await dialog.locator('h2').innerText(), `Scanning: ${who}`);
+  await dialog.locator('button[value=ok]').click();
+  await page.locator('#job .job-state[data-state=running]').waitFor({ timeout: 30000 });
+  await page.locator(`#job-subject:text-is("Scanning: ${who}")`).waitFor({ timeout: 10000 });
+}
+
+// The scan the station started for `who`, through to the result opening by itself.
+async function runScanFromStation(label, who) {
   const stages = new Set();
   let maxProgress = 0;
   const started = Date.now();
-  await page.click('#start-scan');
-  await page.locator('#job .job-state[data-state=running]').waitFor({ timeout: 30000 });
+  await startScanFor(who);
   // Watch the live progress until the page moves to the result.
   while (!/\/scans\//.test(page.url())) {
     const s = await page
@@ -124,14 +134,28 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.match(page.url(), /\/station$/);
     // An operator has no Accounts page.
     assert.equal(await page.locator('nav a:has-text("Accounts")').count(), 0);
+    // One state up front; the cameras and lasers one tap away.
+    assert.match(await page.locator('#rig-readiness').innerText(), /Ready/);
+    await page.click('#rig-status summary');
     await page.locator('#rig-status table').waitFor();
     assert.match(await page.locator('#rig-status').innerText(), /front-left/);
     await page.fill('input[name=name]', 'Ada Lovelace');
     await page.fill('input[name=contact]', 'ada@example.org');
+    // A new customer's consent first: the terms shown, and no scan without the tick.
+    assert.match(await page.locator('#consent-terms').innerText(), /erase/);
+    await page.click('#start-scan');
+    await page.locator('.toast:has-text("tick their consent")').waitFor();
+    assert.equal(await page.locator('dialog[open]').count(), 0, 'no confirmation without consent');
+    await page.check('#consent-given');
+    // Confirming is the last word: Cancel in the dialog starts nothing.
+    await page.click('#start-scan');
+    assert.match(await page.locator('dialog[open]').innerText(), /A new customer: Ada Lovelace \(ada@example.org\)/);
+    await page.click('dialog[open] button[value=cancel]');
+    assert.equal(await page.locator('#job .job-state').count(), 0, 'nothing started');
     // The posture to ask for, as a picture.
     assert.match(await page.locator('.wanted-posture svg').getAttribute('aria-label'), /Stand like this/);
     await shot(page, 'station');
-    const run = await runScanFromStation('first');
+    const run = await runScanFromStation('first', 'Ada Lovelace');
     console.log(`first scan (with calibration) through the UI: ${run.seconds.toFixed(0)} s, stages ${[...run.stages].join(', ')}`);
     assert.ok(run.stages.has('scan'), `stages seen: ${[...run.stages]}`);
     assert.ok([...run.stages].some((s) => s.startsWith('calibration')), 'the first scan calibrates the rig first');
@@ -220,6 +244,7 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await page.locator('#job .job-state[data-state=complete]').waitFor({ timeout: 180000 });
     await page.waitForFunction((old) => /** @type {HTMLElement} */ (document.querySelector('#calibration-age')).innerText !== old, ageBefore, { timeout: 30000 });
     assert.match(await page.locator('#calibration-age').innerText(), /Calibrated (just now|\d+ s ago)/);
+    await page.click('#rig-status summary');
     assert.match(await page.locator('#rig-status table').innerText(), /\d\.\d{3} px/);
     await shot(page, 'station-calibrated');
 
@@ -238,10 +263,22 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await shot(page, 'station-posture-checked');
 
     await page.fill('input[name=name]', 'Grace Hopper');
-    await page.click('#start-scan');
+    await page.check('#consent-given');
+    await startScanFor('Grace Hopper');
     // Generous waits: under CI's parallel tests the first step's frames (and the
     // step the cancel lands after) can take tens of seconds to render.
     await page.locator('#job .job-state[data-stage=scan]').waitFor({ timeout: 180000 });
+    // The lasers' stop is on screen, the page scrolled however far.
+    await page.evaluate(() => window.scrollTo(0, 0));
+    assert.equal(await page.locator('#cancel-job').isVisible(), true);
+    const inView = async () =>
+      page.locator('#cancel-job').evaluate((b) => {
+        const r = b.getBoundingClientRect();
+        return r.top >= 0 && r.bottom <= window.innerHeight;
+      });
+    assert.ok(await inView(), 'Cancel in view at the top of the page');
+    await page.evaluate(() => window.scrollTo(0, document.body.scrollHeight));
+    assert.ok(await inView(), 'Cancel in view at the bottom of the page');
     await page.click('#job button:has-text("Cancel")');
     await page.locator('#job .job-state[data-state=cancelled]').waitFor({ timeout: 120000 });
     assert.match(page.url(), /\/station$/, 'a cancelled scan does not open');
@@ -341,7 +378,9 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
   it('makes a share link the customer opens on a phone, which shows that scan and reaches nothing else', async () => {
     await page.click('button:has-text("Share with customer")');
     const dialog = page.locator('dialog[open]');
-    await dialog.locator('button:has-text("None")').click();
+    // Private by default: nothing ticked, a week.
+    assert.equal(await dialog.locator('input[name=measurement]:checked').count(), 0);
+    assert.equal(await dialog.locator('input[name=days]').inputValue(), '7');
     await dialog.locator('input[value=jacket_waist]').check();
     await dialog.locator('input[value=waist_girth]').check();
     await dialog.locator('button:has-text("Make link")').click();
@@ -358,6 +397,11 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     const names = await customer.locator('table.measurements tr[data-name]').evaluateAll((rows) => rows.map((r) => r.dataset.name).sort());
     assert.deepEqual(names, ['jacket_waist', 'waist_girth']);
     assert.ok((await coverage(customer, '#viewport canvas')) > 0.02, 'the customer sees the body');
+    // The head was not included: the model the link serves stops below the chin.
+    const shown = JSON.parse(await customer.locator('#viewport').getAttribute('data-bounds'));
+    const stature = demoBodyBounds().max[1];
+    assert.ok(shown.max[1] < 0.9 * stature, `the shared model reaches ${shown.max[1]} mm of a ${stature} mm body`);
+    assert.ok(shown.min[1] < 50, 'down to the feet');
     assert.equal(await customer.locator('#topbar').isHidden(), true, 'no staff navigation');
     const overflow = await customer.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
     assert.ok(overflow <= 0, `the page is ${overflow} px wider than the phone`);
@@ -386,8 +430,24 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await login(page, server.url, ...OPERATOR);
     await page.click('.segmented button:has-text("Returning customer")');
     await page.fill('input[type=search]', 'Lovelace');
+    await page.locator('.pick-list[data-query="Lovelace"] button:has-text("Ada Lovelace")').click();
+    assert.equal(await page.locator('#scan-subject').innerText(), 'Scanning: Ada Lovelace');
+    // Her consent is on record from the first scan: not asked again.
+    assert.match(await page.locator('#consent-on-record').innerText(), /Consent given .*, recorded by olivia/);
+    assert.equal(await page.locator('#consent-given').isVisible(), false);
+    // The search changes after the pick: the pick is dropped, even where the new
+    // list shows the same customer, and Start asks for a pick, starting nothing.
+    await page.fill('input[type=search]', 'Ada');
+    assert.equal(await page.locator('.pick-list [aria-selected=true]').count(), 0, 'dropped as the search changes');
+    await page.locator('.pick-list[data-query="Ada"] button:has-text("Ada Lovelace")').waitFor();
+    assert.equal(await page.locator('.pick-list [aria-selected=true]').count(), 0);
+    assert.equal(await page.locator('#scan-subject').innerText(), 'Pick the customer from the list');
+    await page.click('#start-scan');
+    await page.locator('.toast:has-text("Pick the customer from the list")').waitFor();
+    assert.equal(await page.locator('dialog[open]').count(), 0, 'no confirmation without a pick');
+    assert.equal(await page.locator('#job .job-state[data-state=running]').count(), 0, 'nothing started');
     await page.click('.pick-list button:has-text("Ada Lovelace")');
-    const run = await runScanFromStation('second');
+    const run = await runScanFromStation('second', 'Ada Lovelace');
     console.log(`second scan through the UI: ${run.seconds.toFixed(0)} s`);
     state.scanB = /\/scans\/([^/?]+)/.exec(page.url())[1];
     assert.notEqual(state.scanB, state.scanA);
@@ -464,6 +524,10 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await page.click('form.filters button[type=submit]');
     await page.click(`tr[data-scan="${state.scanB}"] td:nth-child(2) a`);
     await page.waitForURL('**/customers/**');
+    // The archive shows her consent: when, by whom, and the terms she agreed to.
+    assert.match(await page.locator('#consent-record summary').innerText(), /Consent given .*, recorded by olivia/);
+    await page.click('#consent-record summary');
+    assert.match(await page.locator('#consent-record .consent-terms').innerText(), /erase/);
     await page.click('button:has-text("Erase customer")');
     await page.locator('dialog[open] button[value=ok]').click();
     await page.waitForURL('**/archive');

@@ -1,6 +1,6 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { overallFraction, stageText } from '../../src/progress.js';
+import { overallFraction, stageText, timeLeftText } from '../../src/progress.js';
 
 test('a scan job fills one bar through calibration, the sweep and the reconstruction', () => {
   const steps = [
@@ -42,4 +42,15 @@ test('an unknown stage keeps the bar where it was and reads as it is', () => {
   assert.match(stageText('scan'), /Scanning/);
   assert.equal(overallFraction('scan', 'scan', Number.NaN), 0.1);
   assert.equal(overallFraction('scan', 'scan', 7), 0.7);
+});
+
+test('the time left follows the bar: none before it has moved, seconds then minutes', () => {
+  assert.equal(timeLeftText(0, 10), null);
+  assert.equal(timeLeftText(0.04, 10), null);
+  assert.equal(timeLeftText(0.5, Number.NaN), null, 'no start time');
+  assert.equal(timeLeftText(1, 100), null, 'done');
+  assert.equal(timeLeftText(0.5, 40), 'about 40 s left');
+  assert.equal(timeLeftText(0.9, 9), 'about 5 s left');
+  assert.equal(timeLeftText(0.25, 60), 'about 3 min left');
+  assert.equal(timeLeftText(0.1, 60), 'about 9 min left');
 });
