@@ -166,6 +166,18 @@ HttpResponse Api::handle(const HttpRequest& request) {
     call.share = ws_.auth().share_by_token(call.params["token"]);
     // One answer for unknown, expired and revoked links: nothing to learn by probing.
     if (!call.share) return error_response(404, "this link is not valid (it may have expired or been withdrawn)");
+    // A link with a PIN opens only with it (X-Share-PIN); too many wrong tries withdraw it.
+    if (call.share->pin) {
+      const std::string pin = request.header("x-share-pin");
+      if (pin.empty()) return error_response(401, "this link needs the PIN the shop gave you");
+      int left = 0;
+      auto answer = ws_.auth().check_share_pin(call.params["token"], pin, &left);
+      if (!answer.ok() || *answer == PinAnswer::kWithdrawn)
+        return error_response(404, "this link is not valid (it may have expired or been withdrawn)");
+      if (*answer == PinAnswer::kWrong)
+        return error_response(401, "wrong PIN; " + std::to_string(left) + (left == 1 ? " try" : " tries") +
+                                       " left before the link is withdrawn");
+    }
   } else if (!(route->access & kAnyone)) {
     call.session = ws_.auth().session(session_cookie(request));
     if (!call.session) return error_response(401, "log in first");

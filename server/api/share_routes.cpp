@@ -23,7 +23,8 @@ nlohmann::json share_json(const ShareLink& s) {
           {"created_at", s.created_at},
           {"expires_at", s.expires_at},
           {"revoked", s.revoked},
-          {"include_head", s.include_head}};
+          {"include_head", s.include_head},
+          {"pin", s.pin}};
 }
 
 std::string link_base(const ApiOptions& o, const HttpRequest& r) {
@@ -58,12 +59,19 @@ void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options
                        const nlohmann::json head = body->value("include_head", nlohmann::json(false));
                        if (!head.is_boolean())
                          return error_response(400, "'include_head' is true to show the head (default: left out)");
+                       const nlohmann::json pin = body->value("pin", nlohmann::json(false));
+                       if (!pin.is_boolean())
+                         return error_response(400, "'pin' is true to protect the link with a PIN staff read out");
                        const int64_t seconds = std::max<int64_t>(1, std::llround(days.get<double>() * kDay));
-                       auto made = ws.auth().create_share(id, names, seconds, call.actor(), head.get<bool>());
+                       ShareOptions share_options;
+                       share_options.include_head = head.get<bool>();
+                       share_options.pin = pin.get<bool>();
+                       auto made = ws.auth().create_share(id, names, seconds, call.actor(), share_options);
                        if (!made.ok()) return error_response(made.status());
                        ws.archive().log(call.actor(), "share scan", "scan", id, made->link.id);
                        nlohmann::json out = share_json(made->link);
                        out["token"] = made->token;
+                       if (share_options.pin) out["pin_code"] = made->pin;  // shown once, like the token
                        out["url"] = link_base(options, call.request) + "/s/" + made->token;
                        return json_response(201, out);
                      }});

@@ -103,6 +103,20 @@ bool same_hash(const std::string& a, const std::string& b) {
   return a.size() == b.size() && sodium_memcmp(a.data(), b.data(), a.size()) == 0;
 }
 
+// A link's PIN as the database keeps it: hashed with the link's token as the key.
+// Six digits are a million guesses, but the token is not in the database, so a
+// copy of the database alone does not give the PIN away; online, a link allows
+// AuthStore::kMaxPinFailures wrong tries.
+std::string share_pin_hash(const std::string& token, const std::string& pin) {
+  unsigned char key[crypto_generichash_KEYBYTES];
+  crypto_generichash(key, sizeof key, reinterpret_cast<const unsigned char*>(token.data()), token.size(), nullptr, 0);
+  unsigned char h[32];
+  crypto_generichash(h, sizeof h, reinterpret_cast<const unsigned char*>(pin.data()), pin.size(), key, sizeof key);
+  char hex[65];
+  sodium_bin2hex(hex, sizeof hex, h, sizeof h);
+  return hex;
+}
+
 bool valid_username(const std::string& u) {
   if (u.empty() || u.size() > AuthStore::kMaxUsername) return false;
   return std::all_of(u.begin(), u.end(), [](char c) {
@@ -302,16 +316,15 @@ struct AuthStore::Impl {
         created_at_s INTEGER NOT NULL,
         expires_at INTEGER NOT NULL,
         revoked INTEGER NOT NULL DEFAULT 0,
-        include_head INTEGER NOT NULL DEFAULT 0);
+        include_head INTEGER NOT NULL DEFAULT 0,
+        pin_hash TEXT,
+        pin_failures INTEGER NOT NULL DEFAULT 0);
       CREATE INDEX IF NOT EXISTS shares_by_scan ON shares(scan_id);
     )sql"));
     // Links made before the head could be left out showed it: they keep doing so.
-    {
-      ASSIGN_OR_RETURN(Statement cols,
-                       db.prepare("SELECT 1 FROM pragma_table_info('shares') WHERE name = 'include_head'"));
-      ASSIGN_OR_RETURN(bool has, cols.step());
-      if (!has) RETURN_IF_ERROR(db.exec("ALTER TABLE shares ADD COLUMN include_head INTEGER NOT NULL DEFAULT 1"));
-    }
+    RETURN_IF_ERROR(add_share_column("include_head", "include_head INTEGER NOT NULL DEFAULT 1"));
+    RETURN_IF_ERROR(add_share_column("pin_hash", "pin_hash TEXT"));
+    RETURN_IF_ERROR(add_share_column("pin_failures", "pin_failures INTEGER NOT NULL DEFAULT 0"));
     ASSIGN_OR_RETURN(Statement ins, db.prepare("INSERT OR IGNORE INTO meta(key, value) VALUES ('schema_version', ?)"));
     RETURN_IF_ERROR(ins.bind(1, std::to_string(kSchemaVersion)).run());
     ASSIGN_OR_RETURN(Statement st, db.prepare("SELECT value FROM meta WHERE key = 'schema_version'"));
@@ -319,6 +332,14 @@ struct AuthStore::Impl {
     if (!row || std::atoi(st.text(0).c_str()) > kSchemaVersion)
       return failed_precondition("accounts database: made by a newer bodyscan; update this one");
     return Status::Ok();
+  }
+
+  // A column the shares table gained after databases were made: added to those.
+  Status add_share_column(const std::string& name, const std::string& definition) {
+    ASSIGN_OR_RETURN(Statement cols, db.prepare("SELECT 1 FROM pragma_table_info('shares') WHERE name = ?"));
+    cols.bind(1, name);
+    ASSIGN_OR_RETURN(bool has, cols.step());
+    return has ? Status::Ok() : db.exec("ALTER TABLE shares ADD COLUMN " + definition);
   }
 
   unsigned long long opslimit() const {
@@ -424,12 +445,14 @@ struct AuthStore::Impl {
   }
 
   static StatusOr<ShareLink> read_share(const Statement& st) {
-    // Columns: id, scan_id, measurements, created_by, created_at, expires_at, revoked, include_head.
+    // Columns: id, scan_id, measurements, created_by, created_at, expires_at, revoked, include_head,
+    // pin_hash.
     ShareLink l;
     l.id = st.text(0), l.scan_id = st.text(1), l.created_by = st.text(3), l.created_at = st.text(4);
     l.expires_at = st.integer(5);
     l.revoked = st.integer(6) != 0;
     l.include_head = st.integer(7) != 0;
+    l.pin = st.maybe_text(8).has_value();
     const auto j = parse_json(st.text(2));
     if (!j.is_array()) return internal_error("accounts: share " + l.id + " has damaged measurements");
     for (const auto& m : j) {
@@ -693,7 +716,8 @@ void AuthStore::unwatch_sessions(int id) {
 // --- share links ---------------------------------------------------------------
 
 StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id, const std::vector<std::string>& measurements,
-                                           int64_t valid_for_s, const std::string& created_by, bool include_head) {
+                                           int64_t valid_for_s, const std::string& created_by,
+                                           const ShareOptions& options) {
   if (scan_id.empty() || scan_id.size() > kMaxScanId) return invalid_argument("share: bad scan id");
   if (valid_for_s <= 0 || valid_for_s > kMaxShareValidity)
     return invalid_argument("share: validity must be more than 0 seconds and at most 365 days");
@@ -716,13 +740,22 @@ StatusOr<NewShare> AuthStore::create_share(const std::string& scan_id, const std
   l.created_by = created_by;
   l.created_at = storage::iso8601_utc(now);
   l.expires_at = now + valid_for_s;
-  l.include_head = include_head;
+  l.include_head = options.include_head;
+  l.pin = options.pin;
+  std::optional<std::string> pin_hash;
+  if (options.pin) {
+    out.pin = std::to_string(100000 + randombytes_uniform(900000));
+    pin_hash = share_pin_hash(out.token, out.pin);
+  }
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("INSERT INTO shares(id, token_hash, scan_id, measurements, "
-                                                   "created_by, created_at, created_at_s, expires_at, include_head) "
-                                                   "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)"));
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare("INSERT INTO shares(id, token_hash, scan_id, measurements, created_by, created_at, "
+                        "created_at_s, expires_at, include_head, pin_hash) "
+                        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"));
   st.bind(1, l.id).bind(2, token_hash(out.token)).bind(3, l.scan_id).bind(4, names_json).bind(5, l.created_by);
-  RETURN_IF_ERROR(st.bind(6, l.created_at).bind(7, now).bind(8, l.expires_at).bind(9, include_head ? 1 : 0).run());
+  st.bind(6, l.created_at).bind(7, now).bind(8, l.expires_at).bind(9, options.include_head ? 1 : 0);
+  RETURN_IF_ERROR(st.bind(10, pin_hash).run());
   return out;
 }
 
@@ -732,12 +765,12 @@ std::optional<ShareLink> AuthStore::share_by_token(const std::string& token) {
   const int64_t now = impl_->now();
   std::lock_guard lock(impl_->mu);
   auto st = impl_->db.prepare(
-      "SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked, include_head, token_hash "
-      "FROM shares WHERE token_hash = ?");
+      "SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked, include_head, pin_hash, "
+      "token_hash FROM shares WHERE token_hash = ?");
   if (!st.ok()) return std::nullopt;
   st->bind(1, hash);
   const auto row = st->step();
-  if (!row.ok() || !*row || !same_hash(st->text(8), hash)) return std::nullopt;
+  if (!row.ok() || !*row || !same_hash(st->text(9), hash)) return std::nullopt;
   auto link = Impl::read_share(*st);
   if (!link.ok() || link->revoked || now >= link->expires_at) return std::nullopt;
   return std::move(*link);
@@ -745,9 +778,10 @@ std::optional<ShareLink> AuthStore::share_by_token(const std::string& token) {
 
 StatusOr<std::vector<ShareLink>> AuthStore::shares(const std::string& scan_id) const {
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Statement st,
-                   impl_->db.prepare("SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked, "
-                                     "include_head FROM shares WHERE scan_id = ? ORDER BY created_at_s, rowid"));
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare("SELECT id, scan_id, measurements, created_by, created_at, expires_at, revoked, "
+                        "include_head, pin_hash FROM shares WHERE scan_id = ? ORDER BY created_at_s, rowid"));
   st.bind(1, scan_id);
   std::vector<ShareLink> out;
   for (;;) {
@@ -757,6 +791,32 @@ StatusOr<std::vector<ShareLink>> AuthStore::shares(const std::string& scan_id) c
     out.push_back(std::move(l));
   }
   return out;
+}
+
+StatusOr<PinAnswer> AuthStore::check_share_pin(const std::string& token, const std::string& pin, int* tries_left) {
+  if (!well_formed_token(token, kShareTokenBytes)) return not_found("no such link");
+  const std::string hash = token_hash(token);
+  const int64_t now = impl_->now();
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("SELECT pin_hash, pin_failures, revoked, expires_at, token_hash "
+                                                   "FROM shares WHERE token_hash = ?"));
+  st.bind(1, hash);
+  ASSIGN_OR_RETURN(bool row, st.step());
+  if (!row || !same_hash(st.text(4), hash) || st.integer(2) != 0 || now >= st.integer(3))
+    return not_found("no such link");
+  const std::optional<std::string> stored = st.maybe_text(0);
+  if (!stored) return PinAnswer::kRight;
+  const int64_t failures = st.integer(1);
+  if (same_hash(*stored, share_pin_hash(token, pin))) {
+    if (tries_left) *tries_left = static_cast<int>(kMaxPinFailures - failures);
+    return PinAnswer::kRight;
+  }
+  const bool withdraw = failures + 1 >= kMaxPinFailures;
+  ASSIGN_OR_RETURN(Statement up, impl_->db.prepare("UPDATE shares SET pin_failures = pin_failures + 1, "
+                                                   "revoked = ? WHERE token_hash = ?"));
+  RETURN_IF_ERROR(up.bind(1, withdraw ? 1 : 0).bind(2, hash).run());
+  if (tries_left) *tries_left = static_cast<int>(std::max<int64_t>(0, kMaxPinFailures - failures - 1));
+  return withdraw ? PinAnswer::kWithdrawn : PinAnswer::kWrong;
 }
 
 Status AuthStore::revoke_share(const std::string& share_id) {

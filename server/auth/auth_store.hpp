@@ -61,13 +61,25 @@ struct ShareLink {
   bool revoked = false;
   // Staff chose to show the head; otherwise the model the link serves has none.
   bool include_head = false;
+  // The link opens only with a PIN that staff read out to the customer.
+  bool pin = false;
+};
+
+struct ShareOptions {
+  bool include_head = false;
+  bool pin = false;  // make a PIN (NewShare::pin) that the link asks for
 };
 
 // token: 128-bit random, base64url (22 chars). Returned once; only its hash is kept.
 struct NewShare {
   ShareLink link;
   std::string token;
+  std::string pin;  // six digits, shown once; empty without one
 };
+
+// A PIN tried on a link: right, wrong (with the tries left), or wrong once too
+// often, which withdraws the link.
+enum class PinAnswer { kRight, kWrong, kWithdrawn };
 
 // Sessions that ended or changed: every session of `username` (password, role
 // or account deleted, end_sessions), or the one session `token` (logout). One of
@@ -148,7 +160,12 @@ class AuthStore {
 
   // Share links. valid_for_s in (0, 365 days].
   StatusOr<NewShare> create_share(const std::string& scan_id, const std::vector<std::string>& measurements,
-                                  int64_t valid_for_s, const std::string& created_by, bool include_head = false);
+                                  int64_t valid_for_s, const std::string& created_by, const ShareOptions& options = {});
+  // A link's PIN checked against what the customer typed: at most
+  // kMaxPinFailures wrong in the link's life, then it is withdrawn. The PIN is
+  // kept as a hash keyed by the token, which the database does not hold.
+  static constexpr int kMaxPinFailures = 5;
+  StatusOr<PinAnswer> check_share_pin(const std::string& token, const std::string& pin, int* tries_left = nullptr);
   std::optional<ShareLink> share_by_token(const std::string& token);          // unexpired and not revoked
   StatusOr<std::vector<ShareLink>> shares(const std::string& scan_id) const;  // all, oldest first
   Status revoke_share(const std::string& share_id);                           // not_found if unknown

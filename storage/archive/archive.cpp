@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -479,6 +480,33 @@ StatusOr<Customer> Archive::add_customer(const std::optional<std::string>& name,
 }
 
 namespace {
+// A search's words, at whitespace; a search of more words than this is refused.
+constexpr size_t kMaxSearchWords = 8;
+
+StatusOr<std::vector<std::string>> search_words(const std::string& text) {
+  std::vector<std::string> words;
+  size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    size_t j = i;
+    while (j < text.size() && !std::isspace(static_cast<unsigned char>(text[j]))) ++j;
+    if (j > i) words.push_back(text.substr(i, j - i));
+    i = j;
+  }
+  if (words.size() > kMaxSearchWords)
+    return invalid_argument("archive: search with at most " + std::to_string(kMaxSearchWords) + " words");
+  return words;
+}
+
+// SQL true when every one of `n` words (bound from parameter `first` on) occurs
+// in `haystack`, in any order and case (ASCII).
+std::string all_words_in(const std::string& haystack, int first, size_t n) {
+  std::string sql = "(1";
+  for (size_t k = 0; k < n; ++k)
+    sql += " AND instr(lower(" + haystack + "), lower(?" + std::to_string(first + static_cast<int>(k)) + "))";
+  return sql + ")";
+}
+
 // The customer's columns and their latest consent's, as read_customer reads them.
 constexpr const char* kCustomerColumns =
     "SELECT c.id, c.name, c.contact, c.created_at, k.given_at, k.recorded_by, k.terms FROM customers c "
@@ -517,13 +545,14 @@ StatusOr<Customer> Archive::customer(const std::string& id) const {
 }
 
 StatusOr<std::vector<Customer>> Archive::customers(const std::string& text) const {
+  ASSIGN_OR_RETURN(const std::vector<std::string> words, search_words(text));
   std::lock_guard lock(impl_->mu);
   ASSIGN_OR_RETURN(Statement st,
-                   impl_->db.prepare(std::string(kCustomerColumns) +
-                                     "WHERE ?1 = '' OR instr(lower(c.id), lower(?1)) OR "
-                                     "instr(lower(IFNULL(c.name, '')), lower(?1)) OR "
-                                     "instr(lower(IFNULL(c.contact, '')), lower(?1)) ORDER BY c.created_at DESC"));
-  st.bind(1, text);
+                   impl_->db.prepare(std::string(kCustomerColumns) + "WHERE " +
+                                     all_words_in("c.id || ' ' || IFNULL(c.name, '') || ' ' || IFNULL(c.contact, '')",
+                                                  1, words.size()) +
+                                     " ORDER BY c.created_at DESC"));
+  for (size_t k = 0; k < words.size(); ++k) st.bind(static_cast<int>(k) + 1, words[k]);
   std::vector<Customer> out;
   for (;;) {
     ASSIGN_OR_RETURN(bool row, st.step());
@@ -770,16 +799,20 @@ StatusOr<ScanRecord> Archive::scan(const std::string& id) const {
 }
 
 StatusOr<std::vector<ScanRecord>> Archive::scans(const ScanQuery& q) const {
+  ASSIGN_OR_RETURN(const std::vector<std::string> words, search_words(q.text));
   std::lock_guard lock(impl_->mu);
-  ASSIGN_OR_RETURN(Statement st,
-                   impl_->db.prepare(
-                       "SELECT s.id FROM scans s JOIN customers c ON c.id = s.customer_id "
-                       "WHERE (?1 = '' OR s.customer_id = ?1) "
-                       "AND (?2 = '' OR instr(lower(s.id), lower(?2)) OR instr(lower(s.customer_id), lower(?2)) "
-                       "     OR instr(lower(IFNULL(c.name, '')), lower(?2)) OR instr(lower(s.operator), lower(?2))) "
-                       "AND (?3 = '' OR s.started_at >= ?3) AND (?4 = '' OR substr(s.started_at, 1, length(?4)) <= ?4) "
-                       "ORDER BY s.started_at DESC, s.id DESC LIMIT ?5"));
-  st.bind(1, q.customer_id).bind(2, q.text).bind(3, q.from).bind(4, q.to).bind(5, q.limit);
+  ASSIGN_OR_RETURN(
+      Statement st,
+      impl_->db.prepare(
+          "SELECT s.id FROM scans s JOIN customers c ON c.id = s.customer_id "
+          "WHERE (?1 = '' OR s.customer_id = ?1) AND " +
+          all_words_in("s.id || ' ' || s.customer_id || ' ' || IFNULL(c.name, '') || ' ' || "
+                       "IFNULL(c.contact, '') || ' ' || s.operator",
+                       5, words.size()) +
+          " AND (?2 = '' OR s.started_at >= ?2) AND (?3 = '' OR substr(s.started_at, 1, length(?3)) <= ?3) "
+          "ORDER BY s.started_at DESC, s.id DESC LIMIT ?4"));
+  st.bind(1, q.customer_id).bind(2, q.from).bind(3, q.to).bind(4, q.limit);
+  for (size_t k = 0; k < words.size(); ++k) st.bind(static_cast<int>(k) + 5, words[k]);
   std::vector<std::string> found;
   for (;;) {
     ASSIGN_OR_RETURN(bool row, st.step());

@@ -117,7 +117,9 @@ struct RecoveryReport {
 
 struct ScanQuery {
   std::string customer_id;  // "" any
-  std::string text;         // matches the scan id, customer id, customer name, operator
+  // Words, each found (in any order and case) in the scan id, customer id,
+  // customer name or contact, or operator; at most 8.
+  std::string text;
   std::string from, to;     // started_at range, ISO 8601 prefixes ("2026-11-01")
   int limit = 100;
 };
@@ -134,6 +136,7 @@ class Archive {
   StatusOr<Customer> add_customer(const std::optional<std::string>& name, const std::optional<std::string>& contact,
                                   const std::string& actor);
   StatusOr<Customer> customer(const std::string& id) const;
+  // `text`: words, each found in the id, name or contact (as ScanQuery::text).
   StatusOr<std::vector<Customer>> customers(const std::string& text = "") const;
   // Records that the customer agreed to `terms` now; the latest consent is the
   // customer's. Erasing the customer erases it.

@@ -305,6 +305,33 @@ TEST(ApiScan, AShareLinkServesTheModelWithoutTheHeadUnlessStaffIncludeIt) {
             304);
 }
 
+// A link with a PIN: nothing opens without it (the page, the model), a wrong one
+// says how many tries are left, and five wrong tries withdraw the link.
+TEST(ApiScan, AShareLinkWithAPinOpensOnlyWithIt) {
+  ServerUnderTest s;
+  Client op = s.as("op");
+  const HttpReply made = op.post("/api/scans/" + s.scan_id + "/shares", R"({"pin": true})");
+  ASSERT_EQ(made.status, 201) << made.body;
+  const nlohmann::json link = parse(made);
+  EXPECT_TRUE(link["pin"].get<bool>());
+  const std::string token = link["token"], pin = link["pin_code"];
+  ASSERT_EQ(pin.size(), 6u);
+  EXPECT_FALSE(parse(op.get("/api/scans/" + s.scan_id + "/shares"))["shares"][0].contains("pin_code"));
+  EXPECT_EQ(op.post("/api/scans/" + s.scan_id + "/shares", R"({"pin": 1234})").status, 400);
+  const std::string page = "/api/share/" + token;
+  EXPECT_EQ(http(s.port, "GET", page).status, 401);
+  EXPECT_EQ(http(s.port, "GET", page + "/mesh.glb").status, 401);
+  const std::string wrong = pin == "123456" ? "654321" : "123456";
+  const HttpReply bad = http(s.port, "GET", page, {{"X-Share-PIN", wrong}});
+  EXPECT_EQ(bad.status, 401);
+  EXPECT_NE(bad.body.find("4 tries left"), std::string::npos) << bad.body;
+  EXPECT_EQ(http(s.port, "GET", page, {{"X-Share-PIN", pin}}).status, 200);
+  EXPECT_EQ(http(s.port, "GET", page + "/mesh.glb", {{"X-Share-PIN", pin}}).body.substr(0, 4), "glTF");
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(http(s.port, "GET", page, {{"X-Share-PIN", wrong}}).status, 401);
+  EXPECT_EQ(http(s.port, "GET", page, {{"X-Share-PIN", wrong}}).status, 404);
+  EXPECT_EQ(http(s.port, "GET", page, {{"X-Share-PIN", pin}}).status, 404) << "withdrawn for good";
+}
+
 // A shop's retention period: the workstation erases the scans that started
 // longer ago (with their share links), logs who did it, and keeps the rest and
 // the customer. It runs at open and hourly; here it is asked at chosen times.

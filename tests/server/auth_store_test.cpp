@@ -4,6 +4,7 @@
 #include <sodium.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -470,6 +471,34 @@ TEST_F(AuthStoreTest, ProtectsTheLastAdmin) {
   EXPECT_FALSE(store->session(r.token));
 }
 
+// A PIN staff read out: six digits, kept hashed with the token as the key; five
+// wrong tries in the link's life withdraw it.
+TEST_F(AuthStoreTest, APinProtectsALinkAndWrongTriesWithdrawIt) {
+  auto store = open();
+  ASSERT_TRUE(store);
+  ShareOptions o;
+  o.pin = true;
+  auto made = store->create_share("s_1", {}, 3600, "anna", o);
+  ASSERT_TRUE(made.ok());
+  ASSERT_EQ(made->pin.size(), 6u);
+  EXPECT_TRUE(std::all_of(made->pin.begin(), made->pin.end(), [](char c) { return c >= '0' && c <= '9'; }));
+  EXPECT_TRUE(store->share_by_token(made->token)->pin);
+  EXPECT_FALSE(store->share_by_token(store->create_share("s_1", {}, 3600, "anna")->token)->pin);
+  const std::string wrong = made->pin == "123456" ? "654321" : "123456";
+  int left = -1;
+  EXPECT_EQ(*store->check_share_pin(made->token, wrong, &left), PinAnswer::kWrong);
+  EXPECT_EQ(left, 4);
+  EXPECT_EQ(*store->check_share_pin(made->token, made->pin, &left), PinAnswer::kRight);
+  EXPECT_EQ(*store->check_share_pin(made->token, "", &left), PinAnswer::kWrong);
+  EXPECT_EQ(*store->check_share_pin(made->token, wrong, &left), PinAnswer::kWrong);
+  EXPECT_EQ(*store->check_share_pin(made->token, wrong, &left), PinAnswer::kWrong);
+  EXPECT_EQ(left, 1);
+  EXPECT_EQ(*store->check_share_pin(made->token, wrong, &left), PinAnswer::kWithdrawn);
+  EXPECT_FALSE(store->share_by_token(made->token));
+  EXPECT_EQ(store->check_share_pin(made->token, made->pin).status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(store->check_share_pin("not-a-token", made->pin).status().code(), StatusCode::kNotFound);
+}
+
 // A database from before the head could be left out: its links showed the head,
 // and keep doing so after the column is added.
 TEST_F(AuthStoreTest, LinksMadeBeforeTheHeadCouldBeLeftOutKeepShowingIt) {
@@ -514,7 +543,9 @@ TEST_F(AuthStoreTest, ShareLinks) {
   EXPECT_EQ(found->measurements, (std::vector<std::string>{"waist_girth", "Hüftumfang"}));
   EXPECT_FALSE(found->revoked);
   EXPECT_FALSE(found->include_head) << "the head is left out unless staff include it";
-  auto headed = store->create_share("s_9", {}, 60, "anna", true);
+  ShareOptions with_head;
+  with_head.include_head = true;
+  auto headed = store->create_share("s_9", {}, 60, "anna", with_head);
   ASSERT_TRUE(headed.ok());
   EXPECT_TRUE(store->share_by_token(headed->token)->include_head);
   EXPECT_TRUE(store->shares("s_9")->back().include_head);

@@ -258,7 +258,7 @@ TEST(Archive, FindsScansByCustomerTextAndDate) {
   auto a = Archive::open(testing::temp_dir());
   ASSERT_TRUE(a.ok());
   Archive& ar = **a;
-  const Customer ana = *ar.add_customer("Ana Souza", std::nullopt, "op");
+  const Customer ana = *ar.add_customer("Ana Souza", "ana.souza@example.org", "op");
   const Customer bo = *ar.add_customer("Bo Li", std::nullopt, "op");
   for (const Customer* c : {&ana, &ana, &bo})
     ASSERT_TRUE(ar.complete_scan(*ar.begin_scan(c->id, "maria", kRig, ""), results(1)).ok());
@@ -270,6 +270,20 @@ TEST(Archive, FindsScansByCustomerTextAndDate) {
   EXPECT_EQ(ar.scans(q)->size(), 2u);
   q.text = "MARIA";
   EXPECT_EQ(ar.scans(q)->size(), 3u);
+  // By contact, and by words in any order, each in any field.
+  q.text = "example.org";
+  EXPECT_EQ(ar.scans(q)->size(), 2u);
+  q.text = "souza ana";
+  EXPECT_EQ(ar.scans(q)->size(), 2u);
+  q.text = "  Souza   maria ";
+  EXPECT_EQ(ar.scans(q)->size(), 2u);
+  q.text = "souza bo";
+  EXPECT_EQ(ar.scans(q)->size(), 0u);
+  q.text = "a b c d e f g h i";
+  EXPECT_EQ(ar.scans(q).status().code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(ar.customers("souza ana")->size(), 1u);
+  EXPECT_EQ(ar.customers("ana.souza@")->size(), 1u);
+  EXPECT_EQ(ar.customers("")->size(), 2u);
   q = {};
   q.from = "2000-01-01";
   q.to = "2000-12-31";

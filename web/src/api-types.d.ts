@@ -524,7 +524,7 @@ export interface paths {
             parameters: {
                 query?: {
                     customer?: string;
-                    /** @description matches scan, customer, name, operator */
+                    /** @description words (at most 8), each found in any order and case in the scan id, the customer id, name or contact, or the operator */
                     q?: string;
                     /** @description ISO 8601 date prefix */
                     from?: string;
@@ -827,7 +827,7 @@ export interface paths {
         get: {
             parameters: {
                 query?: {
-                    /** @description matches id, name or contact */
+                    /** @description words (at most 8), each found in any order and case in the id, name or contact */
                     q?: string;
                 };
                 header?: never;
@@ -1589,6 +1589,11 @@ export interface paths {
                          * @default false
                          */
                         include_head?: boolean;
+                        /**
+                         * @description protect the link with a six-digit PIN that staff read out; the answer's pin_code holds it, once. The link then opens only with X-Share-PIN; five wrong PINs withdraw it
+                         * @default false
+                         */
+                        pin?: boolean;
                     };
                 };
             };
@@ -1673,7 +1678,10 @@ export interface paths {
         get: {
             parameters: {
                 query?: never;
-                header?: never;
+                header?: {
+                    /** @description the link's PIN, for a link made with one */
+                    "X-Share-PIN"?: string;
+                };
                 path: {
                     /** @description the link's 128-bit token */
                     token: string;
@@ -1694,6 +1702,15 @@ export interface paths {
                             mesh?: string;
                             measurements?: components["schemas"]["StoredMeasurement"][];
                         };
+                    };
+                };
+                /** @description the link has a PIN and X-Share-PIN is missing or wrong (the message says how many tries are left) */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
                     };
                 };
                 /** @description unknown, expired or withdrawn link (one answer for all) */
@@ -1726,7 +1743,10 @@ export interface paths {
         get: {
             parameters: {
                 query?: never;
-                header?: never;
+                header?: {
+                    /** @description the link's PIN, for a link made with one */
+                    "X-Share-PIN"?: string;
+                };
                 path: {
                     /** @description the link's 128-bit token */
                     token: string;
@@ -1754,6 +1774,15 @@ export interface paths {
                         [name: string]: unknown;
                     };
                     content?: never;
+                };
+                /** @description the link has a PIN and X-Share-PIN is missing or wrong (the message says how many tries are left) */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
                 };
                 /** @description unknown, expired or withdrawn link */
                 404: {
@@ -1971,10 +2000,14 @@ export interface components {
             expires_at?: number;
             revoked?: boolean;
             include_head?: boolean;
+            /** @description the link asks for a PIN */
+            pin?: boolean;
         };
         NewShare: components["schemas"]["Share"] & {
             token?: string;
             url?: string;
+            /** @description the link's six-digit PIN, when made with pin: shown only in this answer */
+            pin_code?: string;
         };
         /** @description what the job waits for a person to do */
         JobPrompt: {

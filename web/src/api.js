@@ -114,6 +114,7 @@ export function setUnauthorisedHandler(fn) {
  * @property {AbortSignal} [signal]
  * @property {boolean} [raw] answer with the Response rather than its JSON
  * @property {boolean} [quiet401] a 401 is only thrown, not reported as the session's end
+ * @property {Record<string, string>} [headers] sent besides the usual ones
  */
 
 /**
@@ -121,9 +122,9 @@ export function setUnauthorisedHandler(fn) {
  * @param {RequestOptions} [options]
  * @returns {Promise<any>}
  */
-async function request(path, { method = 'GET', body, signal, raw = false, quiet401 = false } = {}) {
+async function request(path, { method = 'GET', body, signal, raw = false, quiet401 = false, headers: extra = {} } = {}) {
   /** @type {Record<string, string>} */
-  const headers = { Accept: 'application/json' };
+  const headers = { Accept: 'application/json', ...extra };
   if (body !== undefined) headers['Content-Type'] = 'application/json';
   if (method !== 'GET' && method !== 'HEAD' && csrfToken) headers['X-CSRF-Token'] = csrfToken;
   let response;
@@ -342,11 +343,21 @@ const makeShare = (id, share) => post(at('/api/scans/{id}/shares', { id }), shar
 const withdrawShare = (id) => del(at('/api/shares/{id}', { id }));
 
 /**
- * The customer's view of a share link; a 401 here is not a staff session's end.
+ * The customer's view of a share link; a 401 here is not a staff session's end
+ * but a link that asks for its PIN (or was given a wrong one).
  * @param {string} token
+ * @param {string} [pin] the PIN the shop read out, for a link that has one
  * @returns {Promise<Answer<'/api/share/{token}', 'get', 200>>}
  */
-const getShare = (token) => get(at('/api/share/{token}', { token }), { quiet401: true });
+const getShare = (token, pin) => get(at('/api/share/{token}', { token }), { quiet401: true, headers: pin ? { 'X-Share-PIN': pin } : {} });
+
+/**
+ * The model a share link shows, as bytes (a link with a PIN sends it too).
+ * @param {string} url
+ * @param {string} [pin]
+ * @returns {Promise<ArrayBuffer>}
+ */
+const getShareModel = async (url, pin) => (await request(url, { raw: true, quiet401: true, headers: pin ? { 'X-Share-PIN': pin } : {} })).arrayBuffer();
 
 // Every call, as `api.getScan(id)` and so on.
 export const api = {
@@ -379,6 +390,7 @@ export const api = {
   makeShare,
   withdrawShare,
   getShare,
+  getShareModel,
 };
 
 // A query string from an object, skipping empty values.

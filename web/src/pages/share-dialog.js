@@ -18,6 +18,7 @@ export async function shareDialog(scanId, measurements, unit) {
   const days = h('input', { type: 'number', name: 'days', min: 1, max: 365, value: '7', required: true, class: 'short' });
   // The head is left out of the model the link serves unless staff include it.
   const head = h('input', { type: 'checkbox', name: 'include_head' });
+  const pin = h('input', { type: 'checkbox', name: 'pin' });
   const made = h('div', { class: 'share-made', hidden: true });
   const form = h(
     'form',
@@ -27,6 +28,7 @@ export async function shareDialog(scanId, measurements, unit) {
     h('div', { class: 'row' }, h('button', { type: 'button', onclick: () => checks.forEach((c) => (c.querySelector('input').checked = true)) }, 'All'), h('button', { type: 'button', onclick: () => checks.forEach((c) => (c.querySelector('input').checked = false)) }, 'None')),
     h('div', { class: 'check-list' }, checks),
     h('label', { class: 'check' }, head, h('span', {}, 'Show the head in the model (the customer asked for it)')),
+    h('label', { class: 'check' }, pin, h('span', {}, 'Protect with a PIN that you read out to the customer')),
     h('label', { class: 'field inline' }, h('span', {}, 'Valid for (days)'), days),
     h('div', { class: 'row end' }, h('button', { type: 'button', value: 'close', onclick: () => dialog.close() }, 'Close'), h('button', { class: 'primary', type: 'submit' }, 'Make link')),
     made,
@@ -83,7 +85,7 @@ export async function shareDialog(scanId, measurements, unit) {
     e.preventDefault();
     const names = checks.map((c) => c.querySelector('input')).filter((i) => i.checked).map((i) => i.value);
     try {
-      const share = await api.makeShare(scanId, { days: Number(days.value), measurements: names, include_head: head.checked });
+      const share = await api.makeShare(scanId, { days: Number(days.value), measurements: names, include_head: head.checked, pin: pin.checked });
       const url = share.url && /^https?:/.test(share.url) ? share.url : `${location.origin}/s/${share.token}`;
       const field = h('input', { readonly: true, value: url, class: 'share-url', 'aria-label': 'Share link', onfocus: (ev) => ev.target.select() });
       clear(
@@ -109,6 +111,7 @@ export async function shareDialog(scanId, measurements, unit) {
             'Copy',
           ),
         ),
+        share.pin_code ? h('p', { class: 'share-pin' }, 'Read out the PIN (shown only now): ', h('strong', { class: 'pin-code' }, share.pin_code)) : null,
       );
       made.hidden = false;
       refresh();

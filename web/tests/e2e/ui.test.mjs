@@ -422,6 +422,25 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await customer.waitForURL('**/login?next=%2Farchive');
     await customer.goto(`${server.url}/s/not-a-real-token`);
     await customer.locator('h1:has-text("This link does not open a scan")').waitFor();
+
+    // A second link, with a PIN staff read out: the phone asks for it, a wrong
+    // one says how many tries are left, the right one opens the body.
+    await page.click('button:has-text("Share with customer")');
+    const second = page.locator('dialog[open]');
+    await second.locator('input[name=pin]').check();
+    await second.locator('button:has-text("Make link")').click();
+    const pinned = (await second.locator('input.share-url').inputValue()).replace(/^https?:\/\/[^/]+/, server.url);
+    const pin = await second.locator('.pin-code').innerText();
+    assert.match(pin, /^\d{6}$/);
+    await second.locator('button:has-text("Close")').click();
+    await customer.goto(pinned);
+    await customer.locator('input[name=pin]').fill(pin === '123456' ? '654321' : '123456');
+    await customer.click('button:has-text("Open")');
+    await customer.locator('.pin-page [role=alert]:has-text("4 tries left")').waitFor();
+    await customer.locator('input[name=pin]').fill(pin);
+    await customer.click('button:has-text("Open")');
+    await customer.locator('#viewport[data-state=ready]').waitFor({ timeout: 120000 });
+    assert.ok((await coverage(customer, '#viewport canvas')) > 0.02, 'the PIN opens the body');
     await phone.close();
   });
 
