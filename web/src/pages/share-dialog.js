@@ -1,6 +1,9 @@
 // A customer share link: which measurements the customer sees, how long the link
-// lasts; the link is shown once (the server keeps only its hash). The scan's
-// other links are listed with their expiry and can be withdrawn.
+// lasts, the head, a PIN; the link is shown once (the server keeps only its
+// hash), with a QR code the customer scans with their phone, so that it is handed
+// over rather than typed. The scan's other links are listed with their expiry and
+// can be withdrawn.
+import QRCode from 'qrcode';
 import { api } from '../api.js';
 import { formatLength } from '../units.js';
 import { clear, errorText, h, toast, when } from '../ui/dom.js';
@@ -88,6 +91,7 @@ export async function shareDialog(scanId, measurements, unit) {
       const share = await api.makeShare(scanId, { days: Number(days.value), measurements: names, include_head: head.checked, pin: pin.checked });
       const url = share.url && /^https?:/.test(share.url) ? share.url : `${location.origin}/s/${share.token}`;
       const field = h('input', { readonly: true, value: url, class: 'share-url', 'aria-label': 'Share link', onfocus: (ev) => ev.target.select() });
+      const qr = h('canvas', { class: 'share-qr', role: 'img', 'aria-label': 'QR code of the link, for the customer to scan with their phone' });
       clear(
         made,
         h('p', {}, 'Give the customer this link (it is shown only now):'),
@@ -111,8 +115,10 @@ export async function shareDialog(scanId, measurements, unit) {
             'Copy',
           ),
         ),
+        qr,
         share.pin_code ? h('p', { class: 'share-pin' }, 'Read out the PIN (shown only now): ', h('strong', { class: 'pin-code' }, share.pin_code)) : null,
       );
+      await QRCode.toCanvas(qr, url, { errorCorrectionLevel: 'M', margin: 4, width: 240 });
       made.hidden = false;
       refresh();
     } catch (err) {

@@ -8,6 +8,7 @@
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { after, before, describe, it } from 'node:test';
+import jsQR from 'jsqr';
 import { ADMIN_PASSWORD, ARTEFACTS, closeSuite, coverage, demoBodyBounds, demoBodyMeasurement, login, logout, newPage, openSuite, shot } from './harness.mjs';
 
 const SCAN_TIMEOUT = 420_000;
@@ -386,6 +387,13 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await dialog.locator('button:has-text("Make link")').click();
     const link = await dialog.locator('input.share-url').inputValue();
     assert.match(link, /\/s\/[A-Za-z0-9_-]{20,}$/);
+    // The QR code beside it holds the link, as an independent reader decodes it.
+    const qr = await dialog.locator('canvas.share-qr').evaluate((c) => {
+      const canvas = /** @type {HTMLCanvasElement} */ (c);
+      const pixels = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height);
+      return { width: canvas.width, height: canvas.height, data: Array.from(pixels.data) };
+    });
+    assert.equal(jsQR(Uint8ClampedArray.from(qr.data), qr.width, qr.height)?.data, link);
     await shot(page, 'share-dialog');
     await dialog.locator('button:has-text("Close")').click();
     state.link = link.replace(/^https?:\/\/[^/]+/, server.url);
