@@ -540,6 +540,16 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
       else await p.waitForLoadState('networkidle');
       const overflow = await p.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
       assert.ok(overflow <= 0, `${path} is ${overflow} px too wide at 1024×768`);
+      // Every touch target at least 44 px high (and 44 px wide), as touch
+      // guidelines ask: buttons, selects, fields, rows to tap, the nav.
+      const small = await p.evaluate(() =>
+        [...document.querySelectorAll('button, select, input:not([type=checkbox]):not([type=radio]), a.button, nav a, [role=option], summary, label.check, table.measurements tr[data-name]')]
+          .map((e) => ({ e, r: e.getBoundingClientRect() }))
+          .filter(({ e, r }) => r.width > 0 && r.height > 0 && window.getComputedStyle(e).visibility !== 'hidden' && !e.closest('[hidden]'))
+          .filter(({ r }) => r.height < 43.5 || r.width < 43.5)
+          .map(({ e, r }) => `${e.tagName.toLowerCase()}${e.className ? `.${String(e.className).trim().replace(/\s+/g, '.')}` : ''} "${(e.textContent || e.getAttribute('aria-label') || '').trim().slice(0, 20)}" ${Math.round(r.width)}×${Math.round(r.height)}`),
+      );
+      assert.deepEqual(small, [], `${path}: touch targets under 44 px`);
       await shot(p, `tablet${path.replace(/\//g, '-').replace(/-s_.*/, '-viewer')}`);
     }
     await tablet.close();
