@@ -120,7 +120,7 @@ struct ScanQuery {
   // Words, each found (in any order and case) in the scan id, customer id,
   // customer name or contact, or operator; at most 8.
   std::string text;
-  std::string from, to;     // started_at range, ISO 8601 prefixes ("2026-11-01")
+  std::string from, to;  // started_at range, ISO 8601 prefixes ("2026-11-01")
   int limit = 100;
 };
 
