@@ -26,6 +26,7 @@ packages=(
   libembree-dev        # ray casting for the simulated rig (hw/sim)
   libpng-dev           # camera images (recon/io)
   libdraco-dev libtinygltf-dev  # glTF binary with Draco, Draco point clouds (storage/formats)
+  libmeshoptimizer-dev # decimating surfaces to a triangle budget (recon/geometry/simplify)
   libcairo2-dev fonts-dejavu-core  # measurement sheets as PDF (storage/formats)
   libsqlite3-dev       # the scan archive's index (storage/archive)
   libsodium-dev        # checksums of archived files; password hashing (server)

@@ -18,7 +18,7 @@ void usage(FILE* out) {
   std::fputs(
       "usage: bodyscan sheet MESH.ply -o OUT.pdf|OUT.csv|OUT.json [options]\n"
       "\n"
-      "Measures the body (mm, Y up, facing +Z) and writes its measurement sheet: the\n"
+      "Measures the body (mm, Y up, facing any way) and writes its measurement sheet: the\n"
       "automatic ISO 8559-1 set, each with its clause. The PDF is one A4 page with\n"
       "front and side silhouettes and the measured lines drawn on them.\n"
       "\n"

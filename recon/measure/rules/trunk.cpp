@@ -196,8 +196,15 @@ Eigen::Vector3d bust_point(const BodyCuts& cuts, double bust_y, Side side) {
 }  // namespace
 
 StatusOr<double> find_crotch(const BodyCuts& cuts, MeasurementSheet& sheet) {
-  const double mid_x = cuts.midline_x(), stature = cuts.stature();
+  const double mid_x = cuts.midline_x(), stature = cuts.stature(), span = kJoinDepth * stature;
   auto merged = [&](double y) { return cuts.midline_loop(y) != nullptr; };
+  // The trunk's own loop: one spanning the midline at least `span` long front to
+  // back where it crosses it.
+  auto trunk = [&](double y) {
+    double f = 0, b = 0;
+    const Ring* m = cuts.midline_loop(y);
+    return m != nullptr && m->crossing_z(mid_x, &f, &b) && f - b >= span;
+  };
   // Down from the trunk, the first level where no loop spans the midline: the legs
   // apart. Walked down rather than up, since legs held close can touch lower down
   // (knees, calves) and join there again; the crotch is where the trunk's loop
@@ -205,19 +212,27 @@ StatusOr<double> find_crotch(const BodyCuts& cuts, MeasurementSheet& sheet) {
   const double step = 5;
   const double top = cuts.level(0.55), bottom = cuts.level(0.25);
   cuts.prefetch(top, bottom, -step);
-  double above = top;
-  double crotch_y = -1;
+  double above = top, above_trunk = top;
+  double crotch_y = -1, trunk_end = -1;
   for (double y = top - step; y >= bottom; y -= step) {
+    if (trunk_end < 0 && !trunk(y)) trunk_end = bisect(y, above_trunk, trunk);
+    if (trunk_end < 0) above_trunk = y;
     if (!merged(y)) {
       crotch_y = bisect(y, above, merged);
       break;
     }
     above = y;
   }
-  if (crotch_y < 0)
+  if (crotch_y < 0 && trunk_end < 0)
     return not_found(
         "measure: the legs are not apart below the trunk down to a quarter of the height; stand with "
         "feet apart");
+  if (crotch_y < 0) crotch_y = bottom;  // joined all the way down
+  // Thighs that touch (heavy or muscular ones, the feet close) join along their
+  // contact, a strip narrower than a crotch's floor: where the narrow join runs
+  // down more than `span` (farther than the saddle a smooth surface leaves under a
+  // crotch), the crotch is its top.
+  if (trunk_end - crotch_y > span) crotch_y = trunk_end;
   // Where the thighs nearly touch no camera sees between them, and the surface
   // bridges the gap below the real crotch; the real crotch's front and back are
   // seen. Up from the join, the first level whose midline crossings are measured
@@ -226,13 +241,13 @@ StatusOr<double> find_crotch(const BodyCuts& cuts, MeasurementSheet& sheet) {
   // A smooth surface rounds the corner where measured thighs meet, closing their
   // gap a few mm below the crotch in a narrow saddle: the crotch is where the join
   // has grown kJoinDepth of the stature long.
-  crotch_y = widened(cuts, crotch_y, mid_x, kJoinDepth * stature, 0.02 * stature);
+  crotch_y = widened(cuts, crotch_y, mid_x, span, 0.02 * stature);
   // Front to back, the middle of the join's first kJoinDepth from its back: the
   // join's front runs into the notch between the thighs, and jumps out of it as the
   // notch closes over a fraction of a millimetre of height.
   double f = cuts.midline_z(), b = cuts.midline_z();
   if (const Ring* m = cuts.midline_loop(crotch_y + 0.5)) m->crossing_z(mid_x, &f, &b);
-  sheet.landmark("crotch", {mid_x, crotch_y, b + 0.5 * std::min(f - b, kJoinDepth * stature)});
+  sheet.landmark("crotch", {mid_x, crotch_y, b + 0.5 * std::min(f - b, span)});
   return crotch_y;
 }
 

@@ -200,6 +200,24 @@ TEST(BodyMeasurements, DoNotDependOnWhereTheBodyStands) {
   EXPECT_NEAR(c->find("waist_girth")->value_mm, a->find("waist_girth")->value_mm, 1.0);
 }
 
+TEST(BodyMeasurements, ThighsThatTouchDoNotLowerTheCrotch) {
+  // A scan whose thighs touch from about 105 mm below the crotch down, joined by
+  // the surface there (tests/data/README.md). Read where the legs' loops part, the
+  // crotch was the bottom of that join, 117 mm low, with the thighs' girths hung
+  // from it. Truth: the posed true mesh's values; allowance: ISO 20685-1's.
+  auto mesh = read_ply_mesh(BODYSCAN_SOURCE_DIR "/tests/data/male_muscular_thighs_touching.ply");
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  BodyMeasureOptions o;
+  o.floor_y = -20;
+  auto b = measure_body(*mesh, o);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  EXPECT_NEAR(b->find("crotch_height")->value_mm, 917.3, 4.0);
+  for (const char* side : {"left", "right"}) {
+    EXPECT_NEAR(b->find(std::string("thigh_girth_") + side)->value_mm, 574.5, 4.0) << side;
+    EXPECT_NEAR(b->find(std::string("mid_thigh_girth_") + side)->value_mm, 502.7, 4.0) << side;
+  }
+}
+
 TEST(BodyMeasurements, AStrayFoldBesideTheFlankDoesNotEndTheArm) {
   // Scans sometimes keep a small fold of surface against the flank, below the
   // armpit, a loop of its own in the cuts there. The arm's track must run past it to
