@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <limits>
+#include <unordered_map>
 
 #include "recon/geometry/fill_holes.hpp"
 #include "recon/geometry/mesh_components.hpp"
@@ -60,8 +62,8 @@ void drop_fins(std::vector<unsigned int>* indices) {
 // Collapses can also pinch two parts of the surface together along an edge
 // (fingers, thighs close together), leaving it shared by four triangles. Opens
 // the surface round every such edge (the triangles touching either end) and
-// closes the holes again without new vertices' shortcuts (fill_holes: Liepa's
-// minimal-dihedral patch, faired). False when edges stay non-manifold.
+// closes the holes again (fill_holes: Liepa's minimal-dihedral patch, faired, not
+// refined). False when edges stay non-manifold.
 bool unpinch(TriangleMesh* mesh) {
   for (int round = 0; round < 3; ++round) {
     std::vector<std::pair<uint64_t, uint32_t>> edges;
@@ -95,6 +97,55 @@ bool unpinch(TriangleMesh* mesh) {
   return analyze_topology(*mesh).non_manifold_edges == 0;
 }
 
+// Marching cubes leaves vertices within a hair of each other where the surface
+// passes through a grid node. Written in metres they can print the same, and an
+// importer that joins vertices by position (most CAD tools) would then make
+// non-manifold edges of them. Vertices within kWeldMm are joined (to the first of
+// them), the triangles that flattens dropped, and unused vertices left out.
+constexpr float kWeldMm = 1e-3f;
+
+// Vertices kept so far, bucketed in kWeldMm cells.
+class WeldGrid {
+ public:
+  explicit WeldGrid(const std::vector<Vec3f>& vertices) : vertices_(vertices) { cells_.reserve(vertices.size()); }
+  // A kept vertex within kWeldMm of vertex i, or i itself (then kept).
+  uint32_t partner(uint32_t i) {
+    const Vec3f& v = vertices_[i];
+    const Eigen::Vector3i c = (v / kWeldMm).array().floor().cast<int>();
+    for (int n = 0; n < 27; ++n) {
+      const auto it = cells_.find(key(c + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1)));
+      if (it == cells_.end()) continue;
+      for (uint32_t j : it->second)
+        if ((vertices_[j] - v).norm() <= kWeldMm) return j;
+    }
+    cells_[key(c)].push_back(i);
+    return i;
+  }
+
+ private:
+  static uint64_t key(const Eigen::Vector3i& c) {
+    const auto bits = [](int x) { return static_cast<uint64_t>(static_cast<uint32_t>(x) & 0x1fffffu); };
+    return bits(c.x()) << 42 | bits(c.y()) << 21 | bits(c.z());
+  }
+  const std::vector<Vec3f>& vertices_;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
+};
+
+TriangleMesh welded(const TriangleMesh& mesh) {
+  WeldGrid grid(mesh.vertices);
+  std::vector<uint32_t> to(mesh.num_vertices());
+  for (uint32_t i = 0; i < mesh.num_vertices(); ++i) to[i] = grid.partner(i);
+  TriangleMesh out;
+  out.vertices = mesh.vertices;
+  out.triangles.reserve(mesh.num_triangles());
+  for (const Triangle& t : mesh.triangles) {
+    const Triangle w = {to[t[0]], to[t[1]], to[t[2]]};
+    if (w[0] != w[1] && w[1] != w[2] && w[0] != w[2]) out.triangles.push_back(w);
+  }
+  remove_unreferenced_vertices(out);
+  return out;
+}
+
 }  // namespace
 
 StatusOr<SimplifyResult> simplify(const TriangleMesh& mesh, const SimplifyOptions& options) {
@@ -102,33 +153,33 @@ StatusOr<SimplifyResult> simplify(const TriangleMesh& mesh, const SimplifyOption
   if (options.max_triangles < 4) return invalid_argument("simplify: a budget of at least 4 triangles");
   if (options.max_error_mm < 0) return invalid_argument("simplify: the error bound is a distance, 0 or more");
   SimplifyResult out;
-  if (mesh.num_triangles() <= options.max_triangles) {
-    out.mesh.vertices = mesh.vertices;
-    out.mesh.triangles = mesh.triangles;
+  const TriangleMesh source = welded(mesh);
+  if (source.num_triangles() <= options.max_triangles) {
+    out.mesh = source;
     out.mesh.normals = compute_vertex_normals(out.mesh);
     return out;
   }
-  std::vector<unsigned int> indices(3 * mesh.num_triangles());
-  for (size_t t = 0; t < mesh.num_triangles(); ++t)
-    for (int k = 0; k < 3; ++k) indices[3 * t + k] = mesh.triangles[t][k];
-  const float* positions = mesh.vertices.front().data();
+  std::vector<unsigned int> indices(3 * source.num_triangles());
+  for (size_t t = 0; t < source.num_triangles(); ++t)
+    for (int k = 0; k < 3; ++k) indices[3 * t + k] = source.triangles[t][k];
+  const float* positions = source.vertices.front().data();
   const size_t stride = sizeof(Vec3f);
   // meshoptimizer's errors are relative to the mesh's extent.
-  const float scale = meshopt_simplifyScale(positions, mesh.num_vertices(), stride);
+  const float scale = meshopt_simplifyScale(positions, source.num_vertices(), stride);
   const float target_error = options.max_error_mm > 0 && scale > 0 ? static_cast<float>(options.max_error_mm / scale)
                                                                    : std::numeric_limits<float>::max();
   std::vector<unsigned int> kept(indices.size());
   float relative_error = 0;
-  kept.resize(meshopt_simplify(kept.data(), indices.data(), indices.size(), positions, mesh.num_vertices(), stride,
+  kept.resize(meshopt_simplify(kept.data(), indices.data(), indices.size(), positions, source.num_vertices(), stride,
                                3 * options.max_triangles, target_error, 0, &relative_error));
   drop_fins(&kept);
   if (kept.size() < 3) return internal_error("simplify: nothing of the surface was left");
   // Only the vertices the triangles still use, in the order they are first used.
-  std::vector<unsigned int> remap(mesh.num_vertices());
-  const size_t n = meshopt_optimizeVertexFetchRemap(remap.data(), kept.data(), kept.size(), mesh.num_vertices());
+  std::vector<unsigned int> remap(source.num_vertices());
+  const size_t n = meshopt_optimizeVertexFetchRemap(remap.data(), kept.data(), kept.size(), source.num_vertices());
   out.mesh.vertices.resize(n);
-  for (size_t v = 0; v < mesh.num_vertices(); ++v)
-    if (remap[v] != ~0u) out.mesh.vertices[remap[v]] = mesh.vertices[v];
+  for (size_t v = 0; v < source.num_vertices(); ++v)
+    if (remap[v] != ~0u) out.mesh.vertices[remap[v]] = source.vertices[v];
   out.mesh.triangles.resize(kept.size() / 3);
   for (size_t t = 0; t < out.mesh.triangles.size(); ++t)
     out.mesh.triangles[t] = {remap[kept[3 * t]], remap[kept[3 * t + 1]], remap[kept[3 * t + 2]]};
@@ -138,8 +189,10 @@ StatusOr<SimplifyResult> simplify(const TriangleMesh& mesh, const SimplifyOption
   // triangles, a sliver): a ten-thousandth of the body or less. A pinched-off
   // fingertip stays, a closed piece touching the hand at a corner.
   remove_small_components(out.mesh, 1e-4);
+  remove_unreferenced_vertices(out.mesh);  // the repair's opened corners
   out.mesh.normals = compute_vertex_normals(out.mesh);
-  out.max_deviation_mm = std::max(largest_vertex_distance(mesh, out.mesh), largest_vertex_distance(out.mesh, mesh));
+  if (options.measure_deviation)
+    out.max_deviation_mm = std::max(largest_vertex_distance(mesh, out.mesh), largest_vertex_distance(out.mesh, mesh));
   return out;
 }
 

@@ -1,13 +1,17 @@
 // Customers and their scans: search, details, the served files (GLB, Draco cloud)
 // with ETags, the measurements (automatic and saved), evaluating a measurement the
-// browser draws, measurement sheets, deleting and reprocessing.
+// browser draws, measurement sheets, avatars for CAD tools, deleting and
+// reprocessing.
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "recon/core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/api/api.hpp"
 #include "server/api/scan_views.hpp"
 #include "server/pipeline/archive_scan.hpp"
+#include "server/pipeline/cad_avatar.hpp"
 #include "server/pipeline/evaluate_measurement.hpp"
 #include "server/workstation/erasure.hpp"
 #include "storage/formats/measurement_sheet.hpp"
@@ -142,6 +146,46 @@ HttpResponse sheet(Workstation& ws, const Call& call, const std::string& format)
   out.set("Content-Disposition", "attachment; filename=\"" + id + "-measurements." + format + "\"");
   out.set("Cache-Control", "no-store");
   ws.archive().log(call.actor(), "export sheet", "scan", id, format);
+  return out;
+}
+
+// A decimated avatar of the scan's current surface for CAD tools
+// (pipeline/cad_avatar.hpp): ?triangles=N (default 70000), ?unit=mm|m (OBJ).
+HttpResponse avatar(Workstation& ws, const Call& call, pipeline::AvatarFormat format) {
+  pipeline::AvatarOptions options;
+  options.format = format;
+  const std::string budget = call.request.param("triangles", "70000");
+  char* end = nullptr;
+  const unsigned long long n = std::strtoull(budget.c_str(), &end, 10);
+  if (budget.empty() || *end != '\0' || budget[0] == '-' || n < pipeline::kMinAvatarTriangles ||
+      n > pipeline::kMaxAvatarTriangles)
+    return error_response(400, "'triangles' is a whole number from " + std::to_string(pipeline::kMinAvatarTriangles) +
+                                   " to " + std::to_string(pipeline::kMaxAvatarTriangles));
+  options.max_triangles = static_cast<size_t>(n);
+  const bool glb = format == pipeline::AvatarFormat::kGlb;
+  auto unit = pipeline::parse_model_unit(call.request.param("unit", glb ? "m" : "mm"));
+  if (!unit.ok()) return error_response(400, unit.status().message());
+  if (glb && *unit != storage::ModelUnit::kMetre)
+    return error_response(400, "a glTF avatar is in metres, as glTF defines ('unit' is for OBJ)");
+  options.unit = *unit;
+  const std::string& id = call.params.at("id");
+  auto mesh = ws.surface(id);
+  if (!mesh.ok()) return error_response(mesh.status());
+  auto a = pipeline::make_avatar(**mesh, options);
+  if (!a.ok()) return error_response(a.status());
+  const char* ext = format == pipeline::AvatarFormat::kObj ? "obj" : "glb";
+  HttpResponse out;
+  out.body = std::move(a->bytes);
+  out.set("Content-Type", format == pipeline::AvatarFormat::kObj ? "model/obj" : "model/gltf-binary");
+  out.set("Content-Disposition", "attachment; filename=\"" + id + "-avatar." + ext + "\"");
+  out.set("Cache-Control", "no-store");
+  out.set("X-Avatar-Triangles", std::to_string(a->triangles));
+  out.set("X-Avatar-Closed", a->closed ? "true" : "false");
+  char deviation[32];
+  std::snprintf(deviation, sizeof deviation, "%.2f", a->max_deviation_mm);
+  out.set("X-Avatar-Deviation-Mm", deviation);
+  ws.archive().log(call.actor(), "export avatar", "scan", id,
+                   std::string(ext) + ", " + std::to_string(a->triangles) + " triangles");
   return out;
 }
 
@@ -319,6 +363,10 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
          if (!st.ok()) return error_response(st);
          return no_content();
        }});
+  routes->push_back({"GET", "/api/scans/{id}/avatar.obj", kStaff,
+                     [](Workstation& ws, const Call& call) { return avatar(ws, call, pipeline::AvatarFormat::kObj); }});
+  routes->push_back({"GET", "/api/scans/{id}/avatar.glb", kStaff,
+                     [](Workstation& ws, const Call& call) { return avatar(ws, call, pipeline::AvatarFormat::kGlb); }});
   for (const char* format : {"csv", "json", "pdf"}) {
     routes->push_back({"GET", std::string("/api/scans/{id}/sheet.") + format, kStaff,
                        [format](Workstation& ws, const Call& call) { return sheet(ws, call, format); }});

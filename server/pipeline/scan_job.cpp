@@ -4,7 +4,9 @@
 
 #include <chrono>
 #include <filesystem>
+#include <optional>
 
+#include "recon/geometry/simplify.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/ply.hpp"
 #include "server/pipeline/measurements_json.hpp"
@@ -109,7 +111,7 @@ StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string
   return out;
 }
 
-StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surface) {
+StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surface, size_t display_triangles) {
   ScanFiles f;
   f.results["calibration.json"] = to_json(r.calibration).dump(2);
   if (!r.raw_stripes.empty()) {
@@ -129,8 +131,20 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
       ASSIGN_OR_RETURN(storage::DracoEncoded mesh_drc, storage::encode_mesh_drc(r.mesh, keep));
       f.results[kArchivedMeshFile] = std::move(mesh_drc.bytes);
     }
-    ASSIGN_OR_RETURN(storage::DracoEncoded e, storage::encode_glb(r.mesh));
-    glb = {{"bytes", e.bytes.size()}, {"position_bits", e.position_bits}, {"max_error_mm", e.max_error_mm}};
+    std::optional<SimplifyResult> display;
+    if (r.mesh.num_triangles() > display_triangles) {
+      SimplifyOptions so;
+      so.max_triangles = display_triangles;
+      so.measure_deviation = false;
+      ASSIGN_OR_RETURN(display, simplify(r.mesh, so));
+    }
+    const TriangleMesh& shown = display ? display->mesh : r.mesh;
+    ASSIGN_OR_RETURN(storage::DracoEncoded e, storage::encode_glb(shown));
+    glb = {{"bytes", e.bytes.size()},
+           {"position_bits", e.position_bits},
+           {"max_error_mm", e.max_error_mm},
+           {"triangles", shown.num_triangles()},
+           {"surface_triangles", r.mesh.num_triangles()}};
     f.results["mesh.glb"] = std::move(e.bytes);
   }
   if (r.body) {

@@ -104,13 +104,20 @@ inline constexpr const char* kRawStripesFile = "stripes.bin";
 // job got) and the raw record (record.json, stripes.bin). The surface is mesh.ply,
 // or for the archive mesh.drc (Draco within 0.01 mm, a seventeenth of the size).
 // The Draco files are checked by decoding them again (storage/formats/draco_files.hpp).
+// mesh.glb is the screen's copy: a surface larger than `display_triangles` is
+// decimated to it first (recon/geometry/simplify.hpp; kept closed). The surface
+// file and the measurements are the full surface's.
 enum class SurfaceFile { kPly, kArchiveDraco };
 inline constexpr const char* kArchivedMeshFile = "mesh.drc";
 inline constexpr double kArchivedMeshErrorMm = 0.01;
+// A software renderer draws half a million triangles in about half a second
+// (docs/benchmarks.md §10), and the eye sees no facets at that density on a body.
+inline constexpr size_t kDisplayTriangles = 500000;
 struct ScanFiles {
   std::map<std::string, std::string> results, raw;
 };
-StatusOr<ScanFiles> scan_result_files(const ScanJobResult& result, SurfaceFile surface = SurfaceFile::kPly);
+StatusOr<ScanFiles> scan_result_files(const ScanJobResult& result, SurfaceFile surface = SurfaceFile::kPly,
+                                      size_t display_triangles = kDisplayTriangles);
 
 // DIR/points.ply, DIR/mesh.ply (when reconstructed), DIR/measurements.json (when
 // measured; docs/measurements.md), DIR/calibration.json and DIR/scan.json (the

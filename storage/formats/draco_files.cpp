@@ -198,6 +198,77 @@ StatusOr<TriangleMesh> from_draco_mesh(const draco::Mesh& dm, const std::map<std
   return mesh;
 }
 
+// Accessor a's bytes (from its offset to its buffer view's end), its count and
+// component type; the view checked to lie in the binary chunk.
+struct AccessorBytes {
+  std::string_view bytes;
+  size_t count = 0;
+  int component_type = 0;
+  std::string type;
+};
+StatusOr<AccessorBytes> accessor_bytes(const nlohmann::json& j, size_t a, std::string_view bin) {
+  const nlohmann::json& acc = j.at("accessors").at(a);
+  const nlohmann::json& view = j.at("bufferViews").at(acc.at("bufferView").get<size_t>());
+  if (view.value("byteStride", size_t{0}) != 0) return invalid_argument("interleaved accessors");
+  const size_t at = view.value("byteOffset", size_t{0}) + acc.value("byteOffset", size_t{0});
+  const size_t length = view.at("byteLength").get<size_t>();
+  if (at > bin.size() || length > bin.size() - at) return invalid_argument("a buffer view runs past the binary chunk");
+  return AccessorBytes{bin.substr(at, length), acc.at("count").get<size_t>(), acc.at("componentType").get<int>(),
+                       acc.value("type", "")};
+}
+
+// A float VEC3 attribute, scaled; empty when the primitive has none.
+StatusOr<std::vector<Vec3f>> plain_vec3(const nlohmann::json& j, const nlohmann::json& prim, const char* name,
+                                        float scale, std::string_view bin) {
+  std::vector<Vec3f> out;
+  if (!prim.at("attributes").contains(name)) return out;
+  ASSIGN_OR_RETURN(AccessorBytes a, accessor_bytes(j, prim["attributes"][name].get<size_t>(), bin));
+  if (a.component_type != 5126 || a.type != "VEC3") return invalid_argument(std::string(name) + " is not float VEC3");
+  if (a.count > a.bytes.size() / 12) return invalid_argument(std::string(name) + " runs past its buffer view");
+  out.resize(a.count);
+  for (size_t i = 0; i < a.count; ++i) {
+    float f[3];
+    std::memcpy(f, a.bytes.data() + 12 * i, 12);
+    out[i] = scale * Vec3f(f[0], f[1], f[2]);
+  }
+  return out;
+}
+
+// The primitive's indices (unsigned byte, short or int), or 0..vertices-1 without.
+StatusOr<std::vector<uint32_t>> plain_indices(const nlohmann::json& j, const nlohmann::json& prim, size_t vertices,
+                                              std::string_view bin) {
+  std::vector<uint32_t> out;
+  if (!prim.contains("indices")) {
+    out.resize(vertices);
+    for (size_t i = 0; i < vertices; ++i) out[i] = static_cast<uint32_t>(i);
+    return out;
+  }
+  ASSIGN_OR_RETURN(AccessorBytes a, accessor_bytes(j, prim["indices"].get<size_t>(), bin));
+  const size_t width = a.component_type == 5121 ? 1 : a.component_type == 5123 ? 2 : a.component_type == 5125 ? 4 : 0;
+  if (width == 0) return invalid_argument("indices of component type " + std::to_string(a.component_type));
+  if (a.count > a.bytes.size() / width) return invalid_argument("the indices run past their buffer view");
+  out.resize(a.count);
+  for (size_t i = 0; i < a.count; ++i) {
+    uint32_t v = 0;
+    std::memcpy(&v, a.bytes.data() + width * i, width);
+    out[i] = v;
+  }
+  return out;
+}
+
+// A primitive with plain accessors: float VEC3 POSITION (m) and NORMAL, and a
+// triangle list.
+StatusOr<TriangleMesh> read_plain_primitive(const nlohmann::json& j, const nlohmann::json& prim, std::string_view bin) {
+  TriangleMesh mesh;
+  ASSIGN_OR_RETURN(mesh.vertices, plain_vec3(j, prim, "POSITION", 1000.f, bin));
+  ASSIGN_OR_RETURN(mesh.normals, plain_vec3(j, prim, "NORMAL", 1.f, bin));
+  ASSIGN_OR_RETURN(std::vector<uint32_t> indices, plain_indices(j, prim, mesh.vertices.size(), bin));
+  if (prim.value("mode", 4) != 4 || indices.size() % 3 != 0) return invalid_argument("not a triangle list");
+  for (size_t i = 0; i < indices.size(); i += 3) mesh.triangles.push_back({indices[i], indices[i + 1], indices[i + 2]});
+  if (!mesh.is_consistent()) return invalid_argument("an index is out of range");
+  return mesh;
+}
+
 }  // namespace
 
 StatusOr<TriangleMesh> decode_glb(std::string_view bytes) {
@@ -222,8 +293,11 @@ StatusOr<TriangleMesh> decode_glb(std::string_view bytes) {
   const std::string_view bin = bytes.substr(bin_at + 8, std::min<size_t>(u32(bin_at), bytes.size() - bin_at - 8));
   try {
     const nlohmann::json& prim = j.at("meshes").at(0).at("primitives").at(0);
-    if (!prim.contains("extensions") || !prim["extensions"].contains("KHR_draco_mesh_compression"))
-      return bad("the mesh is not Draco-compressed");
+    if (!prim.contains("extensions") || !prim["extensions"].contains("KHR_draco_mesh_compression")) {
+      auto plain = read_plain_primitive(j, prim, bin);
+      if (!plain.ok()) return bad(plain.status().message());
+      return plain;
+    }
     const nlohmann::json& ext = prim["extensions"]["KHR_draco_mesh_compression"];
     const nlohmann::json& view = j.at("bufferViews").at(ext.at("bufferView").get<size_t>());
     const size_t offset = view.value("byteOffset", size_t{0}), length = view.at("byteLength").get<size_t>();

@@ -56,6 +56,22 @@ TEST(ScanResults, MeasurementsSitBesideTheMesh) {
   const nlohmann::json info = read_json(dir + "/scan.json")["mesh_glb"];
   EXPECT_EQ(info["bytes"].get<size_t>(), std::filesystem::file_size(dir + "/mesh.glb"));
   EXPECT_LE(info["max_error_mm"].get<double>(), 0.5);
+  EXPECT_EQ(info["triangles"].get<size_t>(), body->num_triangles());
+
+  // A surface larger than the screen's budget is decimated for mesh.glb only.
+  auto small = scan_result_files(r, SurfaceFile::kPly, 20000);
+  ASSERT_TRUE(small.ok()) << small.status().message();
+  auto shown = storage::decode_glb(small->results.at("mesh.glb"));
+  ASSERT_TRUE(shown.ok()) << shown.status().message();
+  EXPECT_LE(shown->num_triangles(), 20000u);
+  EXPECT_GT(shown->num_triangles(), 18000u);
+  EXPECT_TRUE(analyze_topology(*shown).closed());
+  const nlohmann::json small_info = nlohmann::json::parse(small->results.at("scan.json"))["mesh_glb"];
+  EXPECT_EQ(small_info["triangles"].get<size_t>(), shown->num_triangles());
+  EXPECT_EQ(small_info["surface_triangles"].get<size_t>(), body->num_triangles());
+  auto surface = parse_ply(small->results.at("mesh.ply"));
+  ASSERT_TRUE(surface.ok());
+  EXPECT_EQ(surface->triangles.size(), body->num_triangles()) << "the kept surface is the full one";
 }
 
 TEST(ScanResults, AFailedSurfaceKeepsTheCloudAndSaysWhy) {

@@ -9,8 +9,10 @@
 #include <fstream>
 #include <iterator>
 #include <set>
+#include <sstream>
 #include <thread>
 
+#include "recon/geometry/mesh_distance.hpp"
 #include "recon/measure/girth.hpp"
 #include "storage/formats/draco_files.hpp"
 #include "tests/server/server_fixture.hpp"
@@ -303,6 +305,64 @@ TEST(ApiScan, AShareLinkServesTheModelWithoutTheHeadUnlessStaffIncludeIt) {
                  {{"If-None-Match", etag}})
                 .status,
             304);
+}
+
+// Avatars for CAD tools: the scan's surface decimated to the budget asked for,
+// closed, as an OBJ in mm or m and a plain GLB in metres, near the true body.
+TEST(ApiScan, AvatarsForCadToolsAreClosedWithinTheBudgetAndNearTheBody) {
+  ServerUnderTest s;
+  Client t = s.as("tailor");
+  const std::string base = "/api/scans/" + s.scan_id;
+  const MeshDistance to_body(s.body);
+  auto worst_distance = [&](const TriangleMesh& m, float scale) {
+    float worst = 0;
+    for (const Vec3f& v : m.vertices) worst = std::max(worst, to_body.closest_point(scale * v).distance);
+    return worst;
+  };
+
+  const HttpReply glb = t.get(base + "/avatar.glb?triangles=20000");
+  ASSERT_EQ(glb.status, 200) << glb.body;
+  EXPECT_EQ(glb.header("content-type"), "model/gltf-binary");
+  EXPECT_NE(glb.header("content-disposition").find(s.scan_id + "-avatar.glb"), std::string::npos);
+  auto g = storage::decode_glb(glb.body);
+  ASSERT_TRUE(g.ok()) << g.status().message();
+  EXPECT_LE(g->num_triangles(), 20000u);
+  EXPECT_GT(g->num_triangles(), 18000u);
+  EXPECT_EQ(std::to_string(g->num_triangles()), glb.header("x-avatar-triangles"));
+  EXPECT_EQ(glb.header("x-avatar-closed"), "true");
+  EXPECT_TRUE(analyze_topology(*g).closed());
+  EXPECT_EQ(g->normals.size(), g->num_vertices());
+  // The archived surface is the scan's, within its own error of the true body.
+  EXPECT_LT(worst_distance(*g, 1.f), 10.f);
+
+  for (const char* unit : {"mm", "m"}) {
+    const HttpReply obj = t.get(base + "/avatar.obj?triangles=5000&unit=" + unit);
+    ASSERT_EQ(obj.status, 200) << obj.body;
+    EXPECT_EQ(obj.header("content-type"), "model/obj");
+    TriangleMesh m;
+    std::istringstream in(obj.body);
+    std::string line;
+    while (std::getline(in, line)) {
+      float x, y, z;
+      unsigned a, b, c;
+      if (std::sscanf(line.c_str(), "v %f %f %f", &x, &y, &z) == 3) m.vertices.emplace_back(x, y, z);
+      if (std::sscanf(line.c_str(), "f %u//%*u %u//%*u %u//%*u", &a, &b, &c) == 3)
+        m.triangles.push_back({a - 1, b - 1, c - 1});
+    }
+    EXPECT_LE(m.num_triangles(), 5000u) << unit;
+    EXPECT_GT(m.num_triangles(), 4500u) << unit;
+    ASSERT_TRUE(m.is_consistent());
+    EXPECT_TRUE(analyze_topology(m).closed()) << unit;
+    EXPECT_LT(worst_distance(m, std::string(unit) == "m" ? 1000.f : 1.f), 15.f) << unit;
+  }
+
+  EXPECT_EQ(t.get(base + "/avatar.obj?triangles=12").status, 400);
+  EXPECT_EQ(t.get(base + "/avatar.obj?triangles=-5000").status, 400);
+  EXPECT_EQ(t.get(base + "/avatar.obj?triangles=lots").status, 400);
+  EXPECT_EQ(t.get(base + "/avatar.obj?unit=furlong").status, 400);
+  EXPECT_EQ(t.get(base + "/avatar.glb?unit=mm").status, 400);
+  EXPECT_EQ(t.get("/api/scans/no-such-scan/avatar.glb").status, 404);
+  EXPECT_EQ(http(s.port, "GET", base + "/avatar.glb").status, 401);
 }
 
 // A link with a PIN: nothing opens without it (the page, the model), a wrong one

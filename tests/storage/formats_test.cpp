@@ -188,5 +188,68 @@ TEST(MeshFiles, ObjAndStlCarryTheMeshExactly) {
   EXPECT_FALSE(write_stl("/nonexistent-dir/m.stl", m).ok());
 }
 
+TEST(MeshFiles, AnObjInMetresIsTheSameMeshScaled) {
+  const TriangleMesh m = testing::icosphere(1, 250);
+  const std::string obj = encode_obj(m, ModelUnit::kMetre);
+  EXPECT_EQ(obj.rfind("# bodyscan mesh, metres, Y up\n", 0), 0u);
+  std::istringstream in(obj);
+  std::string line;
+  size_t v = 0;
+  while (std::getline(in, line))
+    if (line.rfind("v ", 0) == 0) {
+      float x, y, z;
+      ASSERT_EQ(std::sscanf(line.c_str(), "v %f %f %f", &x, &y, &z), 3);
+      EXPECT_LT((1000.f * Vec3f(x, y, z) - m.vertices[v]).norm(), 1e-3f);
+      ++v;
+    }
+  EXPECT_EQ(v, m.num_vertices());
+}
+
+TEST(PlainGlb, ABodyComesBackExactlyInPlainAccessors) {
+  TriangleMesh mesh = body();
+  mesh.normals = compute_vertex_normals(mesh);
+  auto glb = encode_plain_glb(mesh);
+  ASSERT_TRUE(glb.ok()) << glb.status().message();
+  ASSERT_EQ(glb->size() % 4, 0u);
+  uint32_t total = 0;
+  std::memcpy(&total, glb->data() + 8, 4);
+  EXPECT_EQ(total, glb->size());
+  const nlohmann::json j = glb_json(*glb);
+  EXPECT_EQ(j["asset"]["version"], "2.0");
+  const nlohmann::json& prim = j["meshes"][0]["primitives"][0];
+  EXPECT_FALSE(prim.contains("extensions"));  // no Draco: CAD tools read it
+  EXPECT_FALSE(j.contains("extensionsRequired"));
+  // The bounds glTF requires on positions, in metres.
+  const nlohmann::json& pos = j["accessors"][prim["attributes"]["POSITION"].get<size_t>()];
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e9f), hi = -lo;
+  for (const Vec3f& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_FLOAT_EQ(pos["min"][k].get<float>(), 0.001f * lo[k]);
+    EXPECT_FLOAT_EQ(pos["max"][k].get<float>(), 0.001f * hi[k]);
+  }
+  auto back = decode_glb(*glb);
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_EQ(back->num_vertices(), mesh.num_vertices());
+  ASSERT_EQ(back->triangles, mesh.triangles);
+  ASSERT_EQ(back->normals.size(), mesh.normals.size());
+  float worst = 0;
+  for (size_t i = 0; i < mesh.num_vertices(); ++i)
+    worst = std::max(worst, (back->vertices[i] - mesh.vertices[i]).norm());
+  EXPECT_LT(worst, 1e-3f);  // float metres and back
+  EXPECT_FALSE(encode_plain_glb(TriangleMesh{}).ok());
+  // A vertex without a normal (its triangles degenerate): the file carries none.
+  TriangleMesh no_normal = mesh;
+  no_normal.normals[0] = Vec3f::Zero();
+  auto plain = encode_plain_glb(no_normal);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_FALSE(glb_json(*plain)["meshes"][0]["primitives"][0]["attributes"].contains("NORMAL"));
+  // A plain GLB whose indices run past the vertices is refused, not read.
+  std::string bad = *glb;
+  const size_t indices_at = bad.size() - 12 * mesh.num_triangles();
+  const uint32_t huge = 0xfffffff0u;
+  std::memcpy(bad.data() + indices_at, &huge, 4);
+  EXPECT_FALSE(decode_glb(bad).ok());
+}
+
 }  // namespace
 }  // namespace bodyscan::storage

@@ -1397,6 +1397,100 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/scans/{id}/avatar.obj": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Avatar for CAD tools, Wavefront OBJ: the surface decimated to a triangle budget, closed */
+        get: {
+            parameters: {
+                query?: {
+                    /** @description the triangle budget, 1000 to 5000000 (default 70000, CLO3D's recommendation) */
+                    triangles?: number;
+                    /** @description mm (default) or m; OBJ has no unit, the importer is told */
+                    unit?: string;
+                };
+                header?: never;
+                path: {
+                    id: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description the avatar (Content-Disposition: attachment). X-Avatar-Triangles: its triangles; X-Avatar-Closed: true when every edge joins two triangles; X-Avatar-Deviation-Mm: the largest distance between its vertices and the full surface, both ways */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "model/obj": string;
+                    };
+                };
+                400: components["responses"]["BadRequest"];
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+                404: components["responses"]["NotFound"];
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/scans/{id}/avatar.glb": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Avatar for CAD tools, glTF binary with plain accessors (no Draco), metres: the surface decimated to a triangle budget, closed */
+        get: {
+            parameters: {
+                query?: {
+                    /** @description the triangle budget, 1000 to 5000000 (default 70000, CLO3D's recommendation) */
+                    triangles?: number;
+                    /** @description m (default and only: glTF is metres) */
+                    unit?: string;
+                };
+                header?: never;
+                path: {
+                    id: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description the avatar (Content-Disposition: attachment), with the headers of avatar.obj */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "model/gltf-binary": string;
+                    };
+                };
+                400: components["responses"]["BadRequest"];
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+                404: components["responses"]["NotFound"];
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/scans/{id}/sheet.csv": {
         parameters: {
             query?: never;

@@ -8,6 +8,7 @@ import { BodyView, ModelDecoding } from '../viewer/body-view.js';
 import { MeasureTool, TOOLS } from '../viewer/measure-tool.js';
 import { COLOURS, drawMeasurement, KIND_LABEL, measurementTable, slug } from '../viewer/measurement-table.js';
 import { postureCard } from '../viewer/posture.js';
+import { avatarDialog } from './avatar-dialog.js';
 import { shareDialog } from './share-dialog.js';
 
 /** @typedef {import('../api.js').Customer} Customer */
@@ -291,6 +292,7 @@ export async function mount(container, { id }, ctx) {
         { class: 'row wrap' },
         h('a', { class: 'button', href: `/api/scans/${enc(id)}/sheet.csv?unit=${u}`, download: `${id}-measurements.csv` }, 'Export CSV'),
         h('a', { class: 'button', href: `/api/scans/${enc(id)}/sheet.pdf?unit=${u}`, download: `${id}-measurements.pdf` }, 'Export PDF'),
+        h('button', { type: 'button', onclick: () => avatarDialog(id, state.unit) }, 'Avatar for CAD…'),
         ctx.can.share(role) ? h('button', { type: 'button', onclick: () => shareDialog(id, state.measurements, state.unit) }, 'Share with customer…') : null,
       ),
       ctx.can.deleteRecords(role)

@@ -2,13 +2,16 @@
 // `bodyscan serve` on the simulated rig: staff accounts made in the UI, a scan run
 // from the station with its live progress and previews, the body rendered (not a
 // blank canvas; its bounds against the true body), a girth line drawn on screen
-// and measured by the server, saved by a tailor, the sheet exported, a second scan
-// of the same customer compared, a customer's share link that reaches nothing
-// else, and an admin deleting the scan. Screenshots go to the artefacts folder.
+// and measured by the server, saved by a tailor, the sheet and a CAD avatar
+// exported (the avatar read back by three.js's OBJ reader and the Khronos glTF
+// validator), a second scan of the same customer compared, a customer's share link
+// that reaches nothing else, and an admin deleting the scan. Screenshots go to the artefacts folder.
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { after, before, describe, it } from 'node:test';
+import { validateBytes } from 'gltf-validator';
 import jsQR from 'jsqr';
+import { OBJLoader } from 'three/examples/jsm/loaders/OBJLoader.js';
 import { ADMIN_PASSWORD, ARTEFACTS, closeSuite, coverage, demoBodyBounds, demoBodyMeasurement, login, logout, newPage, openSuite, shot } from './harness.mjs';
 
 const SCAN_TIMEOUT = 420_000;
@@ -374,6 +377,44 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.equal(readFileSync(await pdf.path()).subarray(0, 5).toString(), '%PDF-');
     await pdf.saveAs(`${ARTEFACTS}/sheet.pdf`);
     await page.selectOption('select[aria-label=Unit]', 'cm');
+
+    // An avatar for CAD tools, read back by independent readers: the OBJ by
+    // three.js's OBJLoader, the GLB by the Khronos glTF validator.
+    await page.click('button:has-text("Avatar for CAD")');
+    const avatar = page.locator('dialog[open]');
+    await avatar.locator('input[name=triangles]').fill('20000');
+    await avatar.locator('select[name=unit]').selectOption('m');
+    const [objFile] = await Promise.all([page.waitForEvent('download'), avatar.locator('a:has-text("Download avatar")').click()]);
+    assert.match(objFile.suggestedFilename(), /-avatar\.obj$/);
+    const obj = new OBJLoader().parse(readFileSync(await objFile.path(), 'utf8'));
+    assert.equal(obj.children.length, 1);
+    const objGeometry = /** @type {import('three').Mesh} */ (obj.children[0]).geometry;
+    const corners = objGeometry.getAttribute('position');
+    const triangles = corners.count / 3;
+    assert.ok(triangles <= 20000 && triangles > 18000, `${triangles} triangles`);
+    // Closed: every edge of its triangles is an edge of exactly two (corners
+    // matched by their coordinates, which the file writes once per vertex).
+    const edges = new Map();
+    const corner = (i) => `${corners.getX(i)},${corners.getY(i)},${corners.getZ(i)}`;
+    for (let t = 0; t < corners.count; t += 3)
+      for (let k = 0; k < 3; k++) {
+        const [from, to] = [corner(t + k), corner(t + ((k + 1) % 3))].sort();
+        edges.set(`${from}|${to}`, (edges.get(`${from}|${to}`) ?? 0) + 1);
+      }
+    assert.equal([...edges.values()].filter((n) => n !== 2).length, 0, 'every edge between two triangles');
+    // In metres, where the true body stands (mm), within what the scan's surface leaves out.
+    objGeometry.computeBoundingBox();
+    const avatarBox = objGeometry.boundingBox;
+    const stature = demoBodyBounds().max[1];
+    assert.ok(Math.abs(avatarBox.max.y * 1000 - stature) < 35, `top ${avatarBox.max.y} m vs ${stature} mm`);
+    await avatar.locator('select[name=format]').selectOption('glb');
+    const [glbFile] = await Promise.all([page.waitForEvent('download'), avatar.locator('a:has-text("Download avatar")').click()]);
+    const report = await validateBytes(new Uint8Array(readFileSync(await glbFile.path())));
+    assert.equal(report.issues.numErrors, 0, JSON.stringify(report.issues.messages.slice(0, 5)));
+    assert.equal(report.issues.numWarnings, 0, JSON.stringify(report.issues.messages.slice(0, 5)));
+    assert.ok(report.info.totalTriangleCount <= 20000 && report.info.totalTriangleCount > 18000);
+    assert.deepEqual(report.info.extensionsUsed ?? [], []);
+    await avatar.locator('button:has-text("Close")').click();
   });
 
   it('makes a share link the customer opens on a phone, which shows that scan and reaches nothing else', async () => {
