@@ -8,7 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
+#include <tuple>
 
 #include "recon/geometry/fill_holes.hpp"
 #include "recon/geometry/mesh_components.hpp"
@@ -104,37 +104,40 @@ bool unpinch(TriangleMesh* mesh) {
 // them), the triangles that flattens dropped, and unused vertices left out.
 constexpr float kWeldMm = 1e-3f;
 
-// Vertices kept so far, bucketed in kWeldMm cells.
-class WeldGrid {
- public:
-  explicit WeldGrid(const std::vector<Vec3f>& vertices) : vertices_(vertices) { cells_.reserve(vertices.size()); }
-  // A kept vertex within kWeldMm of vertex i, or i itself (then kept).
-  uint32_t partner(uint32_t i) {
-    const Vec3f& v = vertices_[i];
-    const Eigen::Vector3i c = (v / kWeldMm).array().floor().cast<int>();
-    for (int n = 0; n < 27; ++n) {
-      const auto it = cells_.find(key(c + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1)));
-      if (it == cells_.end()) continue;
-      for (uint32_t j : it->second)
-        if ((vertices_[j] - v).norm() <= kWeldMm) return j;
-    }
-    cells_[key(c)].push_back(i);
-    return i;
-  }
-
- private:
-  static uint64_t key(const Eigen::Vector3i& c) {
-    const auto bits = [](int x) { return static_cast<uint64_t>(static_cast<uint32_t>(x) & 0x1fffffu); };
-    return bits(c.x()) << 42 | bits(c.y()) << 21 | bits(c.z());
-  }
-  const std::vector<Vec3f>& vertices_;
-  std::unordered_map<uint64_t, std::vector<uint32_t>> cells_;
-};
-
 TriangleMesh welded(const TriangleMesh& mesh) {
-  WeldGrid grid(mesh.vertices);
-  std::vector<uint32_t> to(mesh.num_vertices());
-  for (uint32_t i = 0; i < mesh.num_vertices(); ++i) to[i] = grid.partner(i);
+  // In (X, Y, Z) order, each vertex against those after it within kWeldMm in X;
+  // a pair within kWeldMm joins, to the lower index (union-find). A surface from
+  // a grid has thousands of vertices on one X: past kWeldMm in Y the rest of
+  // that X is skipped.
+  const std::vector<Vec3f>& v = mesh.vertices;
+  const size_t n = v.size();
+  std::vector<uint32_t> order(n), to(n);
+  for (uint32_t i = 0; i < n; ++i) order[i] = to[i] = i;
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return std::tie(v[a].x(), v[a].y(), v[a].z()) < std::tie(v[b].x(), v[b].y(), v[b].z());
+  });
+  std::vector<size_t> next_x(n + 1, n);  // the first place in `order` past this one's X
+  for (size_t a = n; a-- > 0;) next_x[a] = a + 1 < n && v[order[a + 1]].x() == v[order[a]].x() ? next_x[a + 1] : a + 1;
+  const auto root = [&](uint32_t i) {
+    while (to[i] != i) i = to[i] = to[to[i]];
+    return i;
+  };
+  for (size_t a = 0; a < n; ++a) {
+    const Vec3f& p = v[order[a]];
+    for (size_t b = a + 1; b < n && v[order[b]].x() - p.x() <= kWeldMm;) {
+      const Vec3f& q = v[order[b]];
+      if (q.y() - p.y() > kWeldMm) {
+        b = next_x[b];
+        continue;
+      }
+      if ((q - p).norm() <= kWeldMm) {
+        const uint32_t ra = root(order[a]), rb = root(order[b]);
+        to[std::max(ra, rb)] = std::min(ra, rb);
+      }
+      ++b;
+    }
+  }
+  for (uint32_t i = 0; i < n; ++i) to[i] = root(i);
   TriangleMesh out;
   out.vertices = mesh.vertices;
   out.triangles.reserve(mesh.num_triangles());
