@@ -16,6 +16,7 @@
 #include "server/workstation/erasure.hpp"
 #include "storage/archive/archive.hpp"
 #include "storage/formats/draco_files.hpp"
+#include "storage/formats/export_profiles.hpp"
 #include "storage/formats/measurement_sheet.hpp"
 #include "storage/formats/mesh_files.hpp"
 
@@ -39,8 +40,9 @@ void usage(FILE* out) {
       "  delete-scan SCAN --yes   deletes one scan\n"
       "  reprocess SCAN           the scan again from its raw record, as a new version\n"
       "  mesh SCAN -o OUT         the scan's surface as .ply, .obj, .stl (mm) or .glb\n"
-      "  sheet SCAN -o OUT [--unit mm|cm|in]\n"
-      "                           the measurement sheet (.pdf, .csv or .json)\n"
+      "  sheet SCAN -o OUT [--unit mm|cm|in] [--profile sheet|iso8559|mtm-order]\n"
+      "                           the measurement sheet (.pdf, .csv or .json); a\n"
+      "                           CSV laid out for its target (docs/archive.md)\n"
       "\n"
       "--actor names who does it in the audit log (default: cli).\n"
       "Exit status: 0 done, 1 failed (the message says why), 2 bad arguments.\n",
@@ -62,15 +64,15 @@ nlohmann::json files_json(const std::vector<storage::ArchivedFile>& files) {
 
 int run_archive(int argc, char** argv) {
   std::vector<std::string> args;
-  std::string actor = "cli", out, unit_text = "cm";
+  std::string actor = "cli", out, unit_text, profile_text = "sheet";
   bool yes = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") {
       usage(stdout);
       return 0;
-    } else if ((a == "--actor" || a == "-o" || a == "--unit") && i + 1 < argc) {
-      (a == "--actor" ? actor : a == "-o" ? out : unit_text) = argv[++i];
+    } else if ((a == "--actor" || a == "-o" || a == "--unit" || a == "--profile") && i + 1 < argc) {
+      (a == "--actor" ? actor : a == "-o" ? out : a == "--unit" ? unit_text : profile_text) = argv[++i];
     } else if (a == "--yes") {
       yes = true;
     } else if (!a.empty() && a[0] == '-') {
@@ -235,7 +237,19 @@ int run_archive(int argc, char** argv) {
   }
   // sheet
   if (!need(3)) return 2;
-  auto unit = storage::parse_length_unit(unit_text);
+  auto profile = storage::find_export_profile(profile_text);
+  if (!profile.ok()) {
+    std::fprintf(stderr, "bodyscan archive: %s\n", profile.status().message().c_str());
+    return 2;
+  }
+  if (profile->id != "sheet" && !ends(".csv")) {
+    std::fprintf(stderr, "bodyscan archive sheet: --profile lays out a CSV (OUT.csv)\n");
+    return 2;
+  }
+  // The tailor's sheet in cm unless asked; another profile in its target's unit.
+  auto unit = storage::parse_length_unit(!unit_text.empty()       ? unit_text
+                                         : profile->id == "sheet" ? "cm"
+                                                                  : storage::unit_symbol(profile->default_unit));
   if (!unit.ok()) {
     std::fprintf(stderr, "bodyscan archive: %s\n", unit.status().message().c_str());
     return 2;
@@ -248,7 +262,7 @@ int run_archive(int argc, char** argv) {
   if (!sheet.ok()) return fail(sheet.status());
   std::string bytes;
   if (ends(".csv")) {
-    bytes = storage::sheet_csv(*sheet, *unit);
+    bytes = storage::profile_csv(*sheet, *profile, *unit);
   } else if (ends(".json")) {
     bytes = storage::sheet_json(*sheet, *unit).dump(1);
   } else if (ends(".pdf")) {

@@ -14,6 +14,7 @@
 #include "server/pipeline/cad_avatar.hpp"
 #include "server/pipeline/evaluate_measurement.hpp"
 #include "server/workstation/erasure.hpp"
+#include "storage/formats/export_profiles.hpp"
 #include "storage/formats/measurement_sheet.hpp"
 
 namespace bodyscan::server {
@@ -123,14 +124,20 @@ HttpResponse no_content() {
 }
 
 HttpResponse sheet(Workstation& ws, const Call& call, const std::string& format) {
-  auto unit = storage::parse_length_unit(call.request.param("unit", "mm"));
+  // A CSV's layout is the export profile's (storage/formats/export_profiles.hpp),
+  // its unit the profile's own unless one is asked for.
+  auto profile = storage::find_export_profile(call.request.param("profile", "sheet"));
+  if (!profile.ok()) return error_response(400, profile.status().message());
+  if (format != "csv" && profile->id != "sheet")
+    return error_response(400, "export profiles lay out the CSV; the " + format + " sheet has one layout");
+  auto unit = storage::parse_length_unit(call.request.param("unit", storage::unit_symbol(profile->default_unit)));
   if (!unit.ok()) return error_response(400, unit.status().message());
   const std::string& id = call.params.at("id");
   auto s = pipeline::archived_sheet(ws.archive(), id);
   if (!s.ok()) return error_response(s.status());
   HttpResponse out;
   if (format == "csv") {
-    out.body = storage::sheet_csv(*s, *unit);
+    out.body = storage::profile_csv(*s, *profile, *unit);
     out.set("Content-Type", "text/csv; charset=utf-8");
   } else if (format == "json") {
     out.body = storage::sheet_json(*s, *unit).dump(1);
@@ -143,9 +150,11 @@ HttpResponse sheet(Workstation& ws, const Call& call, const std::string& format)
     out.body = std::move(*pdf);
     out.set("Content-Type", "application/pdf");
   }
-  out.set("Content-Disposition", "attachment; filename=\"" + id + "-measurements." + format + "\"");
+  const std::string suffix = profile->id == "sheet" ? "measurements" : profile->id;
+  out.set("Content-Disposition", "attachment; filename=\"" + id + "-" + suffix + "." + format + "\"");
   out.set("Cache-Control", "no-store");
-  ws.archive().log(call.actor(), "export sheet", "scan", id, format);
+  ws.archive().log(call.actor(), "export sheet", "scan", id,
+                   profile->id == "sheet" ? format : format + ", " + profile->id);
   return out;
 }
 

@@ -55,10 +55,6 @@ std::vector<SheetEntry> sheet_entries(const BodyMeasurements& body) {
   return out;
 }
 
-namespace {
-
-// A CSV field: quoted when it holds a separator, a quote or a line break, and
-// defused when a spreadsheet would run it as a formula (=, +, -, @ first).
 std::string csv_field(const std::string& s) {
   std::string v = s;
   if (!v.empty() && (v[0] == '=' || v[0] == '+' || v[0] == '-' || v[0] == '@' || v[0] == '\t' || v[0] == '\r'))
@@ -71,8 +67,6 @@ std::string csv_field(const std::string& s) {
   }
   return q + '"';
 }
-
-}  // namespace
 
 std::string sheet_csv(const MeasurementSheet& sheet, LengthUnit unit) {
   std::string out = "iso_clause,name,label,value,unit,flagged,source,customer_ref,scan_id,taken_at\r\n";

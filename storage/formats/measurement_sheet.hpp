@@ -50,6 +50,10 @@ struct MeasurementSheet {
 // The automatic set's entries, in its order.
 std::vector<SheetEntry> sheet_entries(const BodyMeasurements& body);
 
+// A CSV field: quoted when it holds a separator, a quote or a line break, and
+// defused when a spreadsheet would run it as a formula (=, +, -, @ first).
+std::string csv_field(const std::string& s);
+
 // RFC 4180 CSV with a header row: iso_clause, name, label, value, unit, flagged,
 // source, customer_ref, scan_id, taken_at.
 std::string sheet_csv(const MeasurementSheet& sheet, LengthUnit unit);

@@ -589,6 +589,22 @@ TEST(ApiScan, TailorMeasuresSavesAndExports) {
   ASSERT_EQ(pdf.status, 200);
   EXPECT_EQ(pdf.body.substr(0, 5), "%PDF-");
   EXPECT_EQ(t.get(base + "/sheet.csv?unit=furlong").status, 400);
+  // Export profiles lay the CSV out for its target.
+  const HttpReply order = t.get(base + "/sheet.csv?profile=mtm-order");
+  ASSERT_EQ(order.status, 200) << order.body;
+  EXPECT_EQ(order.body.rfind("customer_ref,scan_id,measured_on,unit,height,neck,chest,waist,seat", 0), 0u);
+  EXPECT_NE(order.body.find(",cm,"), std::string::npos) << "an order is in cm unless asked";
+  char waist_cm[32];
+  std::snprintf(waist_cm, sizeof waist_cm, ",%.2f,", waist_mm / 10);
+  EXPECT_NE(order.body.find(waist_cm), std::string::npos) << "the automatic waist, in cm: " << order.body;
+  EXPECT_NE(order.header("content-disposition").find("-mtm-order.csv"), std::string::npos);
+  const HttpReply iso = t.get(base + "/sheet.csv?profile=iso8559&unit=in");
+  ASSERT_EQ(iso.status, 200);
+  EXPECT_EQ(iso.body.rfind("iso_clause,side,measurement,value,unit,flagged\r\n", 0), 0u);
+  EXPECT_NE(iso.body.find("5.3.10,,waist_girth,"), std::string::npos);
+  EXPECT_EQ(iso.body.find("waist at the line"), std::string::npos) << "a saved line has no clause";
+  EXPECT_EQ(t.get(base + "/sheet.csv?profile=excel").status, 400);
+  EXPECT_EQ(t.get(base + "/sheet.pdf?profile=mtm-order").status, 400);
   // Other kinds: point to point, over the skin, along the tape.
   EXPECT_NEAR(
       parse(t.post(base + "/measure", R"({"kind": "distance", "from": [0, 0, 0], "to": [30, 40, 0]})"))["value_mm"]

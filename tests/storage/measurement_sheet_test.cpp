@@ -5,9 +5,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "recon/io/ply.hpp"
+#include "storage/formats/export_profiles.hpp"
 #include "tests/test_data.hpp"
 
 namespace bodyscan::storage {
@@ -94,6 +96,63 @@ TEST(MeasurementSheet, CsvHasOneRowPerMeasurementKeyedByClauseAndName) {
     EXPECT_EQ(rows[i + 1][4], "cm");
     EXPECT_EQ(rows[i + 1][7], "C-0042");
   }
+}
+
+TEST(ExportProfiles, TheIsoProfileKeysEveryClausedValueByClauseAndSide) {
+  const Fixture& f = fixture();
+  auto iso = find_export_profile("iso8559");
+  ASSERT_TRUE(iso.ok());
+  const auto rows = parse_csv(profile_csv(f.sheet, *iso));
+  ASSERT_GE(rows.size(), 2u);
+  EXPECT_EQ(rows[0], (std::vector<std::string>{"iso_clause", "side", "measurement", "value", "unit", "flagged"}));
+  size_t claused = 0;
+  std::set<std::pair<std::string, std::string>> keys;
+  for (const SheetEntry& e : f.sheet.entries) claused += e.iso_clause.empty() ? 0 : 1;
+  ASSERT_EQ(rows.size(), claused + 1) << "a row per measurement with a clause, none without";
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_TRUE(keys.insert({rows[i][0], rows[i][1]}).second) << "clause and side are a key: " << rows[i][0];
+    EXPECT_EQ(rows[i][4], "mm");
+    const std::string name = rows[i][2] + (rows[i][1].empty() ? "" : "_" + rows[i][1]);
+    bool found = false;
+    for (const SheetEntry& e : f.sheet.entries)
+      if (e.name == name) {
+        found = true;
+        EXPECT_EQ(e.iso_clause, rows[i][0]);
+        EXPECT_NEAR(std::stod(rows[i][3]), e.value_mm, 0.05 + 1e-9);
+      }
+    EXPECT_TRUE(found) << name;
+  }
+  EXPECT_EQ(parse_csv(profile_csv(f.sheet, *iso, LengthUnit::kInch))[1][4], "in");
+}
+
+TEST(ExportProfiles, TheOrderIsOneRowUnderTheFormsNamesInCentimetres) {
+  const Fixture& f = fixture();
+  auto order = find_export_profile("mtm-order");
+  ASSERT_TRUE(order.ok());
+  const auto rows = parse_csv(profile_csv(f.sheet, *order));
+  ASSERT_EQ(rows.size(), 2u);
+  ASSERT_EQ(rows[0].size(), rows[1].size());
+  ASSERT_EQ(rows[0].size(), 4 + mtm_order_columns().size());
+  EXPECT_EQ(rows[1][0], "C-0042");
+  EXPECT_EQ(rows[1][2], "2026-11-22");
+  EXPECT_EQ(rows[1][3], "cm");
+  for (size_t c = 0; c < mtm_order_columns().size(); ++c) {
+    EXPECT_EQ(rows[0][4 + c], mtm_order_columns()[c].column);
+    const SheetEntry* e = nullptr;
+    for (const SheetEntry& x : f.sheet.entries)
+      if (x.name == mtm_order_columns()[c].measurement) e = &x;
+    ASSERT_NE(e, nullptr) << "every column maps to a measurement of the automatic set: "
+                          << mtm_order_columns()[c].measurement;
+    EXPECT_NEAR(std::stod(rows[1][4 + c]), e->value_mm / 10, 0.005 + 1e-9) << rows[0][4 + c];
+  }
+  // A sheet without a measurement leaves its cell empty.
+  MeasurementSheet partial = f.sheet;
+  partial.entries.erase(partial.entries.begin());
+  const auto short_rows = parse_csv(profile_csv(partial, *order));
+  EXPECT_EQ(short_rows[1][4], "") << "height, from the missing stature";
+  EXPECT_FALSE(find_export_profile("excel").ok());
+  EXPECT_EQ(profile_csv(f.sheet, *find_export_profile("sheet"), LengthUnit::kCentimetre),
+            sheet_csv(f.sheet, LengthUnit::kCentimetre));
 }
 
 TEST(MeasurementSheet, CsvQuotesAndDefusesWhatPeopleType) {

@@ -1502,8 +1502,10 @@ export interface paths {
         get: {
             parameters: {
                 query?: {
-                    /** @description mm (default), cm or in */
+                    /** @description mm, cm or in (default: the profile's: mm, or cm for mtm-order) */
                     unit?: string;
+                    /** @description the CSV's layout (docs/archive.md, "Export profiles"): sheet (default: a row per measurement), iso8559 (a row per measurement with an ISO 8559-1 clause, keyed by clause and side), mtm-order (one row under a made-to-measure order's column names, in cm unless 'unit' says otherwise) */
+                    profile?: "sheet" | "iso8559" | "mtm-order";
                 };
                 header?: never;
                 path: {

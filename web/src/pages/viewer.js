@@ -34,6 +34,13 @@ function fetchModel(id) {
   return bytes;
 }
 
+// The server's export profiles for the CSV (GET /api/scans/{id}/sheet.csv?profile=).
+const CSV_PROFILES = [
+  ['sheet', 'the tailor'],
+  ['iso8559', 'ISO 8559-1 systems'],
+  ['mtm-order', 'a made-to-measure order'],
+];
+
 /**
  * @param {HTMLElement} container
  * @param {Record<string, string>} params
@@ -60,6 +67,7 @@ export async function mount(container, { id }, ctx) {
     /** @type {Posture | null} */ posture: null,
     /** @type {Scan | null} */ scan: null,
     /** @type {Customer | null} */ customer: null,
+    /** the CSV's layout: an export profile of the server's (docs/archive.md) */ profile: 'sheet',
   };
 
   const viewport = h('div', { class: 'viewport', id: 'viewport' });
@@ -70,7 +78,11 @@ export async function mount(container, { id }, ctx) {
   const tableBox = h('div', { class: 'table-box' });
   const postureBox = h('div', { class: 'posture-box' });
   const actions = h('div', { class: 'actions' });
-  const side = h('aside', { class: 'viewer-side' }, heading, postureBox, resultBox, h('h2', {}, 'Measurements'), tableBox, h('h2', {}, 'Sheet and sharing'), actions);
+  const side = h('aside', { class: 'viewer-side' }, heading, postureBox, h('h2', {}, 'Measurements'), tableBox, h('h2', {}, 'Sheet and sharing'), actions);
+  // The result of a line just drawn sits on the 3-D view's top corner (beside the
+  // head, where the view is empty), in sight however far the side panel is
+  // scrolled, and without resizing the view under the user's fingers.
+  viewport.append(resultBox);
   const page = h('section', { class: 'page viewer-page' }, h('div', { class: 'viewer-main' }, toolbar, viewport, hint), side);
   container.append(page);
 
@@ -290,7 +302,17 @@ export async function mount(container, { id }, ctx) {
       h(
         'div',
         { class: 'row wrap' },
-        h('a', { class: 'button', href: `/api/scans/${enc(id)}/sheet.csv?unit=${u}`, download: `${id}-measurements.csv` }, 'Export CSV'),
+        h(
+          'label',
+          { class: 'field inline' },
+          h('span', {}, 'CSV for'),
+          h(
+            'select',
+            { name: 'profile', 'aria-label': 'CSV layout', onchange: (e) => ((state.profile = e.target.value), renderActions()) },
+            CSV_PROFILES.map(([value, label]) => h('option', { value, selected: value === state.profile }, label)),
+          ),
+        ),
+        h('a', { class: 'button', href: `/api/scans/${enc(id)}/sheet.csv?unit=${u}&profile=${state.profile}`, download: `${id}-${state.profile === 'sheet' ? 'measurements' : state.profile}.csv` }, 'Export CSV'),
         h('a', { class: 'button', href: `/api/scans/${enc(id)}/sheet.pdf?unit=${u}`, download: `${id}-measurements.pdf` }, 'Export PDF'),
         h('button', { type: 'button', onclick: () => avatarDialog(id, state.unit) }, 'Avatar for CAD…'),
         ctx.can.share(role) ? h('button', { type: 'button', onclick: () => shareDialog(id, state.measurements, state.unit) }, 'Share with customer…') : null,

@@ -244,6 +244,15 @@ export class BodyView {
     return true;
   }
 
+  // The model's bounding box (mm): the surface's, else the cloud's; null before
+  // either is shown.
+  modelBounds() {
+    const geometry = this.mesh?.geometry ?? this.points?.geometry;
+    if (!geometry) return null;
+    if (!geometry.boundingBox) geometry.computeBoundingBox();
+    return geometry.boundingBox;
+  }
+
   // Looks at the whole body from `view` (front, back, left, right).
   frame(box = this.mesh ? this.mesh.geometry.boundingBox : null, view = 'front') {
     if (!box) return;

@@ -19,10 +19,28 @@ export const POSTURE_NOTE = 'Taken outside the posture its definition assumes (s
 
 export const COLOURS = { selected: 0xd6336c, fresh: 0x0b7a75, compare: 0x7048e8 };
 
-// Draws a measurement's geometry on a BodyView under `key`.
+// How far beside the body (mm) a height's rule stands.
+const HEIGHT_RULE_GAP = 80;
+
+// Draws a measurement's geometry on a BodyView under `key`. A height is drawn as a
+// rule standing beside the body (its vertical line would run through the body's
+// inside), its ends marked, with a leader from the landmark it was read at.
 export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
   const g = m.geometry || m;
   view.clearOverlays(key);
+  const box = view.modelBounds();
+  if ((g.kind || m.kind) === 'height' && g.path && g.path.length >= 2 && box) {
+    const [low, high] = [...g.path].sort((a, b) => a[1] - b[1]).filter((_, i, all) => i === 0 || i === all.length - 1);
+    const x = box.max.x + HEIGHT_RULE_GAP;
+    const top = [x, high[1], high[2]];
+    const foot = [x, low[1], high[2]];
+    view.showPath(`${key}:path`, [foot, top], { color: colour, width: 3.5, onTop: true });
+    view.showPath(`${key}:leader`, [high, top], { color: colour, width: 1.5, onTop: true });
+    view.showMarker(`${key}:top`, top, { color: colour, radius: 6 });
+    view.showMarker(`${key}:foot`, foot, { color: colour, radius: 6 });
+    view.showMarker(`${key}:landmark`, high, { color: colour, radius: 5 });
+    return;
+  }
   if (g.path && g.path.length >= 2) view.showPath(`${key}:path`, g.path, { closed: !!g.closed, color: colour, width: 3.5 });
   if (g.from && g.to && g.kind !== 'height') {
     view.showMarker(`${key}:from`, g.from, { color: colour, radius: 6 });

@@ -305,6 +305,13 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await drawLine(0.4, 0.43, 0.6, 0.43);
     const girth = await pending;
     assert.equal(girth.status, 200);
+    // The value and its Save field stay beside the 3-D view, in the window,
+    // however far the side panel is scrolled.
+    await page.locator('.viewer-side').evaluate((e) => e.scrollTo(0, e.scrollHeight));
+    const resultAt = await page.locator('.result').boundingBox();
+    const windowHeight = await page.evaluate(() => window.innerHeight);
+    assert.ok(resultAt && resultAt.y >= 0 && resultAt.y + resultAt.height <= windowHeight, `the result at ${JSON.stringify(resultAt)}, the window ${windowHeight} px high`);
+    await shot(page, 'viewer-result');
     await page.fill('.result input[name=label]', 'Jacket waist');
     const saved = page.waitForResponse((r) => r.url().endsWith('/measurements') && r.request().method() === 'POST');
     await page.click('.result button:has-text("Save")');
@@ -373,6 +380,12 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.match(csv, /Waist girth/);
     assert.match(download.suggestedFilename(), /\.csv$/);
     await download.saveAs(`${ARTEFACTS}/sheet.csv`);
+    // The same, laid out as a made-to-measure order (an export profile).
+    await page.selectOption('select[aria-label="CSV layout"]', 'mtm-order');
+    const [orderFile] = await Promise.all([page.waitForEvent('download'), page.click('a:has-text("Export CSV")')]);
+    assert.match(orderFile.suggestedFilename(), /-mtm-order\.csv$/);
+    assert.match(readFileSync(await orderFile.path(), 'utf8'), /^customer_ref,scan_id,measured_on,unit,height,neck,chest,waist,seat,/);
+    await page.selectOption('select[aria-label="CSV layout"]', 'sheet');
     const [pdf] = await Promise.all([page.waitForEvent('download'), page.click('a:has-text("Export PDF")')]);
     assert.equal(readFileSync(await pdf.path()).subarray(0, 5).toString(), '%PDF-');
     await pdf.saveAs(`${ARTEFACTS}/sheet.pdf`);
