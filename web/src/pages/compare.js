@@ -62,12 +62,19 @@ export async function mount(container, { a, b }) {
   /** @type {[import('../api.js').StoredMeasurement[], import('../api.js').StoredMeasurement[]]} the earlier scan's, the later's */
   let sets = [[], []];
   function render() {
+    // Every measurement of either scan, saved ones too: the later scan's, then
+    // what only the earlier has (without a later value), the automatic set first.
+    const laterNames = new Set(sets[1].map((m) => m.name));
+    const rows = [...sets[1], ...sets[0].filter((m) => !laterNames.has(m.name)).map((m) => ({ ...m, value_mm: NaN, geometry: {} }))];
+    rows.sort((x, y) => (x.source === y.source ? 0 : x.source === 'automatic' ? -1 : y.source === 'automatic' ? 1 : 0));
     clear(
       tableBox,
       measurementTable({
-        measurements: sets[1],
+        measurements: rows,
         compareWith: sets[0],
-        columns: [`Later (${when(newer.started_at)})`, `Earlier (${when(older.started_at)})`],
+        // In the order of the bodies above: the earlier on the left.
+        columns: [`Earlier (${when(older.started_at)})`, `Later (${when(newer.started_at)})`],
+        otherFirst: true,
         unit,
         selected,
         onSelect: (m) => {

@@ -48,6 +48,9 @@ export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
   }
 }
 
+// A row's own value is missing where only the compared scan has the measurement.
+const has = (m) => Number.isFinite(m.value_mm);
+
 // rows: [{m, other?}] - `other` is the same measurement on a second scan (compare).
 /**
  * @param {object} options
@@ -57,7 +60,9 @@ export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
  * @param {(m: StoredMeasurement) => void} options.onSelect
  * @param {((m: StoredMeasurement) => void) | null} [options.onDelete] a Delete button on each saved row
  * @param {StoredMeasurement[] | null} [options.compareWith] the same scan's measurements on another scan
- * @param {[string, string]} [options.columns] the headings of the two values compared
+ * @param {[string, string]} [options.columns] the headings of the two values compared, as shown
+ * @param {boolean} [options.otherFirst] the compared value's column before the row's own (a
+ *   comparison shown in the order of its two bodies); the change is still row − compared
  * @param {string} [options.caption]
  * @param {Record<string, string>} [options.groups] the heading of each source's rows
  */
@@ -69,6 +74,7 @@ export function measurementTable({
   onDelete,
   compareWith = null,
   columns = ['This scan', 'Other'],
+  otherFirst = false,
   caption,
   groups = { automatic: 'Automatic (ISO 8559-1)', user: 'Saved by staff' },
 }) {
@@ -91,6 +97,15 @@ export function measurementTable({
     }
     const g = m.geometry || {};
     const other = byName.get(m.name);
+    // A row the compared scan has and this one does not carries no value.
+    const ownCell = h(
+      'td',
+      { class: 'num value' },
+      g.outside_posture ? h('span', { class: 'posture-flag', title: POSTURE_NOTE, 'aria-label': POSTURE_NOTE }, '⚑ ') : null,
+      g.crosses_filled_hole ? h('span', { class: 'filled', title: FILLED_NOTE }, '≈ ') : null,
+      has(m) ? formatLength(m.value_mm, unit) : '—',
+    );
+    const otherCell = compareWith ? h('td', { class: 'num' }, other ? formatLength(other.value_mm, unit) : '—') : null;
     const row = h(
       'tr',
       {
@@ -112,15 +127,8 @@ export function measurementTable({
         h('span', { class: 'm-label' }, m.label || m.name),
         h('small', { class: 'muted' }, ` ${KIND_LABEL[m.kind] || m.kind}${m.iso_clause ? ` · ISO ${m.iso_clause}` : ''}`),
       ),
-      h(
-        'td',
-        { class: 'num value' },
-        g.outside_posture ? h('span', { class: 'posture-flag', title: POSTURE_NOTE, 'aria-label': POSTURE_NOTE }, '⚑ ') : null,
-        g.crosses_filled_hole ? h('span', { class: 'filled', title: FILLED_NOTE }, '≈ ') : null,
-        formatLength(m.value_mm, unit),
-      ),
-      compareWith ? h('td', { class: 'num' }, other ? formatLength(other.value_mm, unit) : '—') : null,
-      compareWith ? h('td', { class: 'num' }, other ? formatDifference(m.value_mm - other.value_mm, unit) : '—') : null,
+      ...(otherFirst ? [otherCell, ownCell] : [ownCell, otherCell]),
+      compareWith ? h('td', { class: 'num' }, other && has(m) ? formatDifference(m.value_mm - other.value_mm, unit) : '—') : null,
       onDelete
         ? h(
             'td',

@@ -542,7 +542,15 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.equal(cells.length, 4, cells.join(' | '));
     // Two scans of one body on one rig: the waist agrees within 2 cm, and each is
     // within 3 cm of the true body's (every 6th laser step is a coarse scan).
-    const [later, earlier] = [cells[1], cells[2]].map((t) => Number(t.replace(/[^0-9.]/g, '')));
+    // In the order of the bodies: the earlier scan's value, then the later's.
+    const [earlier, later] = [cells[1], cells[2]].map((t) => Number(t.replace(/[^0-9.]/g, '')));
+    assert.match(await page.locator('table.measurements thead th').nth(1).innerText(), /^Earlier/);
+    assert.match(cells[3], /\d/, `the change, later − earlier: ${cells.join(' | ')}`);
+    // The earlier scan's saved line is there too, without a later value.
+    const saved = await page.locator('table.measurements tr[data-name=jacket_waist] td').allInnerTexts();
+    assert.equal(saved.length, 4, saved.join(' | '));
+    assert.match(saved[1], /\d/);
+    assert.equal(saved[2], '—');
     assert.ok(Math.abs(later - earlier) < 2, cells.join(' | '));
     const truth = demoBodyMeasurement('waist_girth') / 10;
     for (const scanned of [later, earlier]) assert.ok(Math.abs(scanned - truth) < 3, `${cells.join(' | ')}; the true body's: ${truth.toFixed(1)} cm`);
