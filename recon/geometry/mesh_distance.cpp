@@ -331,7 +331,7 @@ void MeshDistance::build(const std::vector<Vec3f>& centroids, std::vector<uint32
         right_count += bin_count[i];
         cost[i - 1] += right.half_area() * static_cast<float>(right_count);
       }
-      const int split = static_cast<int>(std::min_element(cost, cost + kSahBins - 1) - cost);
+      const int split = static_cast<int>(std::min_element(cost, cost + (kSahBins - 1)) - cost);
       mid = std::partition(first, last, [&](uint32_t t) { return bin_of(t) <= split; });
       if (mid == first || mid == last) mid = nullptr;  // only if rounding emptied a side
     }
