@@ -23,12 +23,6 @@ StatusOr<Avatar> make_avatar(const TriangleMesh& surface, const AvatarOptions& o
   return out;
 }
 
-StatusOr<AvatarFormat> parse_avatar_format(std::string_view text) {
-  if (text == "obj") return AvatarFormat::kObj;
-  if (text == "glb") return AvatarFormat::kGlb;
-  return invalid_argument("an avatar is 'obj' or 'glb'");
-}
-
 StatusOr<storage::ModelUnit> parse_model_unit(std::string_view text) {
   if (text == "mm") return storage::ModelUnit::kMillimetre;
   if (text == "m") return storage::ModelUnit::kMetre;

@@ -37,8 +37,7 @@ struct Avatar {
 
 StatusOr<Avatar> make_avatar(const TriangleMesh& surface, const AvatarOptions& options);
 
-// "obj" or "glb"; "mm" or "m": invalid_argument naming what is accepted otherwise.
-StatusOr<AvatarFormat> parse_avatar_format(std::string_view text);
+// "mm" or "m": invalid_argument naming what is accepted otherwise.
 StatusOr<storage::ModelUnit> parse_model_unit(std::string_view text);
 
 }  // namespace bodyscan::pipeline
