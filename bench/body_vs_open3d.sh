@@ -18,7 +18,7 @@ echo "== bodyscan (library, in-process, includes sampling-free timing)"
   --cloud-out "$OUT/points.ply" --mesh-out "$OUT/bodyscan.ply"
 echo
 echo "== bodyscan reconstruct (the CLI, whole process incl. PLY read/write)"
-/usr/bin/time -f "process: %e s wall, %M KB peak RSS" ./build/server/bodyscan reconstruct "$OUT/points.ply" -o "$OUT/bodyscan_cli.ply" -q
+/usr/bin/time -f "process: %e s wall, %M KB peak RSS" ./build/app/bodyscan reconstruct "$OUT/points.ply" -o "$OUT/bodyscan_cli.ply" -q
 echo
 echo "== Open3D"
 /usr/bin/time -f "process: %e s wall, %M KB peak RSS" /usr/bin/python3 bench/open3d_body.py "$OUT/points.ply" "$OUT/open3d.ply"

@@ -7,7 +7,7 @@ docs/benchmarks.md §7). Each cloud is made into a closed surface by
 `bodyscan reconstruct --body` (normals from the points, as a scan's), then
 measured by `bodyscan measure --girth-y 0`.
 
-    bench/gap_cylinder.py [--bodyscan build/server/bodyscan] [--seed 1]
+    bench/gap_cylinder.py [--bodyscan build/app/bodyscan] [--seed 1]
 
 Prints per case the radius's error (mean and largest, mm) over the strip's middle
 (|Y| < 20, within 20 degrees of its centre) and on the far side, and the tape's
@@ -65,7 +65,7 @@ def read_ply_vertices(path):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--bodyscan", default="build/server/bodyscan")
+    ap.add_argument("--bodyscan", default="build/app/bodyscan")
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
     rng = np.random.default_rng(args.seed)

@@ -22,10 +22,10 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/scan_job.hpp"
 #include "recon/geometry/fill_holes.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/surface/reconstruct.hpp"
-#include "server/pipeline/scan_job.hpp"
 
 using namespace bodyscan;
 

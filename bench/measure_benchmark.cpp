@@ -51,11 +51,11 @@
 #include <vector>
 
 #include "hw/sim/scene.hpp"
+#include "pipeline/rig_backend.hpp"
+#include "pipeline/scan_job.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_measurements.hpp"
 #include "recon/measure/body_slicer.hpp"
-#include "server/pipeline/rig_backend.hpp"
-#include "server/pipeline/scan_job.hpp"
 #include "tests/support/skin_noise.hpp"
 
 using namespace bodyscan;

@@ -1,4 +1,4 @@
-// The posture check before a scan (server/pipeline/posture_sweep.hpp), judged on the
+// The posture check before a scan (pipeline/posture_sweep.hpp), judged on the
 // simulated rig: for each posture the subject is posed in, the posture the quick
 // sweep reads against the one the full automatic set reads on the posed true mesh,
 // whether the two agree on every check the sweep makes (arms, feet, turn), and how
@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "hw/sim/sim_rig.hpp"
+#include "pipeline/posture_sweep.hpp"
+#include "pipeline/rig_backend.hpp"
 #include "recon/measure/body_measurements.hpp"
-#include "server/pipeline/posture_sweep.hpp"
-#include "server/pipeline/rig_backend.hpp"
 
 namespace {
 using namespace bodyscan;

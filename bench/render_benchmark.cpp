@@ -1,5 +1,5 @@
 // How fast the simulated rig renders a full scan: the scan sequence of
-// server/pipeline/acquire (every laser group swept step by step, every camera
+// pipeline/acquire (every laser group swept step by step, every camera
 // grabbing each step; the frames are made and dropped, as a scan streams them), and
 // separately the calibration sequence (the dot grid before each camera, the frame
 // lights, each laser alone).
@@ -16,8 +16,8 @@
 #include <string>
 
 #include "hw/sim/sim_rig.hpp"
-#include "server/pipeline/acquire.hpp"
-#include "server/pipeline/rig_backend.hpp"
+#include "pipeline/acquire.hpp"
+#include "pipeline/rig_backend.hpp"
 
 using namespace bodyscan;
 

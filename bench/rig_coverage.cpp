@@ -18,8 +18,8 @@
 #include <string>
 
 #include "bench/body_region.hpp"
+#include "pipeline/rig_backend.hpp"
 #include "recon/geometry/sample_surface.hpp"
-#include "server/pipeline/rig_backend.hpp"
 
 using namespace bodyscan;
 

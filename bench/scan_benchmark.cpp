@@ -16,12 +16,12 @@
 #include <string>
 
 #include "bench/body_region.hpp"
+#include "pipeline/rig_backend.hpp"
+#include "pipeline/scan.hpp"
 #include "recon/calib/plane_projection.hpp"
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/geometry/sample_surface.hpp"
 #include "recon/spatial/knn_index.hpp"
-#include "server/pipeline/rig_backend.hpp"
-#include "server/pipeline/scan.hpp"
 
 using namespace bodyscan;
 using Clock = std::chrono::steady_clock;

@@ -20,10 +20,10 @@ password="bench-$$-$RANDOM$RANDOM"
 
 if [[ -n "${BODYSCAN_BIN:-}" ]]; then
   bin="$(realpath "$BODYSCAN_BIN")"
-elif "$here/build/server/bodyscan" serve --help >/dev/null 2>&1; then
-  bin="$here/build/server/bodyscan"
+elif "$here/build/app/bodyscan" serve --help >/dev/null 2>&1; then
+  bin="$here/build/app/bodyscan"
 else
-  bin="$here/build-test/server/bodyscan"
+  bin="$here/build-test/app/bodyscan"
 fi
 "$bin" serve --help >/dev/null 2>&1 || { echo "server_load: $bin has no 'serve' command" >&2; exit 1; }
 for tool in curl wrk python3; do

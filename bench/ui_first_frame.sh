@@ -2,7 +2,7 @@
 # The browser UI: time from opening a scan to its first rendered frame and to
 # picking ready, the display mesh the app serves against the whole surface, side
 # by side in one run (docs/benchmarks.md §10).
-#   [RUNS=5] [BODYSCAN_BIN=build/server/bodyscan] [BODYSCAN_WEB_ROOT=build/web] bench/ui_first_frame.sh
+#   [RUNS=5] [BODYSCAN_BIN=build/app/bodyscan] [BODYSCAN_WEB_ROOT=build/web] bench/ui_first_frame.sh
 # Builds nothing (run deploy/build.sh first); needs Chromium (deploy/install-deps.sh
 # --browser). Makes, once, an archive of the demo body's full scan in
 # out/bench-ui/every1 (1.55 M triangles, ~3 min; its mesh.glb the display mesh of
@@ -11,7 +11,7 @@
 # scan in headless Chromium RUNS times with each model.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
-export BODYSCAN_BIN="$(realpath "${BODYSCAN_BIN:-$here/build/server/bodyscan}")"
+export BODYSCAN_BIN="$(realpath "${BODYSCAN_BIN:-$here/build/app/bodyscan}")"
 export BODYSCAN_WEB_ROOT="$(realpath "${BODYSCAN_WEB_ROOT:-$here/build/web}")"
 out="$here/out/bench-ui"
 dir="$out/every1"

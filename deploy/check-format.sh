@@ -24,7 +24,7 @@ fi
 if [[ -d .git ]] && command -v git >/dev/null; then
   mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.h' '*.cpp.in')
 else
-  mapfile -t files < <(find bench fuzz hw recon server storage tests \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.cpp.in' \) | sort)
+  mapfile -t files < <(find app bench core fuzz hw pipeline recon server storage tests \( -name '*.cpp' -o -name '*.hpp' -o -name '*.h' -o -name '*.cpp.in' \) | sort)
 fi
 if $fix; then
   "$tool" -i --style=file "${files[@]}"

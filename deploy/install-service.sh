@@ -26,7 +26,7 @@ for arg in "$@"; do
 done
 
 SERVICE_USER=bodyscan
-BIN_SRC=${BIN_SRC:-build/server/bodyscan}
+BIN_SRC=${BIN_SRC:-build/app/bodyscan}
 BIN_DEST=/usr/local/bin/bodyscan
 WEB_SRC=${WEB_SRC:-build/web}
 WEB_DEST=/usr/local/share/bodyscan/web

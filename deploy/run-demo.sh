@@ -23,7 +23,7 @@ DATA=${DATA:-out/data}
 PORT=${PORT:-8080}
 mkdir -p "$OUT"
 if [[ "${DEMO_SCAN:-}" == 1 || ! -s "$DATA/archive.db" ]] ||
-   ! ./build/server/bodyscan archive "$DATA" list | grep -q complete; then
-  ./build/server/bodyscan scan --rig sim --out "$OUT" --archive "$DATA" --new-customer "Demo customer" --operator demo
+   ! ./build/app/bodyscan archive "$DATA" list | grep -q complete; then
+  ./build/app/bodyscan scan --rig sim --out "$OUT" --archive "$DATA" --new-customer "Demo customer" --operator demo
 fi
-exec ./build/server/bodyscan serve --rig sim --data "$DATA" --port "$PORT"
+exec ./build/app/bodyscan serve --rig sim --data "$DATA" --port "$PORT"

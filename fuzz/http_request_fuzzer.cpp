@@ -18,10 +18,10 @@
 #include <string>
 #include <string_view>
 
+#include "pipeline/archive_scan.hpp"
 #include "recon/io/ply.hpp"
 #include "server/api/api.hpp"
 #include "server/net/http_server.hpp"
-#include "server/pipeline/archive_scan.hpp"
 #include "server/workstation/workstation.hpp"
 
 namespace {

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "recon/core/json_text.hpp"
-#include "server/pipeline/evaluate_measurement.hpp"
+#include "core/json_text.hpp"
+#include "pipeline/evaluate_measurement.hpp"
 
 namespace {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "core/status.hpp"
 #include "hw/rig_description.hpp"
-#include "recon/core/status.hpp"
 
 namespace bodyscan::hw {
 

@@ -7,7 +7,7 @@
 // every path out of a scope, exceptions included.
 #pragma once
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan::hw {
 

@@ -10,7 +10,7 @@
 #include <set>
 #include <sstream>
 
-#include "recon/core/json_text.hpp"
+#include "core/json_text.hpp"
 
 namespace bodyscan::hw {
 

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "core/status.hpp"
 #include "hw/camera_model.hpp"
-#include "recon/core/status.hpp"
 
 namespace bodyscan::hw {
 

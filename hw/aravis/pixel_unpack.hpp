@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan::hw::aravis {
 

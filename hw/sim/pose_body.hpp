@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "core/status.hpp"
 #include "hw/rig_description.hpp"
-#include "recon/core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 
 namespace bodyscan::hw::sim {

@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <string>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan::hw::usb {
 

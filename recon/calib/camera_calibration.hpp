@@ -11,11 +11,11 @@
 
 #include <Eigen/Core>
 
+#include "core/status.hpp"
 #include "recon/calib/frame_markers.hpp"
 #include "recon/calib/lens_correction.hpp"
 #include "recon/calib/plane_projection.hpp"
 #include "recon/calib/reference_frame.hpp"
-#include "recon/core/status.hpp"
 
 namespace bodyscan {
 

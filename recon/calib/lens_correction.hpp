@@ -15,7 +15,7 @@
 
 #include <Eigen/Core>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/scan/stripe.hpp"  // ImageView
 
 namespace bodyscan {

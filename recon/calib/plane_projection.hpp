@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan {
 

@@ -12,7 +12,7 @@
 
 #include <cstddef>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 
 namespace bodyscan {

@@ -4,7 +4,7 @@
 #include <string>
 #include <string_view>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan {
 

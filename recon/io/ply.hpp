@@ -18,7 +18,7 @@
 #include <string>
 #include <string_view>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/point_cloud.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan {
 

@@ -14,7 +14,7 @@
 #include <Eigen/Geometry>
 #include <optional>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 
 namespace bodyscan {

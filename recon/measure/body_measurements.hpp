@@ -33,7 +33,7 @@
 #include <string>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 #include "recon/measure/body_frame.hpp"
 #include "recon/measure/body_posture.hpp"

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 #include "recon/measure/girth.hpp"
 

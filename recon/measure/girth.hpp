@@ -8,7 +8,7 @@
 #include <optional>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/point_cloud.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 #include "recon/measure/plane_section.hpp"

@@ -23,7 +23,7 @@
 #include <memory>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 
 namespace bodyscan {

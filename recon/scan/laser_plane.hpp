@@ -21,8 +21,8 @@
 
 #include <Eigen/Core>
 
+#include "core/status.hpp"
 #include "recon/calib/camera_calibration.hpp"
-#include "recon/core/status.hpp"
 #include "recon/scan/stripe.hpp"
 
 namespace bodyscan {

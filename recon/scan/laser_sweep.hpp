@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan {
 

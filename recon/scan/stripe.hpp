@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan {
 

@@ -30,7 +30,7 @@
 #include <string>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/point_cloud.hpp"
 
 namespace bodyscan {

@@ -1,6 +1,6 @@
 #include "recon/surface/estimate_noise.hpp"
 
-#include "recon/core/median.hpp"
+#include "core/median.hpp"
 #include "recon/surface/estimate_curvature.hpp"
 
 #include <tbb/blocked_range.h>

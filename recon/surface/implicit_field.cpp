@@ -11,7 +11,7 @@
 #include <mutex>
 #include <numeric>
 
-#include "recon/core/median.hpp"
+#include "core/median.hpp"
 
 namespace bodyscan {
 

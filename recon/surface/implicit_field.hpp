@@ -41,8 +41,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "recon/core/progress.hpp"
-#include "recon/core/status.hpp"
+#include "core/progress.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/point_cloud.hpp"
 
 namespace bodyscan {

@@ -16,8 +16,8 @@
 #include <array>
 #include <vector>
 
-#include "recon/core/progress.hpp"
-#include "recon/core/status.hpp"
+#include "core/progress.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 #include "recon/surface/implicit_field.hpp"
 

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "recon/core/median.hpp"
+#include "core/median.hpp"
 #include "recon/geometry/fill_holes.hpp"
 #include "recon/geometry/mesh_components.hpp"
 #include "recon/spatial/knn_index.hpp"

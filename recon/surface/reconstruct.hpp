@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "recon/core/progress.hpp"
-#include "recon/core/status.hpp"
+#include "core/progress.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/fill_holes.hpp"
 #include "recon/geometry/point_cloud.hpp"
 #include "recon/geometry/triangle_mesh.hpp"

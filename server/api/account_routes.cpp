@@ -1,5 +1,5 @@
 // Logging in and out, the session, and the staff accounts (admins).
-#include "recon/core/json_text.hpp"
+#include "core/json_text.hpp"
 #include "server/api/api.hpp"
 
 namespace bodyscan::server {

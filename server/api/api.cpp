@@ -4,7 +4,7 @@
 
 #include <cctype>
 
-#include "recon/core/json_text.hpp"
+#include "core/json_text.hpp"
 #include "server/api/static_files.hpp"
 
 namespace bodyscan::server {

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan::server {
 

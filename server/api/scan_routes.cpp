@@ -6,13 +6,13 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "recon/core/json_text.hpp"
+#include "core/json_text.hpp"
+#include "pipeline/archive_scan.hpp"
+#include "pipeline/cad_avatar.hpp"
+#include "pipeline/evaluate_measurement.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/api/api.hpp"
 #include "server/api/scan_views.hpp"
-#include "server/pipeline/archive_scan.hpp"
-#include "server/pipeline/cad_avatar.hpp"
-#include "server/pipeline/evaluate_measurement.hpp"
 #include "server/workstation/erasure.hpp"
 #include "storage/formats/export_profiles.hpp"
 #include "storage/formats/measurement_sheet.hpp"

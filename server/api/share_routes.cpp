@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pipeline/share_model.hpp"
 #include "server/api/api.hpp"
 #include "server/api/scan_views.hpp"
-#include "server/pipeline/share_model.hpp"
 #include "storage/formats/draco_files.hpp"
 
 namespace bodyscan::server {

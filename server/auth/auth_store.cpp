@@ -17,7 +17,7 @@
 #include <mutex>
 #include <unordered_map>
 
-#include "recon/core/json_text.hpp"
+#include "core/json_text.hpp"
 #include "storage/archive/ids.hpp"
 #include "storage/archive/sqlite.hpp"
 

@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "server/api/api.hpp"
 #include "server/workstation/workstation.hpp"
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "server/auth/auth_store.hpp"
 #include "storage/archive/archive.hpp"
 

@@ -9,8 +9,8 @@
 
 #include <string>
 
+#include "core/status.hpp"
 #include "hw/camera.hpp"
-#include "recon/core/status.hpp"
 #include "recon/io/png_image.hpp"
 
 namespace bodyscan::server {

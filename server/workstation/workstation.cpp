@@ -18,14 +18,14 @@
 
 #include <zlib.h>
 
+#include "core/json_text.hpp"
 #include "hw/rig_description.hpp"
-#include "recon/core/json_text.hpp"
+#include "pipeline/archive_scan.hpp"
+#include "pipeline/posture_sweep.hpp"
+#include "pipeline/rig_backend.hpp"
+#include "pipeline/scan_job.hpp"
+#include "pipeline/scan_recording.hpp"
 #include "recon/io/atomic_file.hpp"
-#include "server/pipeline/archive_scan.hpp"
-#include "server/pipeline/posture_sweep.hpp"
-#include "server/pipeline/rig_backend.hpp"
-#include "server/pipeline/scan_job.hpp"
-#include "server/pipeline/scan_recording.hpp"
 #include "server/workstation/erasure.hpp"
 #include "server/workstation/preview.hpp"
 #include "storage/archive/ids.hpp"

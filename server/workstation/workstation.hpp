@@ -17,11 +17,11 @@
 #include <optional>
 #include <string>
 
+#include "core/status.hpp"
 #include "hw/sim/sim_rig.hpp"
-#include "recon/core/status.hpp"
+#include "pipeline/rig_backend.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 #include "server/auth/auth_store.hpp"
-#include "server/pipeline/rig_backend.hpp"
 #include "storage/archive/archive.hpp"
 
 namespace bodyscan::server {

@@ -15,7 +15,7 @@
 #include <set>
 #include <sstream>
 
-#include "recon/core/json_text.hpp"
+#include "core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "storage/archive/ids.hpp"
 #include "storage/archive/sqlite.hpp"

@@ -33,7 +33,7 @@
 #include <string_view>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan::storage {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 
 namespace bodyscan::storage {
 

@@ -16,7 +16,7 @@
 #include <memory>
 #include <vector>
 
-#include "recon/core/json_text.hpp"
+#include "core/json_text.hpp"
 #include "recon/io/atomic_file.hpp"
 
 namespace bodyscan::storage {

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "storage/formats/measurement_sheet.hpp"
 
 namespace bodyscan::storage {

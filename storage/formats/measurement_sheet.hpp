@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 #include "recon/measure/body_measurements.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/geometry/triangle_mesh.hpp"
 
 namespace bodyscan::storage {

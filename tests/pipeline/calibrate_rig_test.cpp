@@ -6,8 +6,8 @@
 
 #include "hw/device_rig.hpp"
 #include "hw/sim/sim_rig.hpp"
-#include "server/pipeline/calibrate.hpp"
-#include "server/pipeline/rig_backend.hpp"
+#include "pipeline/calibrate.hpp"
+#include "pipeline/rig_backend.hpp"
 #include "tests/half_resolution.hpp"
 
 namespace bodyscan::pipeline {

@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 
 #include "hw/sim/sim_rig.hpp"
+#include "pipeline/posture_sweep.hpp"
+#include "pipeline/rig_backend.hpp"
 #include "recon/measure/body_measurements.hpp"
-#include "server/pipeline/posture_sweep.hpp"
-#include "server/pipeline/rig_backend.hpp"
 
 namespace bodyscan::pipeline {
 namespace {

@@ -5,9 +5,9 @@
 #include <algorithm>
 
 #include "hw/sim/sim_rig.hpp"
+#include "pipeline/rig_backend.hpp"
+#include "pipeline/scan_job.hpp"
 #include "recon/geometry/mesh_distance.hpp"
-#include "server/pipeline/rig_backend.hpp"
-#include "server/pipeline/scan_job.hpp"
 #include "tests/distance_after_shift.hpp"
 #include "tests/half_resolution.hpp"
 

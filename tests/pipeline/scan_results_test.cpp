@@ -6,8 +6,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "pipeline/scan_job.hpp"
 #include "recon/io/ply.hpp"
-#include "server/pipeline/scan_job.hpp"
 #include "storage/formats/draco_files.hpp"
 #include "tests/test_data.hpp"
 

@@ -9,9 +9,9 @@
 
 #include "hw/device_rig.hpp"
 #include "hw/usb/sim_tmcl_board.hpp"
+#include "pipeline/rig_backend.hpp"
+#include "pipeline/scan_job.hpp"
 #include "recon/geometry/mesh_distance.hpp"
-#include "server/pipeline/rig_backend.hpp"
-#include "server/pipeline/scan_job.hpp"
 #include "tests/half_resolution.hpp"
 #include "tests/hw/usb/tmcl_rig.hpp"
 

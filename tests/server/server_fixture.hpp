@@ -10,10 +10,10 @@
 #include <memory>
 #include <string>
 
+#include "pipeline/archive_scan.hpp"
 #include "recon/io/ply.hpp"
 #include "server/api/api.hpp"
 #include "server/net/http_server.hpp"
-#include "server/pipeline/archive_scan.hpp"
 #include "server/workstation/workstation.hpp"
 #include "tests/server/http_client.hpp"
 #include "tests/test_data.hpp"

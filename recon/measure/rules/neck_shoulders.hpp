@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <optional>
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/measure/body_posture.hpp"
 #include "recon/measure/rules/body_cuts.hpp"
 #include "recon/measure/rules/sheet.hpp"

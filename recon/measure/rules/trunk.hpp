@@ -3,7 +3,7 @@
 // taken there (docs/measurements.md, "Landmarks" and "Measurements").
 #pragma once
 
-#include "recon/core/status.hpp"
+#include "core/status.hpp"
 #include "recon/measure/rules/body_cuts.hpp"
 #include "recon/measure/rules/sheet.hpp"
 

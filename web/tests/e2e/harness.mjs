@@ -19,7 +19,7 @@ function required(name, fallback) {
   return v;
 }
 
-export const BIN = () => required('BODYSCAN_BIN', join(REPO, 'build-test/server/bodyscan'));
+export const BIN = () => required('BODYSCAN_BIN', join(REPO, 'build-test/app/bodyscan'));
 export const WEB_ROOT = () => required('BODYSCAN_WEB_ROOT', join(REPO, 'build-test/web'));
 export const CHROMIUM = () => {
   const p = process.env.CHROMIUM || '/usr/bin/chromium';

@@ -1,0 +1,249 @@
+// `bodyscan serve`: the workstation. Opens the archive, the accounts and the rig,
+// serves the API and the browser UI, and on SIGINT, SIGTERM, SIGHUP, SIGQUIT or
+// SIGUSR1 cancels the running job (marked as such in the archive), turns the
+// lasers off and closes cleanly.
+#include <signal.h>
+#include <sodium.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "app/cli_subject.hpp"
+#include "recon/io/atomic_file.hpp"
+#include "server/api/api.hpp"
+#include "server/net/http_server.hpp"
+#include "server/workstation/workstation.hpp"
+
+namespace bodyscan::cli {
+
+namespace {
+
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1};
+
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    case SIGQUIT: return "SIGQUIT";
+    case SIGUSR1: return "SIGUSR1";
+    default: return "signal";
+  }
+}
+
+void usage(FILE* out) {
+  std::fprintf(out,
+               "usage: bodyscan serve [options]\n"
+               "\n"
+               "Runs the workstation: the rig (calibration, scans, reconstruction), the\n"
+               "archive, the REST API and WebSocket events (docs/api.md), and the browser UI.\n"
+               "On embedded defaults: the simulated rig with the demo body, the archive in\n"
+               "./bodyscan-data, port 8080.\n"
+               "\n"
+               "  --address A        the address to listen on (default 0.0.0.0)\n"
+               "  --port N           (default 8080; 0 picks a free port)\n"
+               "  --data DIR         the archive and accounts (default ./bodyscan-data)\n"
+               "  --rig RIG          sim (default), thesis, square, tiered or a rig description file\n"
+               "%s"
+               "  --every N          scans use every Nth laser step unless asked otherwise\n"
+               "                     (default 1)\n"
+               "  --retention-days N erase scans that started more than N days ago, at start\n"
+               "                     and hourly (logged in the audit); default: keep them\n"
+               "  --operator-dot-grid\n"
+               "                     calibration asks a person to hold the lens board before\n"
+               "                     the simulated cameras too, as it does before real ones\n"
+               "                     (staff training)\n"
+               "  --web DIR          the browser UI's files (default: the UI this build made, BUILD/web)\n"
+               "  --tls-cert PEM --tls-key PEM\n"
+               "                     serve HTTPS (session cookies become Secure)\n"
+               "  --behind-tls-proxy a TLS proxy in front forwards to us: cookies Secure\n"
+               "  --trusted-proxy A  believe X-Forwarded-For/-Proto/-Host from this address\n"
+               "                     (the reverse proxy's; repeatable)\n"
+               "  --public-url URL   the address customers' share links start with\n"
+               "  --admin NAME       the first admin account, made when there is none; its\n"
+               "                     password comes from BODYSCAN_ADMIN_PASSWORD, or one is made\n"
+               "                     up, printed once and kept in DATA/first-admin-password\n"
+               "                     (mode 0600) until changed\n"
+               "  --workers N        threads for requests' work (default 3)\n"
+               "  --max-connections N\n"
+               "                     open HTTP and WebSocket connections at most; more are\n"
+               "                     answered 503 (default: the descriptor limit less 128)\n",
+               kSubjectOptionsHelp);
+}
+
+std::string random_password() {
+  unsigned char b[12];
+  randombytes_buf(b, sizeof b);
+  std::string out(sodium_base64_encoded_len(sizeof b, sodium_base64_VARIANT_URLSAFE_NO_PADDING), '\0');
+  sodium_bin2base64(out.data(), out.size(), b, sizeof b, sodium_base64_VARIANT_URLSAFE_NO_PADDING);
+  out.pop_back();
+  return out;
+}
+
+}  // namespace
+
+int run_serve(int argc, char** argv) {
+  server::WorkstationOptions wo;
+  server::NetOptions no;
+  server::ApiOptions ao;
+  ao.web_root = BODYSCAN_WEB_ROOT;
+  std::string admin = "admin";
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      usage(stdout);
+      return 0;
+    }
+    if (a == "--behind-tls-proxy") {
+      ao.secure_cookies = true;
+      continue;
+    }
+    if (a == "--operator-dot-grid") {
+      wo.operator_dot_grid = true;
+      continue;
+    }
+    if (i + 1 >= argc) {
+      std::fprintf(stderr, "bodyscan serve: %s needs a value (or is unknown)\n", a.c_str());
+      usage(stderr);
+      return 2;
+    }
+    const std::string v = argv[++i];
+    auto number = [&](int lo, int hi) -> std::optional<int> {
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end != '\0' || n < lo || n > hi) {
+        std::fprintf(stderr, "bodyscan serve: %s expects a number from %d to %d, got '%s'\n", a.c_str(), lo, hi,
+                     v.c_str());
+        return std::nullopt;
+      }
+      return static_cast<int>(n);
+    };
+    if (a == "--address")
+      no.address = v;
+    else if (a == "--port") {
+      auto n = number(0, 65535);
+      if (!n) return 2;
+      no.port = static_cast<uint16_t>(*n);
+    } else if (a == "--data")
+      wo.data_dir = v;
+    else if (a == "--rig")
+      wo.rig = v;
+    else if (is_subject_option(a)) {
+      if (Status st = set_subject_option(a, v, &wo.subject); !st.ok()) {
+        std::fprintf(stderr, "bodyscan serve: %s\n", st.message().c_str());
+        return 2;
+      }
+    } else if (a == "--every") {
+      auto n = number(1, 1000);
+      if (!n) return 2;
+      wo.default_every = *n;
+    } else if (a == "--retention-days") {
+      auto n = number(1, 36500);
+      if (!n) return 2;
+      wo.retention_days = *n;
+    } else if (a == "--web")
+      ao.web_root = v;
+    else if (a == "--trusted-proxy")
+      no.trusted_proxies.push_back(v);
+    else if (a == "--tls-cert")
+      no.tls_cert = v;
+    else if (a == "--tls-key")
+      no.tls_key = v;
+    else if (a == "--public-url")
+      ao.public_url = v;
+    else if (a == "--admin")
+      admin = v;
+    else if (a == "--workers") {
+      auto n = number(1, 64);
+      if (!n) return 2;
+      no.workers = *n;
+    } else if (a == "--max-connections") {
+      auto n = number(1, 1000000);
+      if (!n) return 2;
+      no.max_connections = static_cast<size_t>(*n);
+    } else {
+      std::fprintf(stderr, "bodyscan serve: unknown option '%s'\n", a.c_str());
+      usage(stderr);
+      return 2;
+    }
+  }
+  if (!no.tls_cert.empty()) ao.secure_cookies = true;
+
+  // The signals that end a process by default and that a person or the system
+  // sends to stop it (Ctrl-C, kill, a closed terminal or ssh session, Ctrl-\,
+  // a stray SIGUSR1) are taken by this thread alone (sigwait below) and stop the
+  // workstation in order, lasers off: every thread started from here on inherits
+  // the block.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  for (int stop : kStopSignals) sigaddset(&stop_signals, stop);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  // Everything the workstation writes (the archive, accounts, logs of people's
+  // scans) is for its own user only, however it was started.
+  umask(0077);
+
+  auto ws = server::Workstation::open(wo);
+  if (!ws.ok()) {
+    std::fprintf(stderr, "bodyscan serve: %s\n", ws.status().message().c_str());
+    return 1;
+  }
+  const auto& recovered = (*ws)->archive().recovery();
+  for (const std::string& id : recovered.scans_failed)
+    std::fprintf(stderr, "bodyscan serve: scan %s was interrupted by the last stop; marked failed\n", id.c_str());
+  if (!(*ws)->auth().has_admin()) {
+    const char* env = std::getenv("BODYSCAN_ADMIN_PASSWORD");
+    const std::string password = env && *env ? env : random_password();
+    auto made = (*ws)->auth().add_account(admin, password, server::Role::kAdmin);
+    if (!made.ok()) {
+      std::fprintf(stderr, "bodyscan serve: cannot make the first admin '%s': %s\n", admin.c_str(),
+                   made.status().message().c_str());
+      return 1;
+    }
+    if (!(env && *env)) {
+      const std::string file = wo.data_dir + "/first-admin-password";
+      const Status w = write_file_atomically(file, password + "\n", FileAccess::kPrivate);
+      if (!w.ok()) std::fprintf(stderr, "bodyscan serve: %s\n", w.message().c_str());
+      std::printf("first admin account: %s, password %s (also in %s; change it after logging in)\n", admin.c_str(),
+                  password.c_str(), file.c_str());
+    } else {
+      std::printf("first admin account: %s (password from BODYSCAN_ADMIN_PASSWORD)\n", admin.c_str());
+    }
+  }
+  // The made-up first password is kept on disk only until it stops working.
+  const std::string first_password_file = wo.data_dir + "/first-admin-password";
+  (*ws)->auth().watch_sessions([first_password_file, admin](const server::SessionChange& change) {
+    if (change.reason != server::SessionChange::kPassword && change.reason != server::SessionChange::kDeleted) return;
+    if (strcasecmp(change.username.c_str(), admin.c_str()) != 0) return;
+    if (std::remove(first_password_file.c_str()) == 0)
+      std::fprintf(stderr, "bodyscan serve: %s removed: the password in it no longer works\n",
+                   first_password_file.c_str());
+  });
+  server::Api api(**ws, ao);
+  auto http = server::HttpServer::start(api, **ws, no);
+  if (!http.ok()) {
+    std::fprintf(stderr, "bodyscan serve: %s\n", http.status().message().c_str());
+    return 1;
+  }
+  const std::string host = no.address == "0.0.0.0" || no.address == "::" ? "localhost" : no.address;
+  std::printf("bodyscan workstation on %s rig, archive in %s\nopen %s://%s:%u/\n",
+              (*ws)->rig_status()["rig"].get<std::string>().c_str(), wo.data_dir.c_str(),
+              (*http)->tls() ? "https" : "http", host.c_str(), (*http)->port());
+  std::fflush(stdout);
+
+  int sig = 0;
+  sigwait(&stop_signals, &sig);
+  std::printf("bodyscan serve: %s: stopping (lasers off, the running job cancelled)\n", signal_name(sig));
+  std::fflush(stdout);
+  // The job first, so that browsers still hear it was cancelled; then the network.
+  (*ws)->shutdown("the workstation stopped");
+  (*http)->stop();
+  ws->reset();
+  std::printf("bodyscan serve: stopped cleanly\n");
+  return 0;
+}
+
+}  // namespace bodyscan::cli
