@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "pipeline/archive_scan.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "recon/io/ply.hpp"
@@ -24,30 +25,27 @@ namespace bodyscan::cli {
 
 namespace {
 
-void usage(FILE* out) {
-  std::fputs(
-      "usage: bodyscan archive DIR COMMAND [args] [--actor NAME]\n"
-      "\n"
-      "  list [TEXT]              scans, newest first (TEXT: part of an id, a customer's\n"
-      "                           name, an operator)\n"
-      "  customers [TEXT]         customers\n"
-      "  show SCAN                a scan's record, versions, files and measurements (JSON)\n"
-      "  verify                   repairs what a crash left (on open), then checks the\n"
-      "                           database and every file against its checksum\n"
-      "  export CUSTOMER DEST     everything held about a customer, into DEST\n"
-      "  erase CUSTOMER --yes     deletes a customer, everything derived from them and\n"
-      "                           their scans' share links\n"
-      "  delete-scan SCAN --yes   deletes one scan\n"
-      "  reprocess SCAN           the scan again from its raw record, as a new version\n"
-      "  mesh SCAN -o OUT         the scan's surface as .ply, .obj, .stl (mm) or .glb\n"
-      "  sheet SCAN -o OUT [--unit mm|cm|in] [--profile sheet|iso8559|mtm-order]\n"
-      "                           the measurement sheet (.pdf, .csv or .json); a\n"
-      "                           CSV laid out for its target (docs/archive.md)\n"
-      "\n"
-      "--actor names who does it in the audit log (default: cli).\n"
-      "Exit status: 0 done, 1 failed (the message says why), 2 bad arguments.\n",
-      out);
-}
+constexpr const char* kUsage =
+    "usage: bodyscan archive DIR COMMAND [args] [--actor NAME]\n"
+    "\n"
+    "  list [TEXT]              scans, newest first (TEXT: part of an id, a customer's\n"
+    "                           name, an operator)\n"
+    "  customers [TEXT]         customers\n"
+    "  show SCAN                a scan's record, versions, files and measurements (JSON)\n"
+    "  verify                   repairs what a crash left (on open), then checks the\n"
+    "                           database and every file against its checksum\n"
+    "  export CUSTOMER DEST     everything held about a customer, into DEST\n"
+    "  erase CUSTOMER --yes     deletes a customer, everything derived from them and\n"
+    "                           their scans' share links\n"
+    "  delete-scan SCAN --yes   deletes one scan\n"
+    "  reprocess SCAN           the scan again from its raw record, as a new version\n"
+    "  mesh SCAN -o OUT         the scan's surface as .ply, .obj, .stl (mm) or .glb\n"
+    "  sheet SCAN -o OUT [--unit mm|cm|in] [--profile sheet|iso8559|mtm-order]\n"
+    "                           the measurement sheet (.pdf, .csv or .json); a\n"
+    "                           CSV laid out for its target (docs/archive.md)\n"
+    "\n"
+    "--actor names who does it in the audit log (default: cli).\n"
+    "Exit status: 0 done, 1 failed (the message says why), 2 bad arguments.\n";
 
 int fail(const Status& s) {
   std::fprintf(stderr, "bodyscan archive: %s\n", s.message().c_str());
@@ -66,26 +64,15 @@ int run_archive(int argc, char** argv) {
   std::vector<std::string> args;
   std::string actor = "cli", out, unit_text, profile_text = "sheet";
   bool yes = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      usage(stdout);
-      return 0;
-    } else if ((a == "--actor" || a == "-o" || a == "--unit" || a == "--profile") && i + 1 < argc) {
-      (a == "--actor" ? actor : a == "-o" ? out : a == "--unit" ? unit_text : profile_text) = argv[++i];
-    } else if (a == "--yes") {
-      yes = true;
-    } else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "bodyscan archive: unknown option '%s'\n", a.c_str());
-      return 2;
-    } else {
-      args.push_back(a);
-    }
-  }
-  if (args.size() < 2) {
-    usage(stderr);
-    return 2;
-  }
+  CommandLine cl("bodyscan archive", kUsage);
+  cl.option("--actor", &actor);
+  cl.option("-o|--output", &out);
+  cl.option("--unit", &unit_text);
+  cl.option("--profile", &profile_text);
+  cl.flag("--yes", &yes);
+  cl.rest("DIR COMMAND [args]", &args);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
+  if (args.size() < 2) return cl.fail("give the archive's DIR and a COMMAND");
   const std::string cmd = args[1];
   auto need = [&](size_t n) {
     if (args.size() == n) return true;
@@ -94,11 +81,7 @@ int run_archive(int argc, char** argv) {
   };
   static const std::vector<std::string> known = {"list",  "customers",   "show",      "verify", "export",
                                                  "erase", "delete-scan", "reprocess", "mesh",   "sheet"};
-  if (std::find(known.begin(), known.end(), cmd) == known.end()) {
-    std::fprintf(stderr, "bodyscan archive: unknown command '%s'\n", cmd.c_str());
-    usage(stderr);
-    return 2;
-  }
+  if (std::find(known.begin(), known.end(), cmd) == known.end()) return cl.fail("unknown command '" + cmd + "'");
   auto opened = storage::Archive::open(args[0]);
   if (!opened.ok()) return fail(opened.status());
   storage::Archive& ar = **opened;

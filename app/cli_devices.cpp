@@ -7,44 +7,31 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/command_line.hpp"
 #include "hw/aravis/aravis_camera.hpp"
 #include "hw/usb/usb_link.hpp"
 
 namespace bodyscan::cli {
 
 namespace {
-void usage(FILE* out) {
-  std::fputs(
-      "usage: bodyscan devices [--json] [--include-fake]\n"
-      "\n"
-      "Lists the GenICam cameras Aravis finds (GigE Vision on every network interface,\n"
-      "USB3 Vision), the USB devices (naming the controller boards bodyscan drives) and\n"
-      "the serial ports under /dev/serial/by-id. A rig description names a camera by the\n"
-      "id shown here (or its IP address) and a board by its USB ids or serial port.\n"
-      "\n"
-      "  --json          one JSON document on stdout\n"
-      "  --include-fake  also Aravis' in-process fake camera (Fake_1), to try the tools\n",
-      out);
-}
+constexpr const char* kUsage =
+    "usage: bodyscan devices [--json] [--include-fake]\n"
+    "\n"
+    "Lists the GenICam cameras Aravis finds (GigE Vision on every network interface,\n"
+    "USB3 Vision), the USB devices (naming the controller boards bodyscan drives) and\n"
+    "the serial ports under /dev/serial/by-id. A rig description names a camera by the\n"
+    "id shown here (or its IP address) and a board by its USB ids or serial port.\n"
+    "\n"
+    "  --json          one JSON document on stdout\n"
+    "  --include-fake  also Aravis' in-process fake camera (Fake_1), to try the tools\n";
 }  // namespace
 
 int run_devices(int argc, char** argv) {
   bool json_out = false, fake = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--json")
-      json_out = true;
-    else if (a == "--include-fake")
-      fake = true;
-    else if (a == "-h" || a == "--help") {
-      usage(stdout);
-      return 0;
-    } else {
-      std::fprintf(stderr, "bodyscan devices: unknown option '%s'\n", a.c_str());
-      usage(stderr);
-      return 2;
-    }
-  }
+  CommandLine cl("bodyscan devices", kUsage);
+  cl.flag("--json", &json_out);
+  cl.flag("--include-fake", &fake);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   const auto cameras = hw::aravis::list_cameras(fake);
   auto usb = hw::usb::list_usb_devices();
   std::vector<std::string> ports;

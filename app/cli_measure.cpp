@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "pipeline/evaluate_measurement.hpp"
 #include "pipeline/measurements_json.hpp"
 #include "recon/io/ply.hpp"
@@ -23,51 +24,34 @@ using pipeline::plane_json;
 using pipeline::point_json;
 using pipeline::polyline_json;
 
-void usage(FILE* out) {
-  std::fputs(
-      "usage: bodyscan measure FILE.ply WHAT [--near X,Y,Z]\n"
-      "\n"
-      "Measures a body (mm, Y up; a mesh, or a point cloud as the thesis does) and\n"
-      "prints one JSON document: each measurement with its name, value_mm and the\n"
-      "geometry to draw.\n"
-      "\n"
-      "  --girth-y Y            horizontal girth at height Y: the tape around the\n"
-      "                         section loop (convex hull, as a tape bridges hollows)\n"
-      "  --plane PX,PY,PZ,NX,NY,NZ\n"
-      "                         girth in the plane through P with normal N\n"
-      "  --near X,Y,Z           measure around the loop nearest this point (default:\n"
-      "                         the loop with the longest tape, the torso at the waist)\n"
-      "  --distance X,Y,Z --to X,Y,Z\n"
-      "                         straight distance between two points\n"
-      "  --arc X,Y,Z --to X,Y,Z (with --girth-y or --plane)\n"
-      "                         length along the girth's tape between two points, the\n"
-      "                         shorter way round (thesis fig. 3.43; meshes)\n"
-      "  --surface X,Y,Z --to X,Y,Z\n"
-      "                         length over the skin between two points: the\n"
-      "                         shortest path on the mesh (meshes)\n"
-      "  --auto                 the automatic set: landmarks and the ISO 8559-1\n"
-      "                         measurements (a standing body, Y up, facing any way,\n"
-      "                         anywhere on the floor; meshes)\n"
-      "  --floor Y              with --auto: the floor's height (default: the mesh's\n"
-      "                         lowest point)\n"
-      "\n"
-      "Exit status: 0 measured, 1 the file or the measurement failed, 2 bad arguments.\n",
-      out);
-}
-
-std::optional<std::vector<double>> numbers(const std::string& text, size_t count) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    char* end = nullptr;
-    const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(x)) return std::nullopt;
-    v.push_back(x);
-  }
-  if (v.size() != count) return std::nullopt;
-  return v;
-}
+constexpr const char* kUsage =
+    "usage: bodyscan measure FILE.ply WHAT [--near X,Y,Z]\n"
+    "\n"
+    "Measures a body (mm, Y up; a mesh, or a point cloud as the thesis does) and\n"
+    "prints one JSON document: each measurement with its name, value_mm and the\n"
+    "geometry to draw.\n"
+    "\n"
+    "  --girth-y Y            horizontal girth at height Y: the tape around the\n"
+    "                         section loop (convex hull, as a tape bridges hollows)\n"
+    "  --plane PX,PY,PZ,NX,NY,NZ\n"
+    "                         girth in the plane through P with normal N\n"
+    "  --near X,Y,Z           measure around the loop nearest this point (default:\n"
+    "                         the loop with the longest tape, the torso at the waist)\n"
+    "  --distance X,Y,Z --to X,Y,Z\n"
+    "                         straight distance between two points\n"
+    "  --arc X,Y,Z --to X,Y,Z (with --girth-y or --plane)\n"
+    "                         length along the girth's tape between two points, the\n"
+    "                         shorter way round (thesis fig. 3.43; meshes)\n"
+    "  --surface X,Y,Z --to X,Y,Z\n"
+    "                         length over the skin between two points: the\n"
+    "                         shortest path on the mesh (meshes)\n"
+    "  --auto                 the automatic set: landmarks and the ISO 8559-1\n"
+    "                         measurements (a standing body, Y up, facing any way,\n"
+    "                         anywhere on the floor; meshes)\n"
+    "  --floor Y              with --auto: the floor's height (default: the mesh's\n"
+    "                         lowest point)\n"
+    "\n"
+    "Exit status: 0 measured, 1 the file or the measurement failed, 2 bad arguments.\n";
 
 }  // namespace
 
@@ -78,70 +62,42 @@ int run_measure(int argc, char** argv) {
   std::optional<Eigen::Vector3d> near, from, to, arc_from, surface_from;
   std::optional<double> floor_y;
   bool automatic = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      usage(stdout);
-      return 0;
-    }
-    if (a == "--auto") {
-      automatic = true;
-      continue;
-    }
-    const bool takes_value = a == "--girth-y" || a == "--plane" || a == "--near" || a == "--distance" || a == "--to" ||
-                             a == "--arc" || a == "--surface" || a == "--floor";
-    if (!takes_value) {
-      if (!a.empty() && a[0] == '-') {
-        std::fprintf(stderr, "bodyscan measure: unknown option '%s'\n", a.c_str());
-        usage(stderr);
-        return 2;
-      }
-      if (!file.empty()) {
-        std::fprintf(stderr, "bodyscan measure: one file only ('%s' and '%s')\n", file.c_str(), a.c_str());
-        return 2;
-      }
-      file = a;
-      continue;
-    }
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "bodyscan measure: %s needs a value\n", a.c_str());
-      return 2;
-    }
-    const std::string v = argv[++i];
-    const size_t count = a == "--girth-y" || a == "--floor" ? 1 : a == "--plane" ? 6 : 3;
-    const auto n = numbers(v, count);
-    if (!n) {
-      std::fprintf(stderr, "bodyscan measure: %s expects %zu comma-separated numbers (mm), got '%s'\n", a.c_str(),
-                   count, v.c_str());
-      return 2;
-    }
-    const std::vector<double>& x = *n;
-    if (a == "--girth-y") girth_y = x[0];
-    if (a == "--plane") {
-      const Eigen::Vector3d normal(x[3], x[4], x[5]);
-      if (!(normal.norm() > 0)) {
-        std::fprintf(stderr, "bodyscan measure: --plane's normal (the last three numbers) must not be zero\n");
-        return 2;
-      }
-      plane = Plane{Eigen::Vector3d(x[0], x[1], x[2]), normal.normalized()};
-    }
-    if (a == "--near") near = Eigen::Vector3d(x[0], x[1], x[2]);
-    if (a == "--distance") from = Eigen::Vector3d(x[0], x[1], x[2]);
-    if (a == "--to") to = Eigen::Vector3d(x[0], x[1], x[2]);
-    if (a == "--arc") arc_from = Eigen::Vector3d(x[0], x[1], x[2]);
-    if (a == "--surface") surface_from = Eigen::Vector3d(x[0], x[1], x[2]);
-    if (a == "--floor") floor_y = x[0];
-  }
+  CommandLine cl("bodyscan measure", kUsage);
+  // Each point or plane option is comma-separated numbers (mm).
+  auto point = [](std::optional<Eigen::Vector3d>* out) {
+    return [out](const std::string& v) -> std::string {
+      const auto x = parse_number_list(v, 3);
+      if (!x) return "expects 3 comma-separated numbers (mm), got '" + v + "'";
+      *out = Eigen::Vector3d((*x)[0], (*x)[1], (*x)[2]);
+      return "";
+    };
+  };
+  cl.positional("FILE", &file, /*required=*/false);
+  cl.flag("--auto", &automatic);
+  cl.option("--girth-y", &girth_y);
+  cl.option("--floor", &floor_y);
+  cl.option("--plane", [&plane](const std::string& v) -> std::string {
+    const auto x = parse_number_list(v, 6);
+    if (!x) return "expects 6 comma-separated numbers (mm), got '" + v + "'";
+    const Eigen::Vector3d normal((*x)[3], (*x)[4], (*x)[5]);
+    if (!(normal.norm() > 0)) return "needs a normal (the last three numbers) that is not zero";
+    plane = Plane{Eigen::Vector3d((*x)[0], (*x)[1], (*x)[2]), normal.normalized()};
+    return "";
+  });
+  cl.option("--near", point(&near));
+  cl.option("--distance", point(&from));
+  cl.option("--to", point(&to));
+  cl.option("--arc", point(&arc_from));
+  cl.option("--surface", point(&surface_from));
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   const int whats = (girth_y ? 1 : 0) + (plane ? 1 : 0) + (from ? 1 : 0) + (surface_from ? 1 : 0) + (automatic ? 1 : 0);
   const int starts = (from ? 1 : 0) + (arc_from ? 1 : 0) + (surface_from ? 1 : 0);
   const bool ends_ok = (starts == 1) == to.has_value() && starts <= 1;
   if (file.empty() || whats != 1 || !ends_ok || (arc_from && near) || (floor_y && !automatic) ||
       (near && (from || surface_from || automatic))) {
-    std::fprintf(stderr,
-                 "bodyscan measure: give a FILE and one of --girth-y or --plane (optionally --near, or --arc with "
-                 "--to), --distance or --surface with --to, or --auto (optionally --floor)\n");
-    usage(stderr);
-    return 2;
+    return cl.fail(
+        "give a FILE and one of --girth-y or --plane (optionally --near, or --arc with --to), --distance or "
+        "--surface with --to, or --auto (optionally --floor)");
   }
   nlohmann::json out = pipeline::measurements_document(file, "mesh");
   // The evaluation names the request's fields ('near' ...): say the options instead.

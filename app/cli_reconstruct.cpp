@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "core/command_line.hpp"
 #include "pipeline/scan_job.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/surface/reconstruct.hpp"
@@ -15,47 +16,47 @@ namespace bodyscan::cli {
 
 namespace {
 
-void usage(FILE* out) {
-  std::fputs(
-      "usage: bodyscan reconstruct IN.ply -o OUT.ply [options]\n"
-      "\n"
-      "Builds a watertight triangle mesh from a point cloud (PLY, ASCII or binary, with\n"
-      "or without normals) by the thesis's anisotropic Gaussian implicit surface.\n"
-      "Every option left out is chosen from the data (scale, density, noise).\n"
-      "\n"
-      "options:\n"
-      "  -o, --output FILE      output mesh: .ply, .glb (glTF binary, Draco, metres), .obj or .stl (mm)\n"
-      "  --sigma S              tangential kernel size in units of the local point\n"
-      "                         spacing (thesis sigma_user; default: from the noise)\n"
-      "  --normal-sigma S       kernel size across the surface, same units (default: auto)\n"
-      "  --sharpen S            curvature sharpening s of thesis eq. 3.24 (default 0)\n"
-      "  --voxel V              grid spacing in the cloud's unit (default: auto)\n"
-      "  --epsilon E            kernel cut-off tolerance, eq. 3.26 (default 0.001)\n"
-      "  --normals SRC          auto | input | cameras | mst (default auto: the file's\n"
-      "                         normals, else its cameras, else spanning-tree propagation)\n"
-      "  --normal-k K           neighbours per PCA normal (default: from the noise)\n"
-      "  --keep-fragments       keep small disconnected pieces (default: drop those under\n"
-      "                         1% of the largest)\n"
-      "  --body                 a body scan: the scan job's settings (every hole filled\n"
-      "                         with a thin plate, the field kept down to 2 % of its\n"
-      "                         median weight); the other options still apply\n"
-      "  --keep-holes           leave the field's zero set open where it is (default: trim\n"
-      "                         flaps past the data and fill every hole; filled vertices\n"
-      "                         get confidence 0 in the output)\n"
-      "  --trim-distance D      before filling, trim flaps whose vertices lie farther than\n"
-      "                         D from every point (default: the median density sigma\n"
-      "                         plus three noise sigmas)\n"
-      "  --ascii                write ASCII PLY (default binary)\n"
-      "  -q, --quiet            print only errors\n",
-      out);
-}
+constexpr const char* kUsage =
+    "usage: bodyscan reconstruct IN.ply -o OUT.ply [options]\n"
+    "\n"
+    "Builds a watertight triangle mesh from a point cloud (PLY, ASCII or binary, with\n"
+    "or without normals) by the thesis's anisotropic Gaussian implicit surface.\n"
+    "Every option left out is chosen from the data (scale, density, noise).\n"
+    "\n"
+    "options:\n"
+    "  -o, --output FILE      output mesh: .ply, .glb (glTF binary, Draco, metres), .obj or .stl (mm)\n"
+    "  --sigma S              tangential kernel size in units of the local point\n"
+    "                         spacing (thesis sigma_user; default: from the noise)\n"
+    "  --normal-sigma S       kernel size across the surface, same units (default: auto)\n"
+    "  --sharpen S            curvature sharpening s of thesis eq. 3.24 (default 0)\n"
+    "  --voxel V              grid spacing in the cloud's unit (default: auto)\n"
+    "  --epsilon E            kernel cut-off tolerance, eq. 3.26 (default 0.001)\n"
+    "  --normals SRC          auto | input | cameras | mst (default auto: the file's\n"
+    "                         normals, else its cameras, else spanning-tree propagation)\n"
+    "  --normal-k K           neighbours per PCA normal (default: from the noise)\n"
+    "  --keep-fragments       keep small disconnected pieces (default: drop those under\n"
+    "                         1% of the largest)\n"
+    "  --body                 a body scan: the scan job's settings (every hole filled\n"
+    "                         with a thin plate, the field kept down to 2 % of its\n"
+    "                         median weight); the other options still apply\n"
+    "  --keep-holes           leave the field's zero set open where it is (default: trim\n"
+    "                         flaps past the data and fill every hole; filled vertices\n"
+    "                         get confidence 0 in the output)\n"
+    "  --trim-distance D      before filling, trim flaps whose vertices lie farther than\n"
+    "                         D from every point (default: the median density sigma\n"
+    "                         plus three noise sigmas)\n"
+    "  --ascii                write ASCII PLY (default binary)\n"
+    "  -q, --quiet            print only errors\n";
 
-bool parse_float(const char* s, float* out) {
-  char* end = nullptr;
-  const float v = std::strtof(s, &end);
-  if (end == s || *end != '\0' || !std::isfinite(v)) return false;
-  *out = v;
-  return true;
+// A float option's value: finite, and positive or at least zero.
+CommandLine::ValueParser float_into(float* out, bool positive) {
+  return [out, positive](const std::string& v) -> std::string {
+    const auto x = parse_double(v);
+    if (!x || (positive && !(*x > 0)) || *x < 0)
+      return std::string("expects a ") + (positive ? "positive" : "non-negative") + " number, got '" + v + "'";
+    *out = static_cast<float>(*x);
+    return "";
+  };
 }
 
 bool ends_with(const std::string& s, const std::string& suffix) {
@@ -72,83 +73,42 @@ int run_reconstruct(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--body") opt = pipeline::body_surface_options(), body = true;
   bool ascii = false, quiet = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* name) -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "bodyscan reconstruct: %s needs a value\n", name);
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    auto number = [&](const char* name, float* dst, bool positive) {
-      const char* v = value(name);
-      if (!parse_float(v, dst) || (positive && !(*dst > 0.f)) || *dst < 0.f) {
-        std::fprintf(stderr, "bodyscan reconstruct: %s expects a %s number, got '%s'\n", name,
-                     positive ? "positive" : "non-negative", v);
-        std::exit(2);
-      }
-    };
-    if (a == "-h" || a == "--help") {
-      usage(stdout);
-      return 0;
-    } else if (a == "-o" || a == "--output") {
-      out = value("-o");
-    } else if (a == "--sigma") {
-      number("--sigma", &opt.sigma_scale, true);
-    } else if (a == "--normal-sigma") {
-      number("--normal-sigma", &opt.normal_scale, true);
-    } else if (a == "--sharpen") {
-      number("--sharpen", &opt.sharpening, false);
-    } else if (a == "--voxel") {
-      number("--voxel", &opt.voxel_size, true);
-    } else if (a == "--epsilon") {
-      number("--epsilon", &opt.epsilon, true);
-      if (opt.epsilon >= 1.f) {
-        std::fputs("bodyscan reconstruct: --epsilon must be below 1\n", stderr);
-        return 2;
-      }
-    } else if (a == "--normal-k") {
-      float k = 0;
-      number("--normal-k", &k, true);
-      opt.normal_k = static_cast<size_t>(k);
-    } else if (a == "--normals") {
-      const char* v = value("--normals");
-      if (!parse_normal_source(v, &opt.normal_source)) {
-        std::fprintf(stderr, "bodyscan reconstruct: --normals expects auto, input, cameras or mst, got '%s'\n", v);
-        return 2;
-      }
-    } else if (a == "--keep-fragments") {
-      opt.min_component_fraction = 0.0;
-    } else if (a == "--body") {
-      // applied before the loop
-    } else if (a == "--keep-holes") {
-      opt.close_holes = false;
-    } else if (a == "--trim-distance") {
-      number("--trim-distance", &opt.hole_trim_distance, true);
-    } else if (a == "--ascii") {
-      ascii = true;
-    } else if (a == "-q" || a == "--quiet") {
-      quiet = true;
-    } else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "bodyscan reconstruct: unknown option '%s'\n", a.c_str());
-      usage(stderr);
-      return 2;
-    } else if (in.empty()) {
-      in = a;
-    } else {
-      std::fprintf(stderr, "bodyscan reconstruct: more than one input file ('%s')\n", a.c_str());
-      return 2;
-    }
-  }
-  if (in.empty() || out.empty()) {
-    usage(stderr);
-    return 2;
-  }
-  if (!ends_with(out, ".ply") && !ends_with(out, ".glb") && !ends_with(out, ".obj") && !ends_with(out, ".stl")) {
-    std::fprintf(stderr, "bodyscan reconstruct: output '%s' must end in .ply, .glb, .obj or .stl\n", out.c_str());
-    return 2;
-  }
+  CommandLine cl("bodyscan reconstruct", kUsage);
+  cl.positional("IN.ply", &in, /*required=*/false);
+  cl.option("-o|--output", &out);
+  cl.option("--sigma", float_into(&opt.sigma_scale, true));
+  cl.option("--normal-sigma", float_into(&opt.normal_scale, true));
+  cl.option("--sharpen", float_into(&opt.sharpening, false));
+  cl.option("--voxel", float_into(&opt.voxel_size, true));
+  cl.option("--epsilon", [&opt](const std::string& v) -> std::string {
+    std::string error = float_into(&opt.epsilon, true)(v);
+    if (error.empty() && opt.epsilon >= 1.f) error = "must be below 1";
+    return error;
+  });
+  cl.option("--normal-k", [&opt](const std::string& v) -> std::string {
+    const auto k = parse_integer(v);
+    if (!k || *k <= 0) return "expects a positive integer, got '" + v + "'";
+    opt.normal_k = static_cast<size_t>(*k);
+    return "";
+  });
+  cl.option("--normals", [&opt](const std::string& v) -> std::string {
+    if (!parse_normal_source(v.c_str(), &opt.normal_source))
+      return "expects auto, input, cameras or mst, got '" + v + "'";
+    return "";
+  });
+  bool keep_fragments = false, keep_holes = false, body_seen = false;
+  cl.flag("--keep-fragments", &keep_fragments);
+  cl.flag("--body", &body_seen);  // applied before parsing
+  cl.flag("--keep-holes", &keep_holes);
+  cl.option("--trim-distance", float_into(&opt.hole_trim_distance, true));
+  cl.flag("--ascii", &ascii);
+  cl.flag("-q|--quiet", &quiet);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
+  if (keep_fragments) opt.min_component_fraction = 0.0;
+  if (keep_holes) opt.close_holes = false;
+  if (in.empty() || out.empty()) return cl.fail("give IN.ply and -o OUT");
+  if (!ends_with(out, ".ply") && !ends_with(out, ".glb") && !ends_with(out, ".obj") && !ends_with(out, ".stl"))
+    return cl.fail("output '" + out + "' must end in .ply, .glb, .obj or .stl");
 
   const auto t0 = std::chrono::steady_clock::now();
   auto read = read_ply(in);

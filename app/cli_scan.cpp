@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "app/cli_subject.hpp"
+#include "core/command_line.hpp"
 #include "core/json_text.hpp"
 #include "hw/rig_description.hpp"
 #include "pipeline/archive_scan.hpp"
@@ -21,46 +22,66 @@ namespace bodyscan::cli {
 
 namespace {
 
-void usage(FILE* out) {
-  std::fprintf(out,
-               "usage: bodyscan scan --rig RIG --out DIR [options]\n"
-               "\n"
-               "Calibrates the rig from what its cameras see (dot grid, frame lights, lasers on\n"
-               "the frame's poles), scans the subject, turns the laser stripes into one point\n"
-               "cloud, reconstructs a closed surface and measures it. Writes DIR/points.ply,\n"
-               "DIR/mesh.ply, DIR/mesh.glb, DIR/measurements.json (docs/measurements.md),\n"
-               "DIR/calibration.json, DIR/scan.json and DIR/raw/ (the raw record that\n"
-               "`bodyscan reprocess` makes the scan again from).\n"
-               "\n"
-               "  --rig RIG        sim (the thesis rig and the demo body), thesis, square, tiered,\n"
-               "                   or a rig description file (JSON)\n"
-               "%s"
-               "  --out DIR        output folder (created)\n"
-               "  --every N        scan every Nth laser step only (default 1: all)\n"
-               "  --method M       homography (default: the thesis's image-to-laser-plane\n"
-               "                   transform, eq. 3.6) or ray (the pixel's two-plane ray met\n"
-               "                   with the laser plane)\n"
-               "  --max-view DEG   drop points their camera saw more than DEG from the\n"
-               "                   surface normal (grazing views put points inside the\n"
-               "                   body; default: the rig description's processing\n"
-               "                   .max_view_deg, else 90: keep them all)\n"
-               "  --no-surface     stop at the point cloud\n"
-               "  --keep-sway      keep every point where it was measured (default: the\n"
-               "                   subject's sway between sweeps is estimated from the\n"
-               "                   cloud and undone; scan.json \"sway\" has its path)\n"
-               "  --archive DIR    also store the scan in the archive in DIR (created;\n"
-               "                   docs/archive.md); --out is then optional\n"
-               "  --customer ID    the archived scan's customer (default: a new one)\n"
-               "  --new-customer NAME  a new customer with this name\n"
-               "  --operator NAME  who runs the scan (the archive's audit log)\n"
-               "  --operator-dot-grid  ask on the terminal for the lens board before the\n"
-               "                   simulated cameras too, as for real ones (a line on\n"
-               "                   standard input answers each request)\n"
-               "  -q, --quiet      print only errors\n"
-               "\n"
-               "Before each real camera a person holds the lens dot-grid board: the request\n"
-               "is printed, and Enter (a line on standard input) answers it.\n",
-               kSubjectOptionsHelp);
+std::string usage() {
+  return std::string(
+             "usage: bodyscan scan --rig RIG --out DIR [options]\n"
+             "\n"
+             "Calibrates the rig from what its cameras see (dot grid, frame lights, lasers on\n"
+             "the frame's poles), scans the subject, turns the laser stripes into one point\n"
+             "cloud, reconstructs a closed surface and measures it. Writes DIR/points.ply,\n"
+             "DIR/mesh.ply, DIR/mesh.glb, DIR/measurements.json (docs/measurements.md),\n"
+             "DIR/calibration.json, DIR/scan.json and DIR/raw/ (the raw record that\n"
+             "`bodyscan reprocess` makes the scan again from).\n"
+             "\n"
+             "  --rig RIG        sim (the thesis rig and the demo body), thesis, square, tiered,\n"
+             "                   or a rig description file (JSON)\n") +
+         kSubjectOptionsHelp +
+         "  --out DIR        output folder (created)\n"
+         "  --every N        scan every Nth laser step only (default 1: all)\n"
+         "  --method M       homography (default: the thesis's image-to-laser-plane\n"
+         "                   transform, eq. 3.6) or ray (the pixel's two-plane ray met\n"
+         "                   with the laser plane)\n"
+         "  --max-view DEG   drop points their camera saw more than DEG from the\n"
+         "                   surface normal (grazing views put points inside the\n"
+         "                   body; default: the rig description's processing\n"
+         "                   .max_view_deg, else 90: keep them all)\n"
+         "  --no-surface     stop at the point cloud\n"
+         "  --keep-sway      keep every point where it was measured (default: the\n"
+         "                   subject's sway between sweeps is estimated from the\n"
+         "                   cloud and undone; scan.json \"sway\" has its path)\n"
+         "  --archive DIR    also store the scan in the archive in DIR (created;\n"
+         "                   docs/archive.md); --out is then optional\n"
+         "  --customer ID    the archived scan's customer (default: a new one)\n"
+         "  --new-customer NAME  a new customer with this name\n"
+         "  --operator NAME  who runs the scan (the archive's audit log)\n"
+         "  --operator-dot-grid  ask on the terminal for the lens board before the\n"
+         "                   simulated cameras too, as for real ones (a line on\n"
+         "                   standard input answers each request)\n"
+         "  -q, --quiet      print only errors\n"
+         "\n"
+         "Before each real camera a person holds the lens dot-grid board: the request\n"
+         "is printed, and Enter (a line on standard input) answers it.\n";
+}
+
+// The processing options `scan` and `reprocess` share.
+void add_processing_options(CommandLine* cl, pipeline::ScanJobOptions* options, bool* no_surface, bool* keep_sway) {
+  cl->option("--method", [options](const std::string& v) -> std::string {
+    if (v == "ray")
+      options->scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
+    else if (v == "homography")
+      options->scan.triangulate.method = TriangulationMethod::kLaserHomography;
+    else
+      return "is ray or homography, not '" + v + "'";
+    return "";
+  });
+  cl->option("--max-view", [options](const std::string& v) -> std::string {
+    const auto deg = parse_double(v);
+    if (!deg || !(*deg > 0 && *deg <= 90)) return "expects degrees in (0, 90], got '" + v + "'";
+    options->max_view_deg = *deg;
+    return "";
+  });
+  cl->flag("--no-surface", no_surface);
+  cl->flag("--keep-sway", keep_sway);
 }
 
 // What the sway estimate found (pipeline::ScanOptions::compensate_sway).
@@ -85,87 +106,26 @@ int run_scan(int argc, char** argv) {
   std::string rig_arg, out, archive_dir, customer_id, new_customer, operator_name = "cli";
   pipeline::ScanJobOptions options;
   bool quiet = false, operator_dot_grid = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "bodyscan scan: %s needs a value\n", a.c_str());
-        return nullptr;
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      usage(stdout);
-      return 0;
-    } else if (a == "--archive" || a == "--customer" || a == "--new-customer" || a == "--operator") {
-      const char* v = value();
-      if (!v) return 2;
-      if (a == "--archive") archive_dir = v;
-      if (a == "--customer") customer_id = v;
-      if (a == "--new-customer") new_customer = v;
-      if (a == "--operator") operator_name = v;
-    } else if (is_subject_option(a)) {
-      const char* v = value();
-      if (!v) return 2;
-      if (Status st = set_subject_option(a, v, &subject); !st.ok()) {
-        std::fprintf(stderr, "bodyscan scan: %s\n", st.message().c_str());
-        return 2;
-      }
-    } else if (a == "--rig" || a == "--out" || a == "--every" || a == "--method" || a == "--max-view") {
-      const char* v = value();
-      if (!v) return 2;
-      if (a == "--rig") rig_arg = v;
-      if (a == "--out") out = v;
-      if (a == "--every") {
-        options.every = std::atoi(v);
-        if (options.every < 1) {
-          std::fprintf(stderr, "bodyscan scan: --every expects a positive integer, got '%s'\n", v);
-          return 2;
-        }
-      }
-      if (a == "--max-view") {
-        char* end = nullptr;
-        const double deg = std::strtod(v, &end);
-        if (end == v || *end != '\0' || !(deg > 0 && deg <= 90)) {
-          std::fprintf(stderr, "bodyscan scan: --max-view expects degrees in (0, 90], got '%s'\n", v);
-          return 2;
-        }
-        options.max_view_deg = deg;
-      }
-      if (a == "--method") {
-        const std::string m = v;
-        if (m == "ray")
-          options.scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
-        else if (m == "homography")
-          options.scan.triangulate.method = TriangulationMethod::kLaserHomography;
-        else {
-          std::fprintf(stderr, "bodyscan scan: --method is ray or homography, not '%s'\n", v);
-          return 2;
-        }
-      }
-    } else if (a == "--no-surface") {
-      options.reconstruct = false;
-    } else if (a == "--keep-sway") {
-      options.scan.compensate_sway = false;
-    } else if (a == "-q" || a == "--quiet") {
-      quiet = true;
-    } else if (a == "--operator-dot-grid") {
-      operator_dot_grid = true;
-    } else {
-      std::fprintf(stderr, "bodyscan scan: unknown option '%s'\n", a.c_str());
-      usage(stderr);
-      return 2;
-    }
-  }
-  if (rig_arg.empty() || (out.empty() && archive_dir.empty())) {
-    std::fprintf(stderr, "bodyscan scan: --rig and --out (or --archive) are required\n");
-    usage(stderr);
-    return 2;
-  }
-  if (archive_dir.empty() && (!customer_id.empty() || !new_customer.empty())) {
-    std::fprintf(stderr, "bodyscan scan: --customer and --new-customer go with --archive\n");
-    return 2;
-  }
+  bool no_surface = false, keep_sway = false;
+  CommandLine cl("bodyscan scan", usage());
+  cl.option("--rig", &rig_arg);
+  add_subject_options(&cl, &subject);
+  cl.option("--out", &out);
+  cl.option("--every", integer_between(1, 1000000, [&options](long long n) { options.every = static_cast<int>(n); }));
+  add_processing_options(&cl, &options, &no_surface, &keep_sway);
+  cl.option("--archive", &archive_dir);
+  cl.option("--customer", &customer_id);
+  cl.option("--new-customer", &new_customer);
+  cl.option("--operator", &operator_name);
+  cl.flag("--operator-dot-grid", &operator_dot_grid);
+  cl.flag("-q|--quiet", &quiet);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
+  if (no_surface) options.reconstruct = false;
+  if (keep_sway) options.scan.compensate_sway = false;
+  if (rig_arg.empty() || (out.empty() && archive_dir.empty()))
+    return cl.fail("--rig and --out (or --archive) are required");
+  if (archive_dir.empty() && (!customer_id.empty() || !new_customer.empty()))
+    return cl.fail("--customer and --new-customer go with --archive");
   auto sim = pipeline::open_rig(rig_arg, subject);
   if (!sim.ok()) {
     std::fprintf(stderr, "bodyscan scan: %s\n", sim.status().message().c_str());
@@ -301,55 +261,23 @@ int run_scan(int argc, char** argv) {
 int run_reprocess(int argc, char** argv) {
   std::string in, out;
   pipeline::ScanJobOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::puts(
-          "usage: bodyscan reprocess SCAN_DIR --out DIR [--method ray|homography] [--max-view DEG] [--no-surface]\n"
-          "                         [--keep-sway]\n"
-          "\n"
-          "Makes a scan again from the raw record `bodyscan scan` left in SCAN_DIR/raw\n"
-          "(calibration and stripe samples; no camera frames), with today's processing,\n"
-          "and writes the results into DIR as `bodyscan scan` does. Archived scans:\n"
-          "`bodyscan archive DIR reprocess SCAN`.");
-      return 0;
-    } else if ((a == "--out" || a == "--method" || a == "--max-view") && i + 1 < argc) {
-      const std::string v = argv[++i];
-      if (a == "--out") out = v;
-      if (a == "--method") {
-        if (v == "ray")
-          options.scan.triangulate.method = TriangulationMethod::kTwoPlaneRay;
-        else if (v == "homography")
-          options.scan.triangulate.method = TriangulationMethod::kLaserHomography;
-        else {
-          std::fprintf(stderr, "bodyscan reprocess: --method is ray or homography, not '%s'\n", v.c_str());
-          return 2;
-        }
-      }
-      if (a == "--max-view") {
-        char* end = nullptr;
-        const double deg = std::strtod(v.c_str(), &end);
-        if (end == v.c_str() || *end != '\0' || !(deg > 0 && deg <= 90)) {
-          std::fprintf(stderr, "bodyscan reprocess: --max-view expects degrees in (0, 90], got '%s'\n", v.c_str());
-          return 2;
-        }
-        options.max_view_deg = deg;
-      }
-    } else if (a == "--no-surface") {
-      options.reconstruct = false;
-    } else if (a == "--keep-sway") {
-      options.scan.compensate_sway = false;
-    } else if (!a.empty() && a[0] != '-' && in.empty()) {
-      in = a;
-    } else {
-      std::fprintf(stderr, "bodyscan reprocess: unexpected '%s'\n", a.c_str());
-      return 2;
-    }
-  }
-  if (in.empty() || out.empty()) {
-    std::fprintf(stderr, "usage: bodyscan reprocess SCAN_DIR --out DIR (see --help)\n");
-    return 2;
-  }
+  bool no_surface = false, keep_sway = false;
+  CommandLine cl("bodyscan reprocess",
+                 "usage: bodyscan reprocess SCAN_DIR --out DIR [--method ray|homography] [--max-view DEG] "
+                 "[--no-surface]\n"
+                 "                         [--keep-sway]\n"
+                 "\n"
+                 "Makes a scan again from the raw record `bodyscan scan` left in SCAN_DIR/raw\n"
+                 "(calibration and stripe samples; no camera frames), with today's processing,\n"
+                 "and writes the results into DIR as `bodyscan scan` does. Archived scans:\n"
+                 "`bodyscan archive DIR reprocess SCAN`.\n");
+  cl.positional("SCAN_DIR", &in);
+  cl.option("--out", &out);
+  add_processing_options(&cl, &options, &no_surface, &keep_sway);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
+  if (no_surface) options.reconstruct = false;
+  if (keep_sway) options.scan.compensate_sway = false;
+  if (out.empty()) return cl.fail("--out is required");
   const auto record = read_whole_file(in + "/raw/" + pipeline::kRawRecordFile);
   const auto stripes = read_whole_file(in + "/raw/" + pipeline::kRawStripesFile);
   if (!record.ok() || !stripes.ok()) {

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "app/cli_subject.hpp"
+#include "core/command_line.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/api/api.hpp"
 #include "server/net/http_server.hpp"
@@ -34,44 +35,43 @@ const char* signal_name(int sig) {
   }
 }
 
-void usage(FILE* out) {
-  std::fprintf(out,
-               "usage: bodyscan serve [options]\n"
-               "\n"
-               "Runs the workstation: the rig (calibration, scans, reconstruction), the\n"
-               "archive, the REST API and WebSocket events (docs/api.md), and the browser UI.\n"
-               "On embedded defaults: the simulated rig with the demo body, the archive in\n"
-               "./bodyscan-data, port 8080.\n"
-               "\n"
-               "  --address A        the address to listen on (default 0.0.0.0)\n"
-               "  --port N           (default 8080; 0 picks a free port)\n"
-               "  --data DIR         the archive and accounts (default ./bodyscan-data)\n"
-               "  --rig RIG          sim (default), thesis, square, tiered or a rig description file\n"
-               "%s"
-               "  --every N          scans use every Nth laser step unless asked otherwise\n"
-               "                     (default 1)\n"
-               "  --retention-days N erase scans that started more than N days ago, at start\n"
-               "                     and hourly (logged in the audit); default: keep them\n"
-               "  --operator-dot-grid\n"
-               "                     calibration asks a person to hold the lens board before\n"
-               "                     the simulated cameras too, as it does before real ones\n"
-               "                     (staff training)\n"
-               "  --web DIR          the browser UI's files (default: the UI this build made, BUILD/web)\n"
-               "  --tls-cert PEM --tls-key PEM\n"
-               "                     serve HTTPS (session cookies become Secure)\n"
-               "  --behind-tls-proxy a TLS proxy in front forwards to us: cookies Secure\n"
-               "  --trusted-proxy A  believe X-Forwarded-For/-Proto/-Host from this address\n"
-               "                     (the reverse proxy's; repeatable)\n"
-               "  --public-url URL   the address customers' share links start with\n"
-               "  --admin NAME       the first admin account, made when there is none; its\n"
-               "                     password comes from BODYSCAN_ADMIN_PASSWORD, or one is made\n"
-               "                     up, printed once and kept in DATA/first-admin-password\n"
-               "                     (mode 0600) until changed\n"
-               "  --workers N        threads for requests' work (default 3)\n"
-               "  --max-connections N\n"
-               "                     open HTTP and WebSocket connections at most; more are\n"
-               "                     answered 503 (default: the descriptor limit less 128)\n",
-               kSubjectOptionsHelp);
+std::string usage() {
+  return std::string(
+             "usage: bodyscan serve [options]\n"
+             "\n"
+             "Runs the workstation: the rig (calibration, scans, reconstruction), the\n"
+             "archive, the REST API and WebSocket events (docs/api.md), and the browser UI.\n"
+             "On embedded defaults: the simulated rig with the demo body, the archive in\n"
+             "./bodyscan-data, port 8080.\n"
+             "\n"
+             "  --address A        the address to listen on (default 0.0.0.0)\n"
+             "  --port N           (default 8080; 0 picks a free port)\n"
+             "  --data DIR         the archive and accounts (default ./bodyscan-data)\n"
+             "  --rig RIG          sim (default), thesis, square, tiered or a rig description file\n") +
+         kSubjectOptionsHelp +
+         "  --every N          scans use every Nth laser step unless asked otherwise\n"
+         "                     (default 1)\n"
+         "  --retention-days N erase scans that started more than N days ago, at start\n"
+         "                     and hourly (logged in the audit); default: keep them\n"
+         "  --operator-dot-grid\n"
+         "                     calibration asks a person to hold the lens board before\n"
+         "                     the simulated cameras too, as it does before real ones\n"
+         "                     (staff training)\n"
+         "  --web DIR          the browser UI's files (default: the UI this build made, BUILD/web)\n"
+         "  --tls-cert PEM --tls-key PEM\n"
+         "                     serve HTTPS (session cookies become Secure)\n"
+         "  --behind-tls-proxy a TLS proxy in front forwards to us: cookies Secure\n"
+         "  --trusted-proxy A  believe X-Forwarded-For/-Proto/-Host from this address\n"
+         "                     (the reverse proxy's; repeatable)\n"
+         "  --public-url URL   the address customers' share links start with\n"
+         "  --admin NAME       the first admin account, made when there is none; its\n"
+         "                     password comes from BODYSCAN_ADMIN_PASSWORD, or one is made\n"
+         "                     up, printed once and kept in DATA/first-admin-password\n"
+         "                     (mode 0600) until changed\n"
+         "  --workers N        threads for requests' work (default 3)\n"
+         "  --max-connections N\n"
+         "                     open HTTP and WebSocket connections at most; more are\n"
+         "                     answered 503 (default: the descriptor limit less 128)\n";
 }
 
 std::string random_password() {
@@ -91,85 +91,27 @@ int run_serve(int argc, char** argv) {
   server::ApiOptions ao;
   ao.web_root = BODYSCAN_WEB_ROOT;
   std::string admin = "admin";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      usage(stdout);
-      return 0;
-    }
-    if (a == "--behind-tls-proxy") {
-      ao.secure_cookies = true;
-      continue;
-    }
-    if (a == "--operator-dot-grid") {
-      wo.operator_dot_grid = true;
-      continue;
-    }
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "bodyscan serve: %s needs a value (or is unknown)\n", a.c_str());
-      usage(stderr);
-      return 2;
-    }
-    const std::string v = argv[++i];
-    auto number = [&](int lo, int hi) -> std::optional<int> {
-      char* end = nullptr;
-      const long n = std::strtol(v.c_str(), &end, 10);
-      if (v.empty() || *end != '\0' || n < lo || n > hi) {
-        std::fprintf(stderr, "bodyscan serve: %s expects a number from %d to %d, got '%s'\n", a.c_str(), lo, hi,
-                     v.c_str());
-        return std::nullopt;
-      }
-      return static_cast<int>(n);
-    };
-    if (a == "--address")
-      no.address = v;
-    else if (a == "--port") {
-      auto n = number(0, 65535);
-      if (!n) return 2;
-      no.port = static_cast<uint16_t>(*n);
-    } else if (a == "--data")
-      wo.data_dir = v;
-    else if (a == "--rig")
-      wo.rig = v;
-    else if (is_subject_option(a)) {
-      if (Status st = set_subject_option(a, v, &wo.subject); !st.ok()) {
-        std::fprintf(stderr, "bodyscan serve: %s\n", st.message().c_str());
-        return 2;
-      }
-    } else if (a == "--every") {
-      auto n = number(1, 1000);
-      if (!n) return 2;
-      wo.default_every = *n;
-    } else if (a == "--retention-days") {
-      auto n = number(1, 36500);
-      if (!n) return 2;
-      wo.retention_days = *n;
-    } else if (a == "--web")
-      ao.web_root = v;
-    else if (a == "--trusted-proxy")
-      no.trusted_proxies.push_back(v);
-    else if (a == "--tls-cert")
-      no.tls_cert = v;
-    else if (a == "--tls-key")
-      no.tls_key = v;
-    else if (a == "--public-url")
-      ao.public_url = v;
-    else if (a == "--admin")
-      admin = v;
-    else if (a == "--workers") {
-      auto n = number(1, 64);
-      if (!n) return 2;
-      no.workers = *n;
-    } else if (a == "--max-connections") {
-      auto n = number(1, 1000000);
-      if (!n) return 2;
-      no.max_connections = static_cast<size_t>(*n);
-    } else {
-      std::fprintf(stderr, "bodyscan serve: unknown option '%s'\n", a.c_str());
-      usage(stderr);
-      return 2;
-    }
-  }
+  CommandLine cl("bodyscan serve", usage());
+  cl.option("--address", &no.address);
+  cl.option("--port", integer_between(0, 65535, [&no](long long n) { no.port = static_cast<uint16_t>(n); }));
+  cl.option("--data", &wo.data_dir);
+  cl.option("--rig", &wo.rig);
+  add_subject_options(&cl, &wo.subject);
+  cl.option("--every", integer_between(1, 1000, [&wo](long long n) { wo.default_every = static_cast<int>(n); }));
+  cl.option("--retention-days",
+            integer_between(1, 36500, [&wo](long long n) { wo.retention_days = static_cast<int>(n); }));
+  cl.flag("--operator-dot-grid", &wo.operator_dot_grid);
+  cl.option("--web", &ao.web_root);
+  cl.option("--tls-cert", &no.tls_cert);
+  cl.option("--tls-key", &no.tls_key);
+  cl.flag("--behind-tls-proxy", &ao.secure_cookies);
+  cl.option("--trusted-proxy", &no.trusted_proxies);
+  cl.option("--public-url", &ao.public_url);
+  cl.option("--admin", &admin);
+  cl.option("--workers", integer_between(1, 64, [&no](long long n) { no.workers = static_cast<int>(n); }));
+  cl.option("--max-connections",
+            integer_between(1, 1000000, [&no](long long n) { no.max_connections = static_cast<size_t>(n); }));
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   if (!no.tls_cert.empty()) ao.secure_cookies = true;
 
   // The signals that end a process by default and that a person or the system

@@ -17,86 +17,46 @@ namespace bodyscan::cli {
 
 namespace {
 
-void usage(FILE* out) {
-  std::fprintf(out,
-               "usage: bodyscan sim render --rig RIG --out DIR [options]\n"
-               "\n"
-               "Renders what the simulated rig's cameras see during one calibration (the\n"
-               "dot-grid target before each camera, room lights, frame lights off, on, front\n"
-               "poles only, each laser alone) and one full scan (per laser group: a base frame\n"
-               "with the lasers off, then every step with the group's lasers on), as PNG\n"
-               "images in DIR with DIR/index.json listing them.\n"
-               "\n"
-               "  --rig RIG        thesis, square, tiered, or a rig description file (JSON)\n"
-               "%s"
-               "  --out DIR        output folder (created)\n"
-               "  --every N        render every Nth laser step only (default 1)\n"
-               "  -q, --quiet      print only errors\n",
-               kSubjectOptionsHelp);
+std::string usage() {
+  return std::string(
+             "usage: bodyscan sim render --rig RIG --out DIR [options]\n"
+             "\n"
+             "Renders what the simulated rig's cameras see during one calibration (the\n"
+             "dot-grid target before each camera, room lights, frame lights off, on, front\n"
+             "poles only, each laser alone) and one full scan (per laser group: a base frame\n"
+             "with the lasers off, then every step with the group's lasers on), as PNG\n"
+             "images in DIR with DIR/index.json listing them.\n"
+             "\n"
+             "  --rig RIG        thesis, square, tiered, or a rig description file (JSON)\n") +
+         kSubjectOptionsHelp +
+         "  --out DIR        output folder (created)\n"
+         "  --every N        render every Nth laser step only (default 1)\n"
+         "  -q, --quiet      print only errors\n";
 }
 
 }  // namespace
 
 int run_sim(int argc, char** argv) {
-  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
-    usage(argc < 2 ? stderr : stdout);
-    return argc < 2 ? 2 : 0;
+  if (argc < 2 || std::string(argv[1]) != "render") {
+    CommandLine sim("bodyscan sim", usage());
+    if (argc >= 2 && argv[1][0] != '-')
+      return sim.fail(std::string("unknown subcommand '") + argv[1] + "' (known: render)");
+    const auto exit = sim.parse(argc, argv);  // --help; anything else is an error
+    return exit ? *exit : sim.fail("give a subcommand (render)");
   }
-  if (std::string(argv[1]) != "render") {
-    std::fprintf(stderr, "bodyscan sim: unknown subcommand '%s' (known: render)\n", argv[1]);
-    return 2;
-  }
+  CommandLine cl("bodyscan sim render", usage());
   pipeline::SimulatedSubject subject;
   std::string rig_arg, out;
   int every = 1;
   bool quiet = false;
-  for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "bodyscan sim render: %s needs a value\n", a.c_str());
-        return nullptr;
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      usage(stdout);
-      return 0;
-    } else if (a == "--rig") {
-      const char* v = value();
-      if (!v) return 2;
-      rig_arg = v;
-    } else if (is_subject_option(a)) {
-      const char* v = value();
-      if (!v) return 2;
-      if (Status st = set_subject_option(a, v, &subject); !st.ok()) {
-        std::fprintf(stderr, "bodyscan sim render: %s\n", st.message().c_str());
-        return 2;
-      }
-    } else if (a == "--out") {
-      const char* v = value();
-      if (!v) return 2;
-      out = v;
-    } else if (a == "--every") {
-      const char* v = value();
-      if (!v) return 2;
-      every = std::atoi(v);
-      if (every < 1) {
-        std::fprintf(stderr, "bodyscan sim render: --every expects a positive integer, got '%s'\n", v);
-        return 2;
-      }
-    } else if (a == "-q" || a == "--quiet") {
-      quiet = true;
-    } else {
-      std::fprintf(stderr, "bodyscan sim render: unknown option '%s'\n", a.c_str());
-      return 2;
-    }
-  }
-  if (rig_arg.empty() || out.empty()) {
-    std::fprintf(stderr, "bodyscan sim render: --rig and --out are required\n");
-    usage(stderr);
-    return 2;
-  }
+  cl.option("--rig", &rig_arg);
+  add_subject_options(&cl, &subject);
+  cl.option("--out", &out);
+  cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
+  cl.flag("-q|--quiet", &quiet);
+  // argv[1] is "render"; its options follow.
+  if (const auto exit = cl.parse(argc - 1, argv + 1)) return *exit;
+  if (rig_arg.empty() || out.empty()) return cl.fail("--rig and --out are required");
   auto made = pipeline::open_simulated_rig(rig_arg, subject);
   if (!made.ok()) {
     std::fprintf(stderr, "bodyscan sim render: %s\n", made.status().message().c_str());

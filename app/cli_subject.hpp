@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "core/status.hpp"
+#include "core/command_line.hpp"
 #include "pipeline/rig_backend.hpp"
 
 namespace bodyscan::cli {
@@ -12,11 +12,7 @@ namespace bodyscan::cli {
 // The options' lines for a command's --help.
 extern const char* const kSubjectOptionsHelp;
 
-// True for the flags below; each takes one value.
-bool is_subject_option(const std::string& flag);
-
-// Sets what `flag` (one of is_subject_option's) with `value` asks; an error says
-// what the value should have been.
-Status set_subject_option(const std::string& flag, const std::string& value, pipeline::SimulatedSubject* subject);
+// Declares the options on `cl`; each parsed value is checked and set on `subject`.
+void add_subject_options(CommandLine* cl, pipeline::SimulatedSubject* subject);
 
 }  // namespace bodyscan::cli

@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "core/command_line.hpp"
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/geometry/sample_surface.hpp"
 #include "recon/io/ply.hpp"
@@ -48,42 +49,20 @@ int main(int argc, char** argv) {
   double noise = 0.5;
   uint64_t seed = 1;
   ReconstructOptions opt;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "body_benchmark: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--body")
-      body = next();
-    else if (a == "--points")
-      points = std::strtoull(next(), nullptr, 10);
-    else if (a == "--noise")
-      noise = std::atof(next());
-    else if (a == "--seed")
-      seed = std::strtoull(next(), nullptr, 10);
-    else if (a == "--cloud-out")
-      cloud_out = next();
-    else if (a == "--mesh-out")
-      mesh_out = next();
-    else if (a == "--evaluate")
-      evaluate = next();
-    else if (a == "--voxel")
-      opt.voxel_size = static_cast<float>(std::atof(next()));
-    else if (a == "--sigma")
-      opt.sigma_scale = static_cast<float>(std::atof(next()));
-    else if (a == "--normal-sigma")
-      opt.normal_scale = static_cast<float>(std::atof(next()));
-    else {
-      std::fprintf(stderr,
-                   "usage: body_benchmark --body MESH.ply [--points N] [--noise MM] [--seed S] "
-                   "[--cloud-out F] [--mesh-out F] [--evaluate MESH.ply]\n");
-      return 2;
-    }
-  }
+  CommandLine cl("body_benchmark",
+                 "usage: body_benchmark --body MESH.ply [--points N] [--noise MM] [--seed S] [--cloud-out F] "
+                 "[--mesh-out F] [--evaluate MESH.ply] [--voxel V] [--sigma S] [--normal-sigma S]\n");
+  cl.option("--body", &body);
+  cl.option("--points", integer_between(1, 1LL << 40, [&points](long long n) { points = static_cast<size_t>(n); }));
+  cl.option("--noise", &noise);
+  cl.option("--seed", &seed);
+  cl.option("--cloud-out", &cloud_out);
+  cl.option("--mesh-out", &mesh_out);
+  cl.option("--evaluate", &evaluate);
+  cl.option("--voxel", &opt.voxel_size);
+  cl.option("--sigma", &opt.sigma_scale);
+  cl.option("--normal-sigma", &opt.normal_scale);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   if (body.empty()) {
     std::fprintf(stderr, "body_benchmark: --body is required\n");
     return 2;

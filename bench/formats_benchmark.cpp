@@ -19,6 +19,7 @@
 
 #include <meshoptimizer.h>
 
+#include "core/command_line.hpp"
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/geometry/simplify.hpp"
 #include "recon/io/ply.hpp"
@@ -95,23 +96,17 @@ int main(int argc, char** argv) {
   int repeat = 3;
   storage::DracoOptions served;
   std::vector<size_t> budgets;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--repeat" && i + 1 < argc)
-      repeat = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--level" && i + 1 < argc)
-      served.compression_level = std::atoi(argv[++i]);
-    else if (a == "--normals")
-      served.normals = true;
-    else if (a == "--avatar" && i + 1 < argc)
-      budgets.push_back(static_cast<size_t>(std::atol(argv[++i])));
-    else
-      files.push_back(a);
-  }
-  if (files.empty()) {
-    std::fprintf(stderr, "usage: formats_benchmark MESH.ply... [--repeat N] [--avatar TRIANGLES ...]\n");
-    return 2;
-  }
+  CommandLine cl(
+      "formats_benchmark",
+      "usage: formats_benchmark MESH.ply... [--repeat N] [--level L] [--normals] [--avatar TRIANGLES ...]\n");
+  cl.rest("MESH.ply...", &files);
+  cl.option("--repeat", integer_between(1, 1000000, [&repeat](long long n) { repeat = static_cast<int>(n); }));
+  cl.option("--level", &served.compression_level);
+  cl.flag("--normals", &served.normals);
+  cl.option("--avatar",
+            integer_between(4, 1LL << 32, [&budgets](long long n) { budgets.push_back(static_cast<size_t>(n)); }));
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
+  if (files.empty()) return cl.fail("give one or more meshes");
   if (!budgets.empty()) return avatars(files, budgets, repeat);
   std::printf("%-40s %10s %9s %8s %8s %8s | %8s %4s %7s %7s %7s | %8s %4s %7s %7s %7s\n", "mesh", "triangles", "ply MB",
               "obj MB", "stl MB", "", "glb MB", "bits", "err mm", "enc s", "dec s", "drc MB", "bits", "err mm", "enc s",

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "pipeline/scan_job.hpp"
 #include "recon/geometry/fill_holes.hpp"
 #include "recon/io/ply.hpp"
@@ -65,36 +66,20 @@ int main(int argc, char** argv) {
   float min_weight = -1.f;  // the body options' own
   HoleFillOptions options;
   options.fairing = pipeline::body_surface_options().hole_fairing;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "hole_fill_benchmark: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--max-dp")
-      limits.push_back(std::strtoull(next(), nullptr, 10));
-    else if (a == "--repeat")
-      repeat = std::max(1, std::atoi(next()));
-    else if (a == "--membrane")
-      options.fairing = HoleFairing::kMembrane;
-    else if (a == "--out")
-      out = next();
-    else if (a == "--save-open")
-      save_open = next();
-    else if (a == "--min-weight")
-      min_weight = std::strtof(next(), nullptr);
-    else if (!a.empty() && a[0] != '-' && in.empty())
-      in = a;
-    else {
-      std::fprintf(stderr,
-                   "usage: hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R] [--save-open "
-                   "OPEN.ply] [--out FILLED.ply] [--min-weight W]\n");
-      return 2;
-    }
-  }
+  bool membrane = false;
+  CommandLine cl("hole_fill_benchmark",
+                 "usage: hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R] [--save-open "
+                 "OPEN.ply] [--out FILLED.ply] [--min-weight W]\n");
+  cl.positional("IN.ply", &in, /*required=*/false);
+  cl.option("--max-dp",
+            integer_between(1, 1LL << 40, [&limits](long long n) { limits.push_back(static_cast<size_t>(n)); }));
+  cl.option("--repeat", integer_between(1, 1000000, [&repeat](long long n) { repeat = static_cast<int>(n); }));
+  cl.flag("--membrane", &membrane);
+  cl.option("--out", &out);
+  cl.option("--save-open", &save_open);
+  cl.option("--min-weight", &min_weight);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
+  if (membrane) options.fairing = HoleFairing::kMembrane;
   if (in.empty()) {
     std::fprintf(stderr, "hole_fill_benchmark: no input mesh\n");
     return 2;

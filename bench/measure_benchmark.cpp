@@ -50,6 +50,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "hw/sim/scene.hpp"
 #include "pipeline/rig_backend.hpp"
 #include "pipeline/scan_job.hpp"
@@ -135,14 +136,15 @@ uint64_t g_seed = 1;
 pipeline::SimulatedSubject g_subject;
 
 // "ARMS,FEET,TURN" into g_subject; false when it is not three numbers.
-bool parse_posture(const char* text) {
-  double arms = 0, feet = 0, turn = 0;
-  char end = 0;
-  if (std::sscanf(text, "%lf,%lf,%lf%c", &arms, &feet, &turn, &end) != 3) return false;
-  g_subject.posture.arm_abduction_deg = {arms, arms};
-  g_subject.posture.ankle_distance_mm = feet;
-  g_subject.turn_deg = turn;
-  return true;
+// ARMS,FEET,TURN: both arms ARMS degrees from the vertical, the ankles FEET mm
+// apart, turned TURN degrees.
+std::string parse_posture(const std::string& text) {
+  const auto v = parse_number_list(text, 3);
+  if (!v) return "expects ARMS,FEET,TURN, got '" + text + "'";
+  g_subject.posture.arm_abduction_deg = {(*v)[0], (*v)[0]};
+  g_subject.posture.ankle_distance_mm = (*v)[1];
+  g_subject.turn_deg = (*v)[2];
+  return "";
 }
 
 // A shipped rig by name, or a description file.
@@ -459,48 +461,32 @@ int main(int argc, char** argv) {
   int every = 1, noise_fields = 0;
   double noise_rms = 0.25;
   std::string noisy_out;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc)
-      rigs.push_back(argv[++i]);
-    else if (a == "--body" && i + 1 < argc)
-      bodies.push_back(argv[++i]);
-    else if (a == "--repeat")
-      repeat = true;
-    else if (a == "--sway" && i + 1 < argc)
-      sway = std::atof(argv[++i]);
-    else if (a == "--every" && i + 1 < argc)
-      every = std::atoi(argv[++i]);
-    else if (a == "--save" && i + 1 < argc)
-      g_save = argv[++i];
-    else if (a == "--saved" && i + 1 < argc)
-      saved = argv[++i];
-    else if (a == "--resurface")
-      g_resurface = true;
-    else if (a == "--noise-study" && i + 1 < argc)
-      noise_fields = std::atoi(argv[++i]);
-    else if (a == "--noise-rms" && i + 1 < argc)
-      noise_rms = std::atof(argv[++i]);
-    else if (a == "--noisy-out" && i + 1 < argc)
-      noisy_out = argv[++i];
-    else if (a == "--seed" && i + 1 < argc)
-      g_seed = std::strtoull(argv[++i], nullptr, 10);
-    else if (a == "--min-weight" && i + 1 < argc)
-      g_surface.min_relative_weight = std::strtof(argv[++i], nullptr);
-    else if (a == "--posture" && i + 1 < argc && parse_posture(argv[i + 1]))
-      ++i;
-    else if (a == "--fairing" && i + 1 < argc) {
-      const std::string f = argv[++i];
-      g_surface.hole_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
-    } else
-      return std::fprintf(
-                 stderr,
+  CommandLine cl("measure_benchmark",
                  "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
                  "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W] "
                  "[--posture ARMS,FEET,TURN]\n"
-                 "       measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body B...\n"),
-             2;
-  }
+                 "       measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body B...\n");
+  cl.option("--rig", &rigs);
+  cl.option("--body", &bodies);
+  cl.flag("--repeat", &repeat);
+  cl.option("--sway", &sway);
+  cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
+  cl.option("--save", &g_save);
+  cl.option("--saved", &saved);
+  cl.flag("--resurface", &g_resurface);
+  cl.option("--noise-study",
+            integer_between(1, 1000000, [&noise_fields](long long n) { noise_fields = static_cast<int>(n); }));
+  cl.option("--noise-rms", &noise_rms);
+  cl.option("--noisy-out", &noisy_out);
+  cl.option("--seed", &g_seed);
+  cl.option("--min-weight", &g_surface.min_relative_weight);
+  cl.option("--posture", parse_posture);
+  cl.option("--fairing", [](const std::string& f) -> std::string {
+    if (f != "membrane" && f != "thin") return "is membrane or thin, not '" + f + "'";
+    g_surface.hole_fairing = f == "membrane" ? HoleFairing::kMembrane : HoleFairing::kThinPlate;
+    return "";
+  });
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   if (noise_fields > 0) {
     if (bodies.empty()) return std::fprintf(stderr, "measure_benchmark: --noise-study needs --body B.ply\n"), 2;
     int rc = 0;

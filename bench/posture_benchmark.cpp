@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "hw/sim/pose_body.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/measure/body_frame.hpp"
@@ -49,14 +50,6 @@ const char* kFamilies[] = {"heights", "torso girths", "limb and neck girths", "l
 // Landmarks whose place skinning does not define: the armpits sit in the crease,
 // where skinning itself is not anatomical (shared/data/skeleton/README.md).
 bool anatomical(const std::string& landmark) { return landmark.rfind("armpit", 0) != 0; }
-
-std::vector<double> list(const std::string& text) {
-  std::vector<double> out;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, ',')) out.push_back(std::atof(part.c_str()));
-  return out;
-}
 
 size_t nearest_vertex(const TriangleMesh& m, const Eigen::Vector3d& p) {
   size_t best = 0;
@@ -174,35 +167,25 @@ int main(int argc, char** argv) {
   double shift = 300;
   std::string json_out;
   bool detail = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
-    if (a == "--detail") {
-      detail = true;
-      continue;
-    }
-    if (!v) {
-      std::fprintf(stderr, "posture_benchmark: %s needs a value (or is unknown)\n", a.c_str());
-      return 2;
-    }
-    ++i;
-    if (a == "--body")
-      bodies.push_back(v);
-    else if (a == "--arms")
-      arms = list(v);
-    else if (a == "--feet")
-      feet = list(v);
-    else if (a == "--turns")
-      turns = list(v);
-    else if (a == "--shift")
-      shift = std::atof(v);
-    else if (a == "--json")
-      json_out = v;
-    else {
-      std::fprintf(stderr, "posture_benchmark: unknown option %s\n", a.c_str());
-      return 2;
-    }
-  }
+  auto number_list = [](std::vector<double>* out) {
+    return [out](const std::string& v) -> std::string {
+      auto x = parse_number_list(v);
+      if (!x) return "expects comma-separated numbers, got '" + v + "'";
+      *out = std::move(*x);
+      return "";
+    };
+  };
+  CommandLine cl("posture_benchmark",
+                 "usage: posture_benchmark [--body B.ply]... [--arms DEG,...] [--feet MM,...] [--turns DEG,...] "
+                 "[--shift MM] [--json OUT] [--detail]\n");
+  cl.option("--body", &bodies);
+  cl.option("--arms", number_list(&arms));
+  cl.option("--feet", number_list(&feet));
+  cl.option("--turns", number_list(&turns));
+  cl.option("--shift", &shift);
+  cl.option("--json", &json_out);
+  cl.flag("--detail", &detail);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   const std::string shared = BODYSCAN_SOURCE_DIR "/../shared/data/bodies";
   if (bodies.empty()) {
     if (std::filesystem::exists(shared + "/male_average.ply")) {

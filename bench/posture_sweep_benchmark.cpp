@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "hw/sim/sim_rig.hpp"
 #include "pipeline/posture_sweep.hpp"
 #include "pipeline/rig_backend.hpp"
@@ -108,23 +109,18 @@ int main(int argc, char** argv) {
   std::string rig = "thesis", body;
   int every = bodyscan::pipeline::kPostureSweepEvery;
   std::vector<Case> cases;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    Case c;
-    char end = 0;
-    if (a == "--rig" && i + 1 < argc)
-      rig = argv[++i];
-    else if (a == "--body" && i + 1 < argc)
-      body = argv[++i];
-    else if (a == "--every" && i + 1 < argc && (every = std::atoi(argv[++i])) > 0)
-      continue;
-    else if (std::sscanf(a.c_str(), "%lf,%lf,%lf%c", &c.arms, &c.feet, &c.turn, &end) == 3)
-      cases.push_back(c);
-    else {
-      std::fprintf(stderr,
-                   "usage: posture_sweep_benchmark [--rig R] [--body X.ply] [--every N] [ARMS,FEET,TURN ...]\n");
-      return 2;
-    }
+  std::vector<std::string> case_args;
+  CommandLine cl("posture_sweep_benchmark",
+                 "usage: posture_sweep_benchmark [--rig R] [--body X.ply] [--every N] [ARMS,FEET,TURN ...]\n");
+  cl.option("--rig", &rig);
+  cl.option("--body", &body);
+  cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
+  cl.rest("ARMS,FEET,TURN ...", &case_args);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
+  for (const std::string& a : case_args) {
+    const auto v = parse_number_list(a, 3);
+    if (!v) return cl.fail("a case is ARMS,FEET,TURN, not '" + a + "'");
+    cases.push_back(Case{(*v)[0], (*v)[1], (*v)[2]});
   }
   if (cases.empty())
     cases = {{42, 380, 0}, {40, 350, 20}, {45, 420, -25}, {20, 300, 0}, {30, 250, 10}, {42, 150, 0}, {42, 380, 40}};

@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "core/command_line.hpp"
 #include "hw/sim/sim_rig.hpp"
 #include "pipeline/acquire.hpp"
 #include "pipeline/rig_backend.hpp"
@@ -25,19 +26,11 @@ int main(int argc, char** argv) {
   std::string rig_name = "thesis";
   int every = 1;
   double sway = 0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc)
-      rig_name = argv[++i];
-    else if (a == "--every" && i + 1 < argc)
-      every = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--sway" && i + 1 < argc)
-      sway = std::atof(argv[++i]);
-    else {
-      std::fprintf(stderr, "usage: render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM]\n");
-      return 2;
-    }
-  }
+  CommandLine cl("render_benchmark", "usage: render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM]\n");
+  cl.option("--rig", &rig_name);
+  cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
+  cl.option("--sway", &sway);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   auto sim = pipeline::open_simulated_rig(rig_name);

@@ -18,6 +18,7 @@
 #include <string>
 
 #include "bench/body_region.hpp"
+#include "core/command_line.hpp"
 #include "pipeline/rig_backend.hpp"
 #include "recon/geometry/sample_surface.hpp"
 
@@ -28,24 +29,14 @@ int main(int argc, char** argv) {
   std::string body;
   double min_angle = 8, min_incidence = 0.1, max_view = 90;
   bool cross = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc)
-      rigs.push_back(argv[++i]);
-    else if (a == "--body" && i + 1 < argc)
-      body = argv[++i];
-    else if (a == "--min-angle" && i + 1 < argc)
-      min_angle = std::atof(argv[++i]);
-    else if (a == "--max-view" && i + 1 < argc)
-      max_view = std::atof(argv[++i]);
-    else if (a == "--cross")
-      cross = true;
-    else
-      return std::fprintf(
-                 stderr,
-                 "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG] [--max-view DEG] [--cross]\n"),
-             2;
-  }
+  CommandLine cl("rig_coverage",
+                 "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG] [--max-view DEG] [--cross]\n");
+  cl.option("--rig", &rigs);
+  cl.option("--body", &body);
+  cl.option("--min-angle", &min_angle);
+  cl.option("--max-view", &max_view);
+  cl.flag("--cross", &cross);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   if (rigs.empty()) rigs = hw::shipped_rig_names();  // all of them
   for (const std::string& name : rigs) {
     pipeline::SimulatedSubject subject;

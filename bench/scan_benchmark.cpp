@@ -16,6 +16,7 @@
 #include <string>
 
 #include "bench/body_region.hpp"
+#include "core/command_line.hpp"
 #include "pipeline/rig_backend.hpp"
 #include "pipeline/scan.hpp"
 #include "recon/calib/plane_projection.hpp"
@@ -415,38 +416,22 @@ int run(const std::string& rig_name, const std::string& body, int every) {
 int main(int argc, char** argv) {
   std::vector<std::string> rigs, bodies;
   int every = 1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc)
-      rigs.push_back(argv[++i]);
-    else if (a == "--body" && i + 1 < argc)
-      bodies.push_back(argv[++i]);
-    else if (a == "--every" && i + 1 < argc)
-      every = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--min-angle" && i + 1 < argc)
-      g_min_angle = std::atof(argv[++i]);
-    else if (a == "--smooth" && i + 1 < argc)
-      g_smooth = std::atoi(argv[++i]);
-    else if (a == "--radius" && i + 1 < argc)
-      g_radius = std::atoi(argv[++i]);
-    else if (a == "--max-view" && i + 1 < argc)
-      g_max_view = std::atof(argv[++i]);
-    else if (a == "--keep-sway")
-      g_keep_sway = true;
-    else if (a == "--threshold" && i + 1 < argc)
-      g_threshold = std::atoi(argv[++i]);
-    else if (a == "--redundant" && i + 1 < argc)
-      g_redundant = static_cast<float>(std::atof(argv[++i]));
-    else if (a == "--weak" && i + 1 < argc)
-      g_weak = static_cast<float>(std::atof(argv[++i]));
-    else {
-      std::fprintf(
-          stderr,
-          "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] "
-          "[--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C] [--keep-sway]\n");
-      return 2;
-    }
-  }
+  CommandLine cl(
+      "scan_benchmark",
+      "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] "
+      "[--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C] [--keep-sway]\n");
+  cl.option("--rig", &rigs);
+  cl.option("--body", &bodies);
+  cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
+  cl.option("--min-angle", &g_min_angle);
+  cl.option("--smooth", &g_smooth);
+  cl.option("--radius", &g_radius);
+  cl.option("--max-view", &g_max_view);
+  cl.flag("--keep-sway", &g_keep_sway);
+  cl.option("--threshold", &g_threshold);
+  cl.option("--redundant", &g_redundant);
+  cl.option("--weak", &g_weak);
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   if (rigs.empty()) rigs = {"thesis", "square"};
   if (bodies.empty()) bodies = {""};
   for (const std::string& r : rigs)

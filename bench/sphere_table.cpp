@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "recon/geometry/sample_surface.hpp"
 #include "recon/io/ply.hpp"
 #include "recon/surface/reconstruct.hpp"
@@ -114,36 +115,31 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   std::string cloud_dir;
   std::vector<std::pair<size_t, double>> cells;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--defaults")
-      defaults = true;
-    else if (a == "--tuned")
-      tuned = true;
-    else if (a == "--nonuniform" && i + 1 < argc)
-      nonuniform = std::atof(argv[++i]);
-    else if (a == "--seed" && i + 1 < argc)
-      seed = std::strtoull(argv[++i], nullptr, 10);
-    else if (a == "--cloud-dir" && i + 1 < argc)
-      cloud_dir = argv[++i];
-    else if (a == "--cells" && i + 1 < argc) {
-      std::string s = argv[++i];
-      size_t pos = 0;
-      while (pos < s.size()) {
-        size_t comma = s.find(',', pos);
-        if (comma == std::string::npos) comma = s.size();
-        const std::string item = s.substr(pos, comma - pos);
-        const size_t colon = item.find(':');
-        cells.push_back({std::stoul(item.substr(0, colon)), std::stod(item.substr(colon + 1))});
-        pos = comma + 1;
-      }
-    } else {
-      std::fprintf(stderr,
-                   "usage: sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S] "
-                   "[--cloud-dir DIR]\n");
-      return 2;
+  CommandLine cl("sphere_table",
+                 "usage: sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S] "
+                 "[--cloud-dir DIR]\n");
+  cl.flag("--defaults", &defaults);
+  cl.flag("--tuned", &tuned);
+  cl.option("--nonuniform", &nonuniform);
+  cl.option("--seed", &seed);
+  cl.option("--cloud-dir", &cloud_dir);
+  // N:s pairs: a cloud of N points with noise sigma s.
+  cl.option("--cells", [&cells](const std::string& v) -> std::string {
+    size_t pos = 0;
+    while (pos <= v.size()) {
+      size_t comma = v.find(',', pos);
+      if (comma == std::string::npos) comma = v.size();
+      const std::string item = v.substr(pos, comma - pos);
+      const size_t colon = item.find(':');
+      const auto n = parse_integer(item.substr(0, colon));
+      const auto sigma = colon == std::string::npos ? std::nullopt : parse_double(item.substr(colon + 1));
+      if (!n || *n < 1 || !sigma) return "expects N:sigma pairs, got '" + item + "'";
+      cells.push_back({static_cast<size_t>(*n), *sigma});
+      pos = comma + 1;
     }
-  }
+    return "";
+  });
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   if (!defaults && !tuned) defaults = tuned = true;
   if (cells.empty())
     for (size_t n : kSizes)

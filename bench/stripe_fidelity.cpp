@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "hw/rig_description.hpp"
 #include "hw/sim/renderer.hpp"
 #include "hw/sim/sim_rig.hpp"
@@ -220,29 +221,17 @@ int main(int argc, char** argv) {
   int every = 12, sub = 8, radius = 4;
   bool noisy = false;
   int smooth = 3;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--rig" && i + 1 < argc)
-      rig_name = argv[++i];
-    else if (a == "--body" && i + 1 < argc)
-      body = argv[++i];
-    else if (a == "--every" && i + 1 < argc)
-      every = std::atoi(argv[++i]);
-    else if (a == "--sub" && i + 1 < argc)
-      sub = std::atoi(argv[++i]);
-    else if (a == "--radius" && i + 1 < argc)
-      radius = std::atoi(argv[++i]);
-    else if (a == "--noisy")
-      noisy = true;
-    else if (a == "--smooth" && i + 1 < argc)
-      smooth = std::atoi(argv[++i]);
-    else {
-      std::fprintf(stderr,
-                   "usage: stripe_fidelity [--rig NAME|FILE] [--body BODY.ply] [--every N] [--sub "
-                   "K] [--radius PX] [--noisy [--smooth N]]\n");
-      return 2;
-    }
-  }
+  CommandLine cl("stripe_fidelity",
+                 "usage: stripe_fidelity [--rig NAME|FILE] [--body BODY.ply] [--every N] [--sub K] [--radius PX] "
+                 "[--noisy [--smooth N]]\n");
+  cl.option("--rig", &rig_name);
+  cl.option("--body", &body);
+  cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
+  cl.option("--sub", integer_between(1, 64, [&sub](long long n) { sub = static_cast<int>(n); }));
+  cl.option("--radius", integer_between(1, 64, [&radius](long long n) { radius = static_cast<int>(n); }));
+  cl.flag("--noisy", &noisy);
+  cl.option("--smooth", integer_between(0, 1000, [&smooth](long long n) { smooth = static_cast<int>(n); }));
+  if (const auto exit = cl.parse(argc, argv)) return *exit;
   std::string path = rig_name;
   if (rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos) {
     auto p = shipped_rig_path(rig_name);
