@@ -28,6 +28,7 @@ packages=(
   libdraco-dev libtinygltf-dev  # glTF binary with Draco, Draco point clouds (storage/formats)
   libmeshoptimizer-dev # decimating surfaces to a triangle budget (recon/geometry/simplify)
   libcairo2-dev fonts-dejavu-core  # measurement sheets as PDF (storage/formats)
+  libqrencode-dev                  # the share link as a QR code on the customer sheet
   libsqlite3-dev       # the scan archive's index (storage/archive)
   libsodium-dev        # checksums of archived files; password hashing (server)
   libboost-dev         # Beast HTTP + WebSocket (server): Debian's default Boost, 1.74

@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "storage/formats/sheet_drawing.hpp"
+
 namespace bodyscan::storage {
 
 StatusOr<LengthUnit> parse_length_unit(std::string_view text) {
@@ -105,142 +107,19 @@ nlohmann::json sheet_json(const MeasurementSheet& sheet, LengthUnit unit) {
   return j;
 }
 
-namespace {
-
-// The body seen from the front (X to the right, Y up) or from its left side (-Z to
-// the right, Y up): which pixels of a raster it covers.
-struct View {
-  int axis_x = 0;     // 0: X, 2: Z
-  double sign_x = 1;  // +1 or -1
-  Eigen::Vector2d project(const Eigen::Vector3d& p) const { return {sign_x * p[axis_x], p.y()}; }
-};
-
-struct Silhouette {
-  int width = 0, height = 0;
-  double lo_x = 0, hi_y = 0, mm_per_px = 1;
-  std::vector<unsigned char> mask;  // width * height, 255 where the body is
-  Eigen::Vector2d to_px(const Eigen::Vector2d& p) const {
-    return {(p.x() - lo_x) / mm_per_px, (hi_y - p.y()) / mm_per_px};
-  }
-};
-
-Silhouette rasterise(const TriangleMesh& mesh, const View& view, double mm_per_px) {
-  Silhouette s;
-  double lo_x = std::numeric_limits<double>::max(), hi_x = -lo_x, lo_y = lo_x, hi_y = -lo_x;
-  for (const Vec3f& v : mesh.vertices) {
-    const Eigen::Vector2d p = view.project(v.cast<double>());
-    lo_x = std::min(lo_x, p.x()), hi_x = std::max(hi_x, p.x()), lo_y = std::min(lo_y, p.y()),
-    hi_y = std::max(hi_y, p.y());
-  }
-  s.lo_x = lo_x, s.hi_y = hi_y, s.mm_per_px = mm_per_px;
-  s.width = static_cast<int>(std::ceil((hi_x - lo_x) / mm_per_px)) + 1;
-  s.height = static_cast<int>(std::ceil((hi_y - lo_y) / mm_per_px)) + 1;
-  s.mask.assign(static_cast<size_t>(s.width) * static_cast<size_t>(s.height), 0);
-  for (const Triangle& t : mesh.triangles) {
-    Eigen::Vector2d q[3];
-    for (int k = 0; k < 3; ++k) q[k] = s.to_px(view.project(mesh.vertices[t[k]].cast<double>()));
-    const double area = (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
-    if (area == 0) continue;
-    const int x0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}))));
-    const int x1 = std::min(s.width - 1, static_cast<int>(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}))));
-    const int y0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}))));
-    const int y1 = std::min(s.height - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}))));
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const Eigen::Vector2d c(x + 0.5, y + 0.5);
-        bool inside = true;
-        for (int k = 0; k < 3 && inside; ++k) {
-          const Eigen::Vector2d a = q[k], b = q[(k + 1) % 3];
-          const double e = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-          inside = area > 0 ? e >= 0 : e <= 0;
-        }
-        if (inside) s.mask[static_cast<size_t>(y) * static_cast<size_t>(s.width) + static_cast<size_t>(x)] = 255;
-      }
-  }
-  return s;
-}
-
-cairo_status_t append_to_string(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
-
-class Page {
- public:
-  explicit Page(cairo_t* cr) : cr_(cr) {}
-  void text(double x, double y, const std::string& s, double size, bool bold = false, bool right = false) {
-    cairo_select_font_face(cr_, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL,
-                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr_, size);
-    if (right) {
-      cairo_text_extents_t ext;
-      cairo_text_extents(cr_, s.c_str(), &ext);
-      x -= ext.x_advance;
-    }
-    cairo_move_to(cr_, x, y);
-    cairo_show_text(cr_, s.c_str());
-  }
-  cairo_t* cr() { return cr_; }
-
- private:
-  cairo_t* cr_;
-};
-
-constexpr double kPageW = 595.276, kPageH = 841.89, kMargin = 40;  // A4 in points
-
-// The silhouette at (x, y) (top left), `pt_per_mm`, with each entry's path drawn
-// and, on the front view, numbered.
-void draw_view(Page& page, const TriangleMesh& mesh, const View& view, const MeasurementSheet& sheet, double x,
-               double y, double pt_per_mm, bool numbers) {
-  constexpr double kPxPerPt = 3;
-  const Silhouette s = rasterise(mesh, view, 1 / (pt_per_mm * kPxPerPt));
-  cairo_t* cr = page.cr();
-  const int stride = cairo_format_stride_for_width(CAIRO_FORMAT_A8, s.width);
-  std::vector<unsigned char> rows(static_cast<size_t>(stride) * static_cast<size_t>(s.height), 0);
-  for (int r = 0; r < s.height; ++r)
-    std::copy_n(s.mask.begin() + static_cast<long>(r) * s.width, s.width, rows.begin() + static_cast<long>(r) * stride);
-  cairo_surface_t* mask = cairo_image_surface_create_for_data(rows.data(), CAIRO_FORMAT_A8, s.width, s.height, stride);
-  cairo_save(cr);
-  cairo_translate(cr, x, y);
-  cairo_scale(cr, 1 / kPxPerPt, 1 / kPxPerPt);
-  cairo_set_source_rgb(cr, 0.78, 0.82, 0.88);
-  cairo_mask_surface(cr, mask, 0, 0);
-  cairo_restore(cr);
-  cairo_surface_finish(mask);
-  cairo_surface_destroy(mask);
-
-  auto at = [&](const Eigen::Vector3d& p) {
-    const Eigen::Vector2d q = s.to_px(view.project(p)) / kPxPerPt;
-    return Eigen::Vector2d(x + q.x(), y + q.y());
-  };
-  cairo_set_line_width(cr, 0.6);
-  for (size_t i = 0; i < sheet.entries.size(); ++i) {
-    const SheetEntry& e = sheet.entries[i];
-    if (e.path.size() < 2 || e.kind == "height") continue;
-    cairo_set_source_rgb(cr, e.flagged ? 0.75 : 0.1, 0.2, e.flagged ? 0.1 : 0.55);
-    Eigen::Vector2d right_most = at(e.path.front());
-    for (size_t k = 0; k < e.path.size(); ++k) {
-      const Eigen::Vector2d p = at(e.path[k]);
-      (k == 0 ? cairo_move_to : cairo_line_to)(cr, p.x(), p.y());
-      if (p.x() > right_most.x()) right_most = p;
-    }
-    if (e.closed) cairo_close_path(cr);
-    cairo_stroke(cr);
-    if (numbers) page.text(right_most.x() + 2, right_most.y() + 2, std::to_string(i + 1), 5);
-  }
-}
-
-}  // namespace
+using drawing::kMargin;
+using drawing::kPageH;
+using drawing::kPageW;
 
 StatusOr<std::string> sheet_pdf(const MeasurementSheet& sheet, const TriangleMesh& mesh, LengthUnit unit) {
   if (!mesh.is_consistent()) return invalid_argument("sheet: the mesh's indices or attributes are inconsistent");
   std::string out;
-  cairo_surface_t* surface = cairo_pdf_surface_create_for_stream(append_to_string, &out, kPageW, kPageH);
+  cairo_surface_t* surface = cairo_pdf_surface_create_for_stream(drawing::append_to_string, &out, kPageW, kPageH);
   cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_TITLE,
                                  ("Body measurements " + sheet.customer_ref).c_str());
   cairo_pdf_surface_set_metadata(surface, CAIRO_PDF_METADATA_CREATOR, "bodyscan");
   cairo_t* cr = cairo_create(surface);
-  Page page(cr);
+  drawing::Page page(cr);
 
   const double table_x = mesh.empty() ? kMargin : 300, table_right = kPageW - kMargin, row_h = 12.5;
   size_t next = 0;
@@ -273,9 +152,10 @@ StatusOr<std::string> sheet_pdf(const MeasurementSheet& sheet, const TriangleMes
       cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
       page.text(kMargin, top - 12, "front", 7);
       page.text(kMargin, top + view_h + gap - 12, "left side", 7);
-      draw_view(page, mesh, View{0, 1}, sheet, kMargin + (col_w - size.x() * scale) / 2, top, scale, true);
-      draw_view(page, mesh, View{2, -1}, sheet, kMargin + (col_w - size.z() * scale) / 2, top + view_h + gap, scale,
-                false);
+      drawing::draw_body(page, mesh, drawing::kFront, sheet.entries, kMargin + (col_w - size.x() * scale) / 2, top,
+                         scale, true);
+      drawing::draw_body(page, mesh, drawing::kLeftSide, sheet.entries, kMargin + (col_w - size.z() * scale) / 2,
+                         top + view_h + gap, scale, false);
     }
 
     double y = 125;
