@@ -74,6 +74,8 @@ std::string usage() {
          "                     answered 503 (default: the descriptor limit less 128)\n";
 }
 
+constexpr size_t kMaxLogoBytes = 2 << 20;
+
 std::string random_password() {
   unsigned char b[12];
   randombytes_buf(b, sizeof b);
@@ -107,11 +109,32 @@ int run_serve(int argc, char** argv) {
   cl.flag("--behind-tls-proxy", &ao.secure_cookies);
   cl.option("--trusted-proxy", &no.trusted_proxies);
   cl.option("--public-url", &ao.public_url);
+  cl.option("--shop-name", &ao.shop_name);
+  std::string logo_path;
+  cl.option("--shop-logo", &logo_path);
+  cl.option("--locale", [&ao](const std::string& v) -> std::string {
+    auto locale = storage::parse_locale(v);
+    if (!locale.ok()) return "expects en or de (the languages shipped), got '" + v + "'";
+    ao.locale = *locale;
+    return "";
+  });
   cl.option("--admin", &admin);
   cl.option("--workers", integer_between(1, 64, [&no](long long n) { no.workers = static_cast<int>(n); }));
   cl.option("--max-connections",
             integer_between(1, 1000000, [&no](long long n) { no.max_connections = static_cast<size_t>(n); }));
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  if (!logo_path.empty()) {
+    // Read once and tried on a sheet now, so that a wrong file stops the start
+    // rather than every customer's sheet.
+    auto logo = read_whole_file(logo_path);
+    if (!logo.ok()) return cl.fail("--shop-logo: " + logo.status().message());
+    if (logo->size() > kMaxLogoBytes) return cl.fail("--shop-logo: the PNG is over 2 MB");
+    storage::CustomerSheet trial;
+    trial.shop_logo_png = *logo;
+    if (auto tried = storage::customer_sheet_pdf(trial, TriangleMesh(), storage::LengthUnit::kCentimetre); !tried.ok())
+      return cl.fail("--shop-logo " + logo_path + ": " + tried.status().message());
+    ao.shop_logo_png = std::move(*logo);
+  }
   if (!no.tls_cert.empty()) ao.secure_cookies = true;
 
   // The signals that end a process by default and that a person or the system

@@ -16,6 +16,7 @@
 #include "server/api/http_types.hpp"
 #include "server/auth/auth_store.hpp"
 #include "server/workstation/workstation.hpp"
+#include "storage/formats/customer_sheet.hpp"
 
 namespace bodyscan::server {
 
@@ -42,6 +43,10 @@ struct ApiOptions {
   std::string web_root;         // the UI's static files
   bool secure_cookies = false;  // Secure on the session cookie (TLS here or at a proxy)
   std::string public_url;       // share links' base, e.g. "https://scanner.shop.example"; "" from Host
+  // The shop as the customer's page and sheet name it, in its language.
+  std::string shop_name;
+  std::string shop_logo_png;  // PNG bytes; "" for none
+  storage::Locale locale = storage::Locale::kEnglish;
 };
 
 class Api {

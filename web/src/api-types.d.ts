@@ -1773,7 +1773,10 @@ export interface paths {
         /** The customer's view: when the scan was taken and the measurements shared */
         get: {
             parameters: {
-                query?: never;
+                query?: {
+                    /** @description the language of the plain labels: en or de; default: the shop's */
+                    locale?: "en" | "de";
+                };
                 header?: {
                     /** @description the link's PIN, for a link made with one */
                     "X-Share-PIN"?: string;
@@ -1796,8 +1799,27 @@ export interface paths {
                             taken_at?: string;
                             expires_at?: number;
                             mesh?: string;
-                            measurements?: components["schemas"]["StoredMeasurement"][];
+                            measurements?: (components["schemas"]["StoredMeasurement"] & {
+                                /** @description the measurement's plain name in the shop's language (absent for one staff took) */
+                                plain_label?: string;
+                            })[];
+                            /**
+                             * @description the language of the plain labels: the one asked for, else the shop's (bodyscan serve --locale)
+                             * @enum {string}
+                             */
+                            locale?: "en" | "de";
+                            /** @description the shop's name; empty when not configured */
+                            shop?: string;
                         };
+                    };
+                };
+                /** @description an unknown locale */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
                     };
                 };
                 /** @description the link has a PIN and X-Share-PIN is missing or wrong (the message says how many tries are left) */
@@ -1870,6 +1892,80 @@ export interface paths {
                         [name: string]: unknown;
                     };
                     content?: never;
+                };
+                /** @description the link has a PIN and X-Share-PIN is missing or wrong (the message says how many tries are left) */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description unknown, expired or withdrawn link */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/share/{token}/sheet.pdf": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The customer's sheet: one A4 page with their name, the shared measurements under plain names, the silhouette, the shop and the link as a QR code, in the shop's language */
+        get: {
+            parameters: {
+                query?: {
+                    /** @description mm, cm (default) or in */
+                    unit?: "mm" | "cm" | "in";
+                    /** @description en or de; default: the shop's language */
+                    locale?: "en" | "de";
+                };
+                header?: {
+                    /** @description the link's PIN, for a link made with one */
+                    "X-Share-PIN"?: string;
+                };
+                path: {
+                    /** @description the link's 128-bit token */
+                    token: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description the sheet */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/pdf": string;
+                    };
+                };
+                /** @description an unknown unit or locale */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
                 };
                 /** @description the link has a PIN and X-Share-PIN is missing or wrong (the message says how many tries are left) */
                 401: {

@@ -347,9 +347,11 @@ const withdrawShare = (id) => del(at('/api/shares/{id}', { id }));
  * but a link that asks for its PIN (or was given a wrong one).
  * @param {string} token
  * @param {string} [pin] the PIN the shop read out, for a link that has one
+ * @param {string} [locale] the plain labels' language (en, de); the shop's by default
  * @returns {Promise<Answer<'/api/share/{token}', 'get', 200>>}
  */
-const getShare = (token, pin) => get(at('/api/share/{token}', { token }), { quiet401: true, headers: pin ? { 'X-Share-PIN': pin } : {} });
+const getShare = (token, pin, locale) =>
+  get(at('/api/share/{token}', { token }) + query({ locale }), { quiet401: true, headers: pin ? { 'X-Share-PIN': pin } : {} });
 
 /**
  * The model a share link shows, as bytes (a link with a PIN sends it too).
@@ -358,6 +360,17 @@ const getShare = (token, pin) => get(at('/api/share/{token}', { token }), { quie
  * @returns {Promise<ArrayBuffer>}
  */
 const getShareModel = async (url, pin) => (await request(url, { raw: true, quiet401: true, headers: pin ? { 'X-Share-PIN': pin } : {} })).arrayBuffer();
+
+/**
+ * The customer's sheet for a share link (PDF), as a Blob.
+ * @param {string} token
+ * @param {string} unit
+ * @param {string} [locale] its language; the shop's by default
+ * @param {string} [pin]
+ * @returns {Promise<Blob>}
+ */
+const getShareSheet = async (token, unit, locale, pin) =>
+  (await request(at('/api/share/{token}/sheet.pdf', { token }) + query({ unit, locale }), { raw: true, quiet401: true, headers: pin ? { 'X-Share-PIN': pin } : {} })).blob();
 
 // Every call, as `api.getScan(id)` and so on.
 export const api = {
@@ -391,6 +404,7 @@ export const api = {
   withdrawShare,
   getShare,
   getShareModel,
+  getShareSheet,
 };
 
 // A query string from an object, skipping empty values.

@@ -13,12 +13,21 @@ export function convert(mm, unit) {
   return mm * u.perMm;
 }
 
-// "934 mm", "93.5 cm", "36.81 in"; an em dash for a missing value.
-export function formatLength(mm, unit, { withUnit = true } = {}) {
+// "934 mm", "93.5 cm", "36.81 in"; an em dash for a missing value. With a
+// `locale`, its decimal mark ("93,5 cm" in German), no grouping.
+/**
+ * @param {number | null | undefined} mm
+ * @param {string} unit
+ * @param {{ withUnit?: boolean, locale?: string }} [options]
+ */
+export function formatLength(mm, unit, { withUnit = true, locale } = {}) {
   if (mm === null || mm === undefined || !Number.isFinite(mm)) return '—';
   const u = UNITS[unit];
   if (!u) throw new Error(`unknown unit ${unit}`);
-  const text = convert(mm, unit).toFixed(u.digits);
+  const value = convert(mm, unit);
+  const text = locale
+    ? value.toLocaleString(locale, { minimumFractionDigits: u.digits, maximumFractionDigits: u.digits, useGrouping: false })
+    : value.toFixed(u.digits);
   return withUnit ? `${text} ${u.label}` : text;
 }
 

@@ -307,6 +307,62 @@ TEST(ApiScan, AShareLinkServesTheModelWithoutTheHeadUnlessStaffIncludeIt) {
             304);
 }
 
+// The text pdftotext reads from a PDF.
+std::string pdf_text(const std::string& pdf) {
+  const std::string dir = temp_dir();
+  { std::ofstream(dir + "/sheet.pdf", std::ios::binary) << pdf; }
+  EXPECT_EQ(std::system(("pdftotext " + dir + "/sheet.pdf " + dir + "/sheet.txt").c_str()), 0);
+  std::ifstream in(dir + "/sheet.txt");
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The customer's sheet through their link: their name, the shared measurements
+// under plain names and nothing else, in the shop's language or the one asked for.
+TEST(ApiScan, AShareLinkGivesTheCustomerTheirSheet) {
+  ServerUnderTest s;
+  Client tailor = s.as("tailor");
+  const HttpReply made =
+      tailor.post("/api/scans/" + s.scan_id + "/shares", R"({"measurements": ["waist_girth", "crotch_height"]})");
+  ASSERT_EQ(made.status, 201) << made.body;
+  const std::string at = "/api/share/" + parse(made)["token"].get<std::string>();
+
+  const nlohmann::json view = parse(http(s.port, "GET", at));
+  EXPECT_EQ(view["locale"], "en");
+  ASSERT_EQ(view["measurements"].size(), 2u) << view.dump();
+  for (const auto& m : view["measurements"])
+    EXPECT_EQ(m["plain_label"], m["name"] == "waist_girth" ? "Waist" : "Inside leg") << m.dump();
+
+  const nlohmann::json in_german = parse(http(s.port, "GET", at + "?locale=de"));
+  EXPECT_EQ(in_german["locale"], "de");
+  for (const auto& m : in_german["measurements"])
+    EXPECT_EQ(m["plain_label"], m["name"] == "waist_girth" ? "Taillenumfang" : "Schrittlänge") << m.dump();
+  EXPECT_EQ(http(s.port, "GET", at + "?locale=xx").status, 400);
+
+  const HttpReply sheet = http(s.port, "GET", at + "/sheet.pdf?unit=mm");
+  ASSERT_EQ(sheet.status, 200) << sheet.body;
+  EXPECT_EQ(sheet.header("content-type"), "application/pdf");
+  EXPECT_EQ(sheet.header("cache-control"), "private, no-store");
+  const std::string text = pdf_text(sheet.body);
+  for (const char* want : {"Your body measurements", "Demo Customer", "Waist", "Inside leg", "mm", "Link valid until"})
+    EXPECT_NE(text.find(want), std::string::npos) << want << "\n" << text;
+  EXPECT_EQ(text.find("Chest"), std::string::npos) << "only what the link shares";
+  EXPECT_EQ(text.find("tailor"), std::string::npos) << "no staff names";
+
+  const std::string german = pdf_text(http(s.port, "GET", at + "/sheet.pdf?locale=de").body);
+  for (const char* want : {"Ihre Körpermaße", "Taillenumfang", "Schrittlänge", "Link gültig bis"})
+    EXPECT_NE(german.find(want), std::string::npos) << want << "\n" << german;
+  EXPECT_EQ(http(s.port, "GET", at + "/sheet.pdf?locale=fr").status, 400);
+  EXPECT_EQ(http(s.port, "GET", at + "/sheet.pdf?unit=furlong").status, 400);
+  EXPECT_EQ(http(s.port, "GET", "/api/share/AAAAAAAAAAAAAAAAAAAAAA/sheet.pdf").status, 404);
+  // A link with a PIN gives the sheet only with it.
+  const HttpReply pinned = tailor.post("/api/scans/" + s.scan_id + "/shares", R"({"pin": true})");
+  ASSERT_EQ(pinned.status, 201);
+  const std::string pinned_at = "/api/share/" + parse(pinned)["token"].get<std::string>() + "/sheet.pdf";
+  EXPECT_EQ(http(s.port, "GET", pinned_at).status, 401);
+  EXPECT_EQ(http(s.port, "GET", pinned_at, {{"X-Share-PIN", parse(pinned)["pin_code"].get<std::string>()}}).status,
+            200);
+}
+
 // Avatars for CAD tools: the scan's surface decimated to the budget asked for,
 // closed, as an OBJ in mm or m and a plain GLB in metres, near the true body.
 TEST(ApiScan, AvatarsForCadToolsAreClosedWithinTheBudgetAndNearTheBody) {

@@ -5,14 +5,14 @@
 import { api, enc } from '../api.js';
 import { preferredUnit } from '../units.js';
 import { unitSelect } from '../ui/unit-select.js';
-import { clear, errorText, h, when } from '../ui/dom.js';
+import { clear, errorText, h } from '../ui/dom.js';
+import { customerLocale, customerWords, formatWhen } from '../i18n.js';
 import { BodyView } from '../viewer/body-view.js';
 import { COLOURS, drawMeasurement, measurementTable } from '../viewer/measurement-table.js';
 
 export async function mount(container, { token }) {
   const t0 = performance.now();
   let unit = preferredUnit();
-  let selected = null;
   /** @type {import('../api.js').ShareView} */
   let share;
   /** @type {string | undefined} */
@@ -37,8 +37,79 @@ export async function mount(container, { token }) {
       return;
     }
   }
+  // The shop's language unless this browser chose the other; the plain labels
+  // come from the server in the language shown.
+  let locale = customerLocale(chosenLocale() || share.locale);
+  /** @type {BodyView | null} */
+  let view = null;
+  const show = async () => {
+    if (locale !== share.locale) share = await api.getShare(token, pin, locale);
+    view?.dispose();
+    clear(container);
+    view = render(
+      container,
+      { token, pin, share, locale, t0, unit },
+      (next) => {
+        locale = next;
+        rememberLocale(next);
+        show();
+      },
+      (u) => {
+        unit = u;
+      },
+    );
+  };
+  await show();
+  return () => view?.dispose();
+}
+
+const LOCALE_KEY = 'bodyscan.customer-locale';
+const chosenLocale = () => globalThis.localStorage?.getItem(LOCALE_KEY) || undefined;
+const rememberLocale = (locale) => globalThis.localStorage?.setItem(LOCALE_KEY, locale);
+
+// The page in `locale`; returns its 3-D view. `onLocale` is called with a language
+// the customer picks, `onUnit` with a unit.
+/**
+ * @param {HTMLElement} container
+ * @param {{ token: string, pin: string | undefined, share: import('../api.js').ShareView, locale: import('../i18n.js').Locale, t0: number, unit: string }} state
+ * @param {(locale: import('../i18n.js').Locale) => void} onLocale
+ * @param {(unit: string) => void} onUnit
+ */
+function render(container, { token, pin, share, locale, t0, unit }, onLocale, onUnit) {
+  let selected = null;
+  const words = customerWords(locale);
+  document.documentElement.lang = locale;
+  const languages = h(
+    'select',
+    { class: 'language', 'aria-label': words.language, onchange: (e) => onLocale(customerLocale(e.target.value)) },
+    h('option', { value: 'en', selected: locale === 'en', lang: 'en' }, 'English'),
+    h('option', { value: 'de', selected: locale === 'de', lang: 'de' }, 'Deutsch'),
+  );
   const viewport = h('div', { class: 'viewport', id: 'viewport' });
   const tableBox = h('div', { class: 'table-box' });
+  const sheetError = h('p', { class: 'form-error', role: 'alert' });
+  const sheetButton = h(
+    'button',
+    {
+      type: 'button',
+      class: 'sheet-button',
+      onclick: async () => {
+        sheetError.textContent = '';
+        try {
+          const blob = await api.getShareSheet(token, unit, locale, pin);
+          const url = URL.createObjectURL(blob);
+          const a = h('a', { href: url, download: 'body-measurements.pdf' });
+          document.body.append(a);
+          a.click();
+          a.remove();
+          setTimeout(() => URL.revokeObjectURL(url), 60_000);
+        } catch (e) {
+          sheetError.textContent = `${words.sheetFailed} ${errorText(e)}`;
+        }
+      },
+    },
+    words.sheet,
+  );
   container.append(
     h(
       'section',
@@ -46,27 +117,35 @@ export async function mount(container, { token }) {
       h(
         'header',
         { class: 'customer-head' },
-        h('h1', {}, 'Your body scan'),
-        h('p', { class: 'muted' }, `Taken ${when(share.taken_at)} · this link works until ${when(new Date(share.expires_at * 1000).toISOString())}`),
+        h('div', { class: 'row customer-top' }, share.shop ? h('p', { class: 'shop-name' }, share.shop) : h('span'), languages),
+        h('h1', {}, words.title),
+        h('p', { class: 'muted' }, words.taken(formatWhen(share.taken_at, locale), formatWhen(new Date(share.expires_at * 1000).toISOString(), locale))),
       ),
-      h('div', { class: 'viewer-main' }, viewport, h('p', { class: 'hint' }, 'Drag to turn, pinch or scroll to zoom. Tap a measurement to see it on the body.')),
+      h('div', { class: 'viewer-main' }, viewport, h('p', { class: 'hint' }, words.hint)),
       h(
         'aside',
         { class: 'viewer-side' },
         h(
           'div',
           { class: 'row' },
-          h('h2', {}, 'Measurements'),
-          unitSelect(unit, (u) => {
-            unit = u;
-            renderTable();
-          }),
+          h('h2', {}, words.measurements),
+          unitSelect(
+            unit,
+            (u) => {
+              unit = u;
+              onUnit(u);
+              renderTable();
+            },
+            words.unit,
+          ),
         ),
         tableBox,
+        h('div', { class: 'row' }, sheetButton),
+        sheetError,
       ),
     ),
   );
-  const view = new BodyView(viewport, { label: 'Your body in 3-D' });
+  const view = new BodyView(viewport, { label: words.model });
 
   function renderTable() {
     clear(
@@ -76,7 +155,10 @@ export async function mount(container, { token }) {
             measurements: share.measurements,
             unit,
             selected,
-            groups: { automatic: 'Body measurements', user: 'Taken by the shop' },
+            plain: true,
+            locale,
+            headings: [words.measurement, words.value],
+            groups: words.groups,
             onSelect: (m) => {
               selected = selected === m.name ? null : m.name;
               view.clearOverlays('sel');
@@ -84,14 +166,15 @@ export async function mount(container, { token }) {
               renderTable();
             },
           })
-        : h('p', { class: 'muted' }, 'The shop shared no measurements with this link.'),
+        : h('p', { class: 'muted' }, words.noMeasurements),
+      share.measurements.some((m) => m.geometry?.crosses_filled_hole) ? h('p', { class: 'estimated-note' }, words.estimated) : null,
     );
   }
   renderTable();
   view.loadMesh(api.getShareModel(share.mesh || `/api/share/${enc(token)}/mesh.glb`, pin), { t0 }).catch((e) => {
-    viewport.append(h('p', { class: 'form-error overlay' }, `The model did not load: ${errorText(e)}`));
+    viewport.append(h('p', { class: 'form-error overlay' }, `${words.modelFailed} ${errorText(e)}`));
   });
-  return () => view.dispose();
+  return view;
 }
 
 // A form for the link's PIN; resolves with the right one, or undefined when the

@@ -5,7 +5,7 @@
 // can be withdrawn.
 import QRCode from 'qrcode';
 import { api } from '../api.js';
-import { formatLength } from '../units.js';
+import { formatLength, preferredUnit } from '../units.js';
 import { clear, errorText, h, toast, when } from '../ui/dom.js';
 
 /**
@@ -117,6 +117,23 @@ export async function shareDialog(scanId, measurements, unit) {
         ),
         qr,
         share.pin_code ? h('p', { class: 'share-pin' }, 'Read out the PIN (shown only now): ', h('strong', { class: 'pin-code' }, share.pin_code)) : null,
+        h(
+          'button',
+          {
+            type: 'button',
+            class: 'customer-sheet',
+            title: "The customer's sheet to print: their name, these measurements under plain names, the link's QR code",
+            onclick: async () => {
+              try {
+                const blob = await api.getShareSheet(share.token, preferredUnit(), undefined, share.pin_code);
+                window.open(URL.createObjectURL(blob), '_blank', 'noopener');
+              } catch (err) {
+                toast(`No sheet: ${errorText(err)}`, 'error');
+              }
+            },
+          },
+          'Customer sheet (PDF)',
+        ),
       );
       await QRCode.toCanvas(qr, url, { errorCorrectionLevel: 'M', margin: 4, width: 240 });
       made.hidden = false;

@@ -3,14 +3,14 @@
 import { setPreferredUnit, UNITS } from '../units.js';
 import { h } from './dom.js';
 
-export function unitSelect(current, onChange) {
+export function unitSelect(current, onChange, label = 'Unit') {
   return h(
     'label',
     { class: 'unit-select' },
     h(
       'select',
       {
-        'aria-label': 'Unit',
+        'aria-label': label,
         onchange: (e) => {
           setPreferredUnit(e.target.value);
           onChange(e.target.value);

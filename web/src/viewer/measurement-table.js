@@ -54,7 +54,7 @@ const has = (m) => Number.isFinite(m.value_mm);
 // rows: [{m, other?}] - `other` is the same measurement on a second scan (compare).
 /**
  * @param {object} options
- * @param {StoredMeasurement[]} options.measurements
+ * @param {(StoredMeasurement & { plain_label?: string })[]} options.measurements
  * @param {string} options.unit
  * @param {string | null} options.selected the name of the selected row
  * @param {(m: StoredMeasurement) => void} options.onSelect
@@ -65,6 +65,10 @@ const has = (m) => Number.isFinite(m.value_mm);
  *   comparison shown in the order of its two bodies); the change is still row − compared
  * @param {string} [options.caption]
  * @param {Record<string, string>} [options.groups] the heading of each source's rows
+ * @param {boolean} [options.plain] the customer's table: plain names (`plain_label`), no kinds or
+ *   clauses, no posture flag, a line that crosses filled-in skin starred (the page says why in a sentence)
+ * @param {string} [options.locale] the values' decimal mark and the headings' language
+ * @param {[string, string]} [options.headings] the name and value columns' headings
  */
 export function measurementTable({
   measurements,
@@ -77,13 +81,16 @@ export function measurementTable({
   otherFirst = false,
   caption,
   groups = { automatic: 'Automatic (ISO 8559-1)', user: 'Saved by staff' },
+  plain = false,
+  locale,
+  headings = ['Measurement', 'Value'],
 }) {
   const byName = new Map((compareWith || []).map((m) => [m.name, m]));
   const head = h(
     'tr',
     {},
-    h('th', { scope: 'col' }, 'Measurement'),
-    h('th', { scope: 'col', class: 'num' }, compareWith ? columns[0] : 'Value'),
+    h('th', { scope: 'col' }, headings[0]),
+    h('th', { scope: 'col', class: 'num' }, compareWith ? columns[0] : headings[1]),
     compareWith ? h('th', { scope: 'col', class: 'num' }, columns[1]) : null,
     compareWith ? h('th', { scope: 'col', class: 'num' }, 'Change') : null,
     onDelete ? h('th', { scope: 'col' }, h('span', { class: 'sr-only' }, 'Delete')) : null,
@@ -101,9 +108,9 @@ export function measurementTable({
     const ownCell = h(
       'td',
       { class: 'num value' },
-      g.outside_posture ? h('span', { class: 'posture-flag', title: POSTURE_NOTE, 'aria-label': POSTURE_NOTE }, '⚑ ') : null,
-      g.crosses_filled_hole ? h('span', { class: 'filled', title: FILLED_NOTE }, '≈ ') : null,
-      has(m) ? formatLength(m.value_mm, unit) : '—',
+      g.outside_posture && !plain ? h('span', { class: 'posture-flag', title: POSTURE_NOTE, 'aria-label': POSTURE_NOTE }, '⚑ ') : null,
+      g.crosses_filled_hole && !plain ? h('span', { class: 'filled', title: FILLED_NOTE }, '≈ ') : null,
+      has(m) ? formatLength(m.value_mm, unit, { locale }) : '—',
     );
     const otherCell = compareWith ? h('td', { class: 'num' }, other ? formatLength(other.value_mm, unit) : '—') : null;
     const row = h(
@@ -124,8 +131,12 @@ export function measurementTable({
       h(
         'td',
         {},
-        h('span', { class: 'm-label' }, m.label || m.name),
-        h('small', { class: 'muted' }, ` ${KIND_LABEL[m.kind] || m.kind}${m.iso_clause ? ` · ISO ${m.iso_clause}` : ''}`),
+        h('span', { class: 'm-label' }, (plain && m.plain_label) || m.label || m.name),
+        plain
+          ? g.crosses_filled_hole
+            ? h('span', { class: 'estimated' }, ' *')
+            : null
+          : h('small', { class: 'muted' }, ` ${KIND_LABEL[m.kind] || m.kind}${m.iso_clause ? ` · ISO ${m.iso_clause}` : ''}`),
       ),
       ...(otherFirst ? [otherCell, ownCell] : [ownCell, otherCell]),
       compareWith ? h('td', { class: 'num' }, other && has(m) ? formatDifference(m.value_mm - other.value_mm, unit) : '—') : null,

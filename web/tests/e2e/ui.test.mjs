@@ -7,10 +7,12 @@
 // validator), a second scan of the same customer compared, a customer's share link
 // that reaches nothing else, and an admin deleting the scan. Screenshots go to the artefacts folder.
 import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
 import { readFileSync } from 'node:fs';
 import { after, before, describe, it } from 'node:test';
 import { validateBytes } from 'gltf-validator';
 import jsQR from 'jsqr';
+import { PNG } from 'pngjs';
 import { OBJLoader } from 'three/examples/jsm/loaders/OBJLoader.js';
 import { ADMIN_PASSWORD, ARTEFACTS, closeSuite, coverage, demoBodyBounds, demoBodyMeasurement, login, logout, newPage, openSuite, shot } from './harness.mjs';
 
@@ -468,6 +470,33 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     const overflow = await customer.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
     assert.ok(overflow <= 0, `the page is ${overflow} px wider than the phone`);
     await shot(customer, 'customer-phone');
+    // Their sheet to take home: their name, the shared measurements under plain
+    // names, and the link as a QR code an independent reader decodes.
+    const [sheet] = await Promise.all([customer.waitForEvent('download'), customer.click('button:has-text("Your sheet (PDF)")')]);
+    const sheetPath = `${ARTEFACTS}/customer-sheet.pdf`;
+    await sheet.saveAs(sheetPath);
+    const sheetText = execFileSync('pdftotext', [sheetPath, '-'], { encoding: 'utf8' });
+    for (const want of ['Your body measurements', 'Ada Lovelace', 'Waist', 'Jacket waist', 'Your 3-D model: scan with your phone'])
+      assert.ok(sheetText.includes(want), `${want} on the sheet:\n${sheetText}`);
+    assert.ok(!/ISO|5\.3\./.test(sheetText), `no clause numbers on the customer's sheet:\n${sheetText}`);
+    execFileSync('pdftoppm', ['-r', '150', '-png', '-singlefile', sheetPath, `${ARTEFACTS}/customer-sheet`]);
+    const raster = PNG.sync.read(readFileSync(`${ARTEFACTS}/customer-sheet.png`));
+    assert.equal(jsQR(new Uint8ClampedArray(raster.data), raster.width, raster.height)?.data, link, 'the QR code on the sheet holds the link');
+    // In German, as the customer picks it: the words, the decimal comma, and the sheet.
+    await customer.selectOption('select.language', 'de');
+    await customer.locator('h1:has-text("Ihr Körperscan")').waitFor();
+    assert.equal(await customer.evaluate(() => document.documentElement.lang), 'de');
+    assert.equal(await customer.locator('table.measurements thead th').first().innerText(), 'Maß');
+    const waistDe = await customer.locator('table.measurements tr[data-name=waist_girth]').innerText();
+    assert.match(waistDe, /Taillenumfang[\s\S]*\d+,\d cm/, waistDe);
+    await customer.locator('#viewport[data-state=ready]').waitFor({ timeout: 120000 });
+    const [sheetDe] = await Promise.all([customer.waitForEvent('download'), customer.click('button:has-text("Ihr Maßblatt (PDF)")')]);
+    const germanText = execFileSync('pdftotext', [await sheetDe.path(), '-'], { encoding: 'utf8' });
+    for (const want of ['Ihre Körpermaße', 'Gescannt am', 'Taillenumfang', 'Ihr 3-D-Modell'])
+      assert.ok(germanText.includes(want), `${want} on the German sheet:\n${germanText}`);
+    await shot(customer, 'customer-phone-de');
+    await customer.selectOption('select.language', 'en');
+    await customer.locator('h1:has-text("Your body scan")').waitFor();
     // Nothing else: no staff API, no other scan's model, no staff page.
     const probes = await customer.evaluate(async (scan) => {
       const status = async (u) => (await fetch(u)).status;

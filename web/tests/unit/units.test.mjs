@@ -29,3 +29,10 @@ test('the unit choice is kept per browser, cm when none or a bad one is stored',
   assert.equal(preferredUnit(storage), 'cm');
   assert.throws(() => setPreferredUnit('cubit', storage));
 });
+
+test("the customer's locale writes its own decimal mark, without grouping", () => {
+  assert.equal(formatLength(934.4, 'cm', { locale: 'de' }), '93,4 cm');
+  assert.equal(formatLength(12345.6, 'mm', { locale: 'de' }), '12346 mm');
+  assert.equal(formatLength(934.4, 'cm', { locale: 'en' }), '93.4 cm');
+  assert.equal(formatLength(254, 'in', { locale: 'de', withUnit: false }), '10,00');
+});
