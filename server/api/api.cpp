@@ -174,9 +174,16 @@ HttpResponse Api::handle(const HttpRequest& request) {
       auto answer = ws_.auth().check_share_pin(call.params["token"], pin, &left);
       if (!answer.ok() || *answer == PinAnswer::kWithdrawn)
         return error_response(404, "this link is not valid (it may have expired or been withdrawn)");
-      if (*answer == PinAnswer::kWrong)
-        return error_response(401, "wrong PIN; " + std::to_string(left) + (left == 1 ? " try" : " tries") +
-                                       " left before the link is withdrawn");
+      if (*answer == PinAnswer::kWrong) {
+        HttpResponse wrong =
+            error_response(401, "wrong PIN; " + std::to_string(left) + (left == 1 ? " try" : " tries") +
+                                    " left before the link is withdrawn");
+        // The count as a number too, for the customer's page to say in its language.
+        nlohmann::json body = nlohmann::json::parse(wrong.body);
+        body["error"]["tries_left"] = left;
+        wrong.body = body.dump();
+        return wrong;
+      }
     }
   } else if (!(route->access & kAnyone)) {
     call.session = ws_.auth().session(session_cookie(request));

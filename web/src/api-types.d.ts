@@ -2043,6 +2043,8 @@ export interface components {
                 status?: number;
                 code?: string;
                 message?: string;
+                /** @description a share link's wrong PIN: the tries left before it is withdrawn */
+                tries_left?: number;
             };
         };
         /** @enum {string} */

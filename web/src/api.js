@@ -70,13 +70,15 @@ export class ApiError extends Error {
    * @param {string} code the server's error code, or 'error' or 'network'
    * @param {string} message
    * @param {number | null} [retryAfter] seconds, from Retry-After
+   * @param {number | null} [triesLeft] a share link's wrong PIN: the tries left
    */
-  constructor(status, code, message, retryAfter = null) {
+  constructor(status, code, message, retryAfter = null, triesLeft = null) {
     super(message);
     this.name = 'ApiError';
     this.status = status;
     this.code = code;
     this.retryAfter = retryAfter;
+    this.triesLeft = triesLeft;
   }
 }
 
@@ -84,18 +86,20 @@ export class ApiError extends Error {
 async function errorFrom(response) {
   let code = 'error';
   let message = `${response.status} ${response.statusText}`.trim();
+  let triesLeft = null;
   try {
     /** @type {Schemas['Error']} */
     const body = await response.json();
     if (body && body.error) {
       code = body.error.code || code;
       message = body.error.message || message;
+      triesLeft = body.error.tries_left ?? null;
     }
   } catch {
     // not JSON: keep the status line
   }
   const retry = response.headers.get('Retry-After');
-  return new ApiError(response.status, code, message, retry ? Number(retry) : null);
+  return new ApiError(response.status, code, message, retry ? Number(retry) : null, triesLeft);
 }
 
 // Called with every 401 from a staff call (the session ended): main.js sends the

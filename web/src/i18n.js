@@ -22,6 +22,12 @@ const WORDS = {
     unit: 'Unit',
     language: 'Language',
     groups: { automatic: 'Body measurements', user: 'Taken by the shop' },
+    notOpen: 'This link does not open a scan',
+    expired: 'It may have expired or been withdrawn. Ask the shop for a new link.',
+    withdrawn: 'It was withdrawn after too many wrong PINs, or has expired. Ask the shop for a new link.',
+    askPin: 'Enter the six-digit PIN the shop gave you.',
+    open: 'Open',
+    wrongPin: (left) => `Wrong PIN: ${left} ${left === 1 ? 'try' : 'tries'} left before the link is withdrawn.`,
   },
   de: {
     title: 'Ihr Körperscan',
@@ -39,6 +45,12 @@ const WORDS = {
     unit: 'Einheit',
     language: 'Sprache',
     groups: { automatic: 'Körpermaße', user: 'Vom Geschäft gemessen' },
+    notOpen: 'Dieser Link öffnet keinen Scan',
+    expired: 'Er ist vielleicht abgelaufen oder zurückgezogen. Bitten Sie das Geschäft um einen neuen Link.',
+    withdrawn: 'Er wurde nach zu vielen falschen PINs zurückgezogen oder ist abgelaufen. Bitten Sie das Geschäft um einen neuen Link.',
+    askPin: 'Geben Sie die sechsstellige PIN ein, die Sie im Geschäft bekommen haben.',
+    open: 'Öffnen',
+    wrongPin: (left) => `Falsche PIN: noch ${left} ${left === 1 ? 'Versuch' : 'Versuche'}, dann wird der Link zurückgezogen.`,
   },
 };
 

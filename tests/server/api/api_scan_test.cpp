@@ -441,6 +441,7 @@ TEST(ApiScan, AShareLinkWithAPinOpensOnlyWithIt) {
   const HttpReply bad = http(s.port, "GET", page, {{"X-Share-PIN", wrong}});
   EXPECT_EQ(bad.status, 401);
   EXPECT_NE(bad.body.find("4 tries left"), std::string::npos) << bad.body;
+  EXPECT_EQ(parse(bad)["error"]["tries_left"], 4) << "as a number, for the page to say in its language";
   EXPECT_EQ(http(s.port, "GET", page, {{"X-Share-PIN", pin}}).status, 200);
   EXPECT_EQ(http(s.port, "GET", page + "/mesh.glb", {{"X-Share-PIN", pin}}).body.substr(0, 4), "glTF");
   for (int i = 0; i < 3; ++i) EXPECT_EQ(http(s.port, "GET", page, {{"X-Share-PIN", wrong}}).status, 401);

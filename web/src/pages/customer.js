@@ -17,12 +17,15 @@ export async function mount(container, { token }) {
   let share;
   /** @type {string | undefined} */
   let pin;
+  // Before the link opens, the shop's language is not known: this browser's choice,
+  // else its own language.
+  const early = customerWords(customerLocale(chosenLocale() || navigator.language));
   try {
     share = await api.getShare(token);
   } catch (e) {
     if (e.status === 401) {
       // The link asks for its PIN: the page asks, and opens once it is right.
-      pin = await askPin(container, token);
+      pin = await askPin(container, token, early);
       if (pin === undefined) return;
       share = await api.getShare(token, pin);
     } else {
@@ -30,8 +33,8 @@ export async function mount(container, { token }) {
         h(
           'section',
           { class: 'page narrow customer-page' },
-          h('h1', {}, 'This link does not open a scan'),
-          h('p', {}, e.status === 404 ? 'It may have expired or been withdrawn. Ask the shop for a new link.' : errorText(e)),
+          h('h1', {}, early.notOpen),
+          h('p', {}, e.status === 404 ? early.expired : errorText(e)),
         ),
       );
       return;
@@ -182,17 +185,18 @@ function render(container, { token, pin, share, locale, t0, unit }, onLocale, on
 /**
  * @param {HTMLElement} container
  * @param {string} token
+ * @param {ReturnType<typeof customerWords>} words
  * @returns {Promise<string | undefined>}
  */
-function askPin(container, token) {
+function askPin(container, token, words) {
   return new Promise((resolve) => {
     const input = h('input', { name: 'pin', inputmode: 'numeric', autocomplete: 'one-time-code', maxlength: 6, pattern: '[0-9]{6}', required: true, 'aria-label': 'PIN', class: 'pin-input' });
     const message = h('p', { class: 'form-error', role: 'alert' });
     const section = h(
       'section',
       { class: 'page narrow customer-page pin-page' },
-      h('h1', {}, 'Your body scan'),
-      h('p', {}, 'Enter the six-digit PIN the shop gave you.'),
+      h('h1', {}, words.title),
+      h('p', {}, words.askPin),
       h(
         'form',
         {
@@ -204,16 +208,16 @@ function askPin(container, token) {
               resolve(input.value.trim());
             } catch (err) {
               if (err.status === 401) {
-                message.textContent = errorText(err);
+                message.textContent = err.triesLeft === null ? errorText(err) : words.wrongPin(err.triesLeft);
                 input.select();
                 return;
               }
-              clear(section, h('h1', {}, 'This link does not open a scan'), h('p', {}, err.status === 404 ? 'It was withdrawn after too many wrong PINs, or has expired. Ask the shop for a new link.' : errorText(err)));
+              clear(section, h('h1', {}, words.notOpen), h('p', {}, err.status === 404 ? words.withdrawn : errorText(err)));
               resolve(undefined);
             }
           },
         },
-        h('div', { class: 'row' }, input, h('button', { class: 'primary', type: 'submit' }, 'Open')),
+        h('div', { class: 'row' }, input, h('button', { class: 'primary', type: 'submit' }, words.open)),
         message,
       ),
     );

@@ -14,7 +14,7 @@ import { validateBytes } from 'gltf-validator';
 import jsQR from 'jsqr';
 import { PNG } from 'pngjs';
 import { OBJLoader } from 'three/examples/jsm/loaders/OBJLoader.js';
-import { ADMIN_PASSWORD, ARTEFACTS, closeSuite, coverage, demoBodyBounds, demoBodyMeasurement, login, logout, newPage, openSuite, shot } from './harness.mjs';
+import { accessibilityProblems, ADMIN_PASSWORD, ARTEFACTS, closeSuite, coverage, demoBodyBounds, demoBodyMeasurement, login, logout, newPage, openSuite, shot } from './harness.mjs';
 
 const SCAN_TIMEOUT = 420_000;
 const OPERATOR = ['olivia', 'operator pass 1'];
@@ -74,7 +74,12 @@ async function runScanFromStation(label, who) {
         .catch(() => null);
       if (src) {
         state[`${label}Preview`] = src;
+        await page
+          .locator('#job')
+          .scrollIntoViewIfNeeded({ timeout: 1000 })
+          .catch(() => null);
         await shot(page, `${label}-station-scanning`);
+        assert.deepEqual(await accessibilityProblems(page), [], 'axe-core on the station mid-scan');
       }
     }
     const failed = page.locator('#job .job-state[data-state=failed], #job .job-state[data-state=cancelled]');
@@ -161,6 +166,7 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     // The posture to ask for, as a picture.
     assert.match(await page.locator('.wanted-posture svg').getAttribute('aria-label'), /Stand like this/);
     await shot(page, 'station');
+    assert.deepEqual(await accessibilityProblems(page), [], 'axe-core on the station');
     const run = await runScanFromStation('first', 'Ada Lovelace');
     console.log(`first scan (with calibration) through the UI: ${run.seconds.toFixed(0)} s, stages ${[...run.stages].join(', ')}`);
     assert.ok(run.stages.has('scan'), `stages seen: ${[...run.stages]}`);
@@ -470,6 +476,7 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     const overflow = await customer.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
     assert.ok(overflow <= 0, `the page is ${overflow} px wider than the phone`);
     await shot(customer, 'customer-phone');
+    assert.deepEqual(await accessibilityProblems(customer), [], "axe-core on the customer's page");
     // Their sheet to take home: their name, the shared measurements under plain
     // names, and the link as a QR code an independent reader decodes.
     const [sheet] = await Promise.all([customer.waitForEvent('download'), customer.click('button:has-text("Your sheet (PDF)")')]);
@@ -495,6 +502,7 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     for (const want of ['Ihre Körpermaße', 'Gescannt am', 'Taillenumfang', 'Ihr 3-D-Modell'])
       assert.ok(germanText.includes(want), `${want} on the German sheet:\n${germanText}`);
     await shot(customer, 'customer-phone-de');
+    assert.deepEqual(await accessibilityProblems(customer), [], "axe-core on the customer's page in German");
     await customer.selectOption('select.language', 'en');
     await customer.locator('h1:has-text("Your body scan")').waitFor();
     // Nothing else: no staff API, no other scan's model, no staff page.
