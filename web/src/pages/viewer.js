@@ -6,7 +6,7 @@ import { unitSelect } from '../ui/unit-select.js';
 import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 import { BodyView, ModelDecoding } from '../viewer/body-view.js';
 import { MeasureTool, TOOLS } from '../viewer/measure-tool.js';
-import { COLOURS, drawMeasurement, KIND_LABEL, measurementTable, slug } from '../viewer/measurement-table.js';
+import { arcEndsMoved, COLOURS, drawMeasurement, KIND_LABEL, measurementTable, sideShowing, slug } from '../viewer/measurement-table.js';
 import { postureCard } from '../viewer/posture.js';
 import { avatarDialog } from './avatar-dialog.js';
 import { shareDialog } from './share-dialog.js';
@@ -104,6 +104,7 @@ export async function mount(container, { id }, ctx) {
     }
     return group;
   };
+  const viewGroup = segmented('View', [['front', 'Front'], ['left', 'Side'], ['back', 'Back']], 'front', (v) => view.setView(v));
   let pointsLoaded = false;
   toolbar.append(
     segmented('Show', [['mesh', 'Surface'], ['points', 'Points']], 'mesh', async (mode) => {
@@ -118,7 +119,7 @@ export async function mount(container, { id }, ctx) {
       view.setMode(mode);
       if (mode === 'points' && tool.mode !== 'rotate') hint.textContent = 'Measuring works on the surface; switch back to it.';
     }),
-    segmented('View', [['front', 'Front'], ['left', 'Side'], ['back', 'Back']], 'front', (v) => view.setView(v)),
+    viewGroup,
     segmented('Tool', Object.entries(TOOLS).map(([k, t]) => [k, t.label]), 'rotate', (m) => tool.setMode(m)),
     unitSelect(state.unit, (u) => {
       state.unit = u;
@@ -188,7 +189,15 @@ export async function mount(container, { id }, ctx) {
   function select(m) {
     state.selected = state.selected === m.name ? null : m.name;
     view.clearOverlays('sel');
-    if (state.selected) drawMeasurement(view, 'sel', m, COLOURS.selected);
+    if (state.selected) {
+      drawMeasurement(view, 'sel', m, COLOURS.selected);
+      // One on the back or a side is turned to.
+      const showing = sideShowing(m, view.modelBounds());
+      if (showing && !view.facing(showing)) {
+        view.setView(showing);
+        for (const b of viewGroup.children) b.setAttribute('aria-checked', /** @type {HTMLElement} */ (b).dataset.value === showing ? 'true' : 'false');
+      }
+    }
     for (const row of tableBox.querySelectorAll('tr[data-name]')) {
       const on = row.dataset.name === state.selected;
       row.classList.toggle('selected', on);
@@ -239,6 +248,7 @@ export async function mount(container, { id }, ctx) {
       resultBox,
       h('p', { class: 'result-value', dataset: { valueMm: String(r.value_mm) } }, h('strong', {}, formatLength(r.value_mm, state.unit)), ` ${KIND_LABEL[r.kind] || r.kind}`),
       r.crosses_filled_hole ? h('p', { class: 'badge warn' }, 'crosses skin the cameras did not see') : null,
+      arcNote(r),
       canSave
         ? h(
             'form',
@@ -256,6 +266,19 @@ export async function mount(container, { id }, ctx) {
         : h('div', { class: 'row' }, h('button', { type: 'button', onclick: discard }, 'Close')),
     );
     if (canSave) name.focus({ preventScroll: true });
+  }
+
+  // An arc whose ends the tape moved says so: by how much, and why it can be
+  // shorter than the straight distance between the same taps.
+  function arcNote(r) {
+    const moved = arcEndsMoved(r);
+    if (!moved) return null;
+    const [a, b] = moved.moved.map((mm) => formatLength(mm, state.unit));
+    return h(
+      'p',
+      { class: 'note arc-ends' },
+      `The ends moved ${a} and ${b} onto the tape (a tape bridges hollows; the small dots are where you tapped), so the arc can be shorter than the straight distance.`,
+    );
   }
 
   function discard() {

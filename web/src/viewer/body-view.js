@@ -273,6 +273,17 @@ export class BodyView {
   setView(view) {
     const box = this.mesh ? this.mesh.geometry.boundingBox : this.points?.geometry.boundingBox;
     this.frame(box, view);
+    this.container.dataset.view = view;
+  }
+
+  // Whether the camera looks at the body from within 60° of `view`'s side
+  // (front, back, left, right), seen from above.
+  facing(view) {
+    const want = VIEWS[view];
+    if (!want) return true;
+    const from = this.camera.position.clone().sub(this.controls.target).setY(0);
+    if (from.lengthSq() === 0) return true;
+    return from.normalize().dot(want) >= 0.5;
   }
 
   copyCamera(other) {

@@ -42,10 +42,71 @@ export function drawMeasurement(view, key, m, colour = COLOURS.selected) {
     return;
   }
   if (g.path && g.path.length >= 2) view.showPath(`${key}:path`, g.path, { closed: !!g.closed, color: colour, width: 3.5 });
-  if (g.from && g.to && g.kind !== 'height') {
+  const moved = arcEndsMoved(g);
+  if (moved) {
+    // The arc's ends where the tape put them, each with a thin leader back to
+    // the point tapped, so that a shorter arc than the straight distance shows why.
+    view.showMarker(`${key}:from`, moved.from, { color: colour, radius: 6 });
+    view.showMarker(`${key}:to`, moved.to, { color: colour, radius: 6 });
+    view.showMarker(`${key}:tapped-from`, g.from, { color: colour, radius: 3 });
+    view.showMarker(`${key}:tapped-to`, g.to, { color: colour, radius: 3 });
+    view.showPath(`${key}:moved-from`, [g.from, moved.from], { color: colour, width: 1 });
+    view.showPath(`${key}:moved-to`, [g.to, moved.to], { color: colour, width: 1 });
+  } else if (g.from && g.to && g.kind !== 'height') {
     view.showMarker(`${key}:from`, g.from, { color: colour, radius: 6 });
     view.showMarker(`${key}:to`, g.to, { color: colour, radius: 6 });
   }
+}
+
+// The side of the body a measurement lies on, as the view that shows it: 'back'
+// for a length down the back, 'left' for the left arm; null for one that goes
+// round the body (a girth) or stands beside it (a height), which any view shows.
+// The body faces +Z (the scan frame); `box` is its bounding box.
+/**
+ * @param {{ kind?: string, geometry?: any, path?: number[][], from?: number[], to?: number[] }} m
+ * @param {{ min: { x: number, z: number }, max: { x: number, z: number } } | null} box
+ * @returns {'front' | 'back' | 'left' | 'right' | null}
+ */
+export function sideShowing(m, box) {
+  const g = m.geometry || m;
+  if (!box || (g.kind || m.kind) === 'height' || g.closed) return null;
+  const points = g.path && g.path.length ? g.path : [g.from, g.to].filter(Boolean);
+  if (!points.length) return null;
+  const cx = (box.min.x + box.max.x) / 2;
+  const cz = (box.min.z + box.max.z) / 2;
+  // Offsets from the body's axis as fractions of its half-width and half-depth,
+  // so that a point on the back and one at the shoulder's tip weigh alike.
+  const hx = Math.max(1, (box.max.x - box.min.x) / 2);
+  const hz = Math.max(1, (box.max.z - box.min.z) / 2);
+  let dx = 0;
+  let dz = 0;
+  for (const p of points) {
+    dx += (p[0] - cx) / hx;
+    dz += (p[2] - cz) / hz;
+  }
+  dx /= points.length;
+  dz /= points.length;
+  // Near the axis: round the body, or across its middle; any view shows it.
+  if (Math.hypot(dx, dz) < 0.25) return null;
+  if (Math.abs(dz) >= Math.abs(dx)) return dz > 0 ? 'front' : 'back';
+  return dx > 0 ? 'left' : 'right';
+}
+
+// An arc's ends as the server placed them on the tape: how far each moved from
+// the point tapped (a tape bridges hollows, so a tap in one lands on the tape's
+// hull). Null for anything else, or ends that stayed within `within` mm.
+/**
+ * @param {any} result
+ * @param {number} [within]
+ * @returns {{ from: number[], to: number[], moved: [number, number] } | null}
+ */
+export function arcEndsMoved(result, within = 2) {
+  const g = result?.geometry || result;
+  if (!g || g.kind !== 'arc' || !g.from || !g.to || !g.path || g.path.length < 2) return null;
+  const ends = [g.path[0], g.path[g.path.length - 1]];
+  const moved = /** @type {[number, number]} */ ([Math.hypot(...ends[0].map((v, i) => v - g.from[i])), Math.hypot(...ends[1].map((v, i) => v - g.to[i]))]);
+  if (Math.max(...moved) <= within) return null;
+  return { from: ends[0], to: ends[1], moved };
 }
 
 // A row's own value is missing where only the compared scan has the measurement.

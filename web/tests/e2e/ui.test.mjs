@@ -209,6 +209,15 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await page.waitForTimeout(300);
     assert.equal(await page.locator('tr[data-name=hip_girth]').getAttribute('aria-selected'), 'true');
     assert.notEqual(await coverage(page, '#viewport canvas'), unselected);
+    // One down the back turns the view to the back, and the View buttons say so;
+    // one round the body leaves the view as it is.
+    await page.click('table.measurements tr[data-name=back_neck_to_waist]');
+    await page.waitForFunction(() => document.querySelector('#viewport')?.getAttribute('data-view') === 'back');
+    assert.equal(await page.locator('.segmented[aria-label=View] button[aria-checked=true]').innerText(), 'Back');
+    await page.click('table.measurements tr[data-name=waist_girth]');
+    assert.equal(await page.locator('#viewport').getAttribute('data-view'), 'back');
+    await page.click('.segmented[aria-label=View] button[data-value=front]');
+    await page.click('table.measurements tr[data-name=waist_girth]');
   });
 
   it('measures a girth line drawn across the body: the server evaluates the plane the screen shows', async () => {
