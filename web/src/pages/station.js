@@ -11,6 +11,8 @@ import { api, enc } from '../api.js';
 import { overallFraction, stageText, timeLeftText } from '../progress.js';
 import { ago, clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 import { postureCheckCard, wantedPostureCard } from '../viewer/posture.js';
+import { preferredUnit } from '../units.js';
+import { shareDialog } from './share-dialog.js';
 
 /** @typedef {import('../api.js').Job} Job */
 /** @typedef {import('../api.js').RigStatus} RigStatus */
@@ -479,6 +481,16 @@ export async function mount(container, _params, ctx) {
     img.src = `data:image/png;base64,${p.png_base64}`;
   }
 
+  /** @param {string} scanId */
+  async function shareFromStation(scanId) {
+    try {
+      const { measurements } = await api.getMeasurements(scanId);
+      await shareDialog(scanId, measurements, preferredUnit());
+    } catch (e) {
+      toast(`No link made: ${errorText(e)}`, 'error');
+    }
+  }
+
   async function renderRecent() {
     try {
       const [{ scans }, { customers }] = await Promise.all([api.findScans({ limit: 6 }), api.findCustomers()]);
@@ -487,7 +499,22 @@ export async function mount(container, _params, ctx) {
         recentBox,
         h('h2', {}, 'Latest scans'),
         scans.length
-          ? h('ul', { class: 'plain' }, scans.map((s) => h('li', {}, h('a', { href: `/scans/${enc(s.id)}` }, names.get(s.customer_id) || s.customer_id), ` · ${when(s.started_at)} · ${s.status}`)))
+          ? h(
+              'ul',
+              { class: 'plain recent-scans' },
+              scans.map((s) =>
+                h(
+                  'li',
+                  { dataset: { scan: s.id } },
+                  h('a', { href: `/scans/${enc(s.id)}` }, names.get(s.customer_id) || s.customer_id),
+                  ` · ${when(s.started_at)} · ${s.status} `,
+                  // The link and its QR code handed over here, while the customer is still at the rig.
+                  s.status === 'complete' && ctx.can.share(ctx.session.role)
+                    ? h('button', { type: 'button', class: 'share-scan', onclick: () => shareFromStation(s.id) }, 'Share…')
+                    : null,
+                ),
+              ),
+            )
           : h('p', { class: 'muted' }, 'None yet.'),
       );
     } catch (e) {

@@ -555,6 +555,19 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
   it('scans the returning customer and compares the two scans side by side', async () => {
     await logout(page);
     await login(page, server.url, ...OPERATOR);
+    // The station hands a link over too: its latest scans each offer one, with the QR code.
+    await page.click(`.recent-scans li[data-scan="${state.scanA}"] button.share-scan`);
+    const fromStation = page.locator('dialog[open]');
+    await fromStation.locator('input[value=waist_girth]').check();
+    await fromStation.locator('button:has-text("Make link")').click();
+    const stationLink = await fromStation.locator('input.share-url').inputValue();
+    const stationQr = await fromStation.locator('canvas.share-qr').evaluate((c) => {
+      const canvas = /** @type {HTMLCanvasElement} */ (c);
+      const pixels = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height);
+      return { width: canvas.width, height: canvas.height, data: Array.from(pixels.data) };
+    });
+    assert.equal(jsQR(Uint8ClampedArray.from(stationQr.data), stationQr.width, stationQr.height)?.data, stationLink);
+    await fromStation.locator('button:has-text("Close")').click();
     await page.click('.segmented button:has-text("Returning customer")');
     await page.fill('input[type=search]', 'Lovelace');
     await page.locator('.pick-list[data-query="Lovelace"] button:has-text("Ada Lovelace")').click();
