@@ -44,8 +44,8 @@ struct HoleFillOptions {
   // rig's feet, 70 mm up - and 1000 takes those loops whole (the fill then takes
   // 7.2 s instead of 5.3 on that scan, bench/hole_fill_benchmark). But on the
   // thesis rig the whole programme spans the unseen shoulder tops worse than the
-  // split parts do (male_muscular: 22 of 34 measurements within the ISO allowance
-  // at 400, 19 at 1000; docs/benchmarks.md §7), so the default stays at 400.
+  // split parts do (fewer measurements within the ISO allowance at 1000;
+  // docs/benchmarks.md §7, "Hole filling"), so the default stays at 400.
   size_t max_dp_edges = 400;
   bool refine = true;
   HoleFairing fairing = HoleFairing::kMembrane;

@@ -71,9 +71,9 @@ struct SwayOptions {
   // sweeps, and fits the path to them; they stop once no knot moved more than
   // converged_mm. The first pairing is at no sway, and the path comes up to the
   // sway over several; the arms' moments, seen at the sweeps' ends by few pairs,
-  // come last (tiered rig, male_heavy swaying 3 mm: the third re-pairing still
-  // moved a knot 0.59 mm, and the arms' path was 0.64 mm RMS off sideways; settled
-  // after 9, 0.49; no closer after 16).
+  // come last, so a swaying body needs several more re-pairings than a still one
+  // before the path settles (the counts: docs/scan-processing.md, "The subject's
+  // sway").
   int iterations = 12;
   double converged_mm = 0.05;
   double smoothness = 0.01;    // weight of the path's second differences, relative to the data

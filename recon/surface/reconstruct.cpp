@@ -208,8 +208,9 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input, const R
     // operator fitted again to the carried normals. Only there: refitted
     // everywhere, it bends unevenly sampled limbs too far (wrists 0.9 mm small).
     // The edge is where the point lies more than edge_refit_offset density sigmas
-    // from its neighbourhood's mean across the surface (4 % of female_average's
-    // points at 0.6; inside a patch the offset is a fraction of that).
+    // from its neighbourhood's mean across the surface: a few per cent of a body
+    // scan's points at the default, since inside a patch the offset is a fraction
+    // of that (docs/reconstruction.md item 4).
     if (options.edge_refit_offset > 0.f && frames.offset.size() == pts.size()) {
       const std::vector<ShapeOperator> carried = estimate_shape_operators(pts, index, graph, frames, {.k = 20});
       for (size_t i = 0; i < pts.size(); ++i) {

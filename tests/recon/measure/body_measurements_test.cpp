@@ -359,9 +359,9 @@ TEST(BodyMeasurements, KneeHeightsReadTheLevelKneesMean) {
 TEST(BodyMeasurements, TheWristIsAboveThePalmWhenAScanFusesTheFingers) {
   // An arm's horizontal cuts, armpit downwards, every 3 mm (tapes in mm): the upper
   // arm, the forearm narrowing to the wrist at cut 60, the palm widening to 306 mm by
-  // cut 67. Shaped on a thesis-rig scan of female_heavy whose fingers the surface
-  // fused, so the track ran on into them (to 244 mm) and the wrist was taken there:
-  // wrist girth 105 mm instead of 157, outer arm length 571 mm instead of 438.
+  // cut 67. Shaped as a scan whose surface fused the fingers: the track runs on
+  // into them, and the wrist must not be taken there, which would shrink the wrist
+  // girth and lengthen the outer arm by the hand's length.
   std::vector<double> g;
   for (int i = 0; i < 30; ++i) g.push_back(350);
   for (int i = 30; i <= 60; ++i) g.push_back(350 - 80.0 * (i - 30) / 30);  // 270 at the wrist
@@ -378,8 +378,8 @@ TEST(BodyMeasurements, TheWristIsAboveThePalmWhenAScanFusesTheFingers) {
   wobbly[50] += 6;
   wobbly[58] = 266;
   EXPECT_EQ(wrist_cut(wobbly, 10), 58u);
-  // A heavy forearm narrows twice, 27 mm apart (female_heavy's, under smooth skin
-  // noise): a bump of 4-5 mm between, the second narrow within 2 mm of the first.
+  // A heavy forearm under smooth skin noise can narrow twice, 27 mm apart: a bump
+  // of 4-5 mm between, the second narrow within 2 mm of the first.
   // Whichever of the two is narrower, the wrist is the second, nearer the hand.
   for (double first : {259.0, 261.0, 262.0}) {
     std::vector<double> twice;
@@ -457,10 +457,10 @@ TEST(BodyMeasurements, TheNeckLevelFollowsATaperSmoothly) {
 
 TEST(BodyMeasurements, AShallowUnderBustFoldStaysPutUnderTheScansNoise) {
   // A man's fold under the chest lies 1 mm behind its chord and is flat at the
-  // bottom: its deepest sample moved 10 mm between two scans of male_average (12.6 mm
-  // of under-bust girth), and 6-11 mm under +-0.5 mm of skin noise (girth 6-13 mm).
-  // Refined to the vertex of a parabola it stays within 3 mm; the girth within 4 mm
-  // (the noise itself widens the tape by 1-2 mm).
+  // bottom, so its deepest sample wanders by several mm with a scan's noise and the
+  // under-bust girth with it. Refined to the vertex of a parabola it stays within
+  // 3 mm under +-0.5 mm of skin noise; the girth within 4 mm (the noise itself widens
+  // the tape by 1-2 mm).
   under_skin_noise({1u, 2u, 3u}, [](const BodyMeasurements& b, const BodyMeasurements& clean, uint32_t seed) {
     EXPECT_NEAR(b.landmark("underbust_front_point")->position.y(),
                 clean.landmark("underbust_front_point")->position.y(), 3.0)
@@ -470,11 +470,11 @@ TEST(BodyMeasurements, AShallowUnderBustFoldStaysPutUnderTheScansNoise) {
 }
 
 TEST(BodyMeasurements, TheHipLevelStaysPutUnderTheScansNoise) {
-  // The hip level is the buttocks' backmost cut, and the back is flat there: on the
-  // heavy bodies the band within 0.5 mm of the backmost is 30-40 mm tall, and its
-  // middle put the hip 6.8 and 9.2 mm off on tiered-rig scans of female_heavy and
-  // male_heavy. The vertex of a parabola over 2 % of the height either side stays
-  // within 1.5 mm of the clean body's under +-0.5 mm of skin noise, three seeds.
+  // The hip level is the buttocks' backmost cut, and the back is flat there: on a
+  // heavy body the band within 0.5 mm of the backmost is 30-40 mm tall, and its
+  // middle wanders across it with a scan's noise. The vertex of a parabola over 2 %
+  // of the height either side stays within 1.5 mm of the clean body's under
+  // +-0.5 mm of skin noise, three seeds.
   under_skin_noise({1u, 2u, 3u}, [](const BodyMeasurements& b, const BodyMeasurements& clean, uint32_t seed) {
     EXPECT_NEAR(b.find("hip_height")->value_mm, clean.find("hip_height")->value_mm, 1.5) << "seed " << seed;
   });
@@ -482,10 +482,10 @@ TEST(BodyMeasurements, TheHipLevelStaysPutUnderTheScansNoise) {
 
 TEST(BodyMeasurements, TheBustLevelStaysPutUnderTheScansNoise) {
   // The bust is the chest's most forward cut, and the front is flat over the
-  // breast's apex: the middle of the band within 0.5 mm of the foremost sat 3.5 mm
-  // low on a tiered-rig scan of female_average, where the tape grows 3 mm per mm
-  // (bust girth -8.6 mm). The vertex of a parabola over 1 % of the height either
-  // side stays within 1 mm of the clean body's under +-0.5 mm of skin noise.
+  // breast's apex, and there the tape grows about 3 mm per mm of height: the middle
+  // of the band within 0.5 mm of the foremost wanders with a scan's noise. The
+  // vertex of a parabola over 1 % of the height either side stays within 1 mm of
+  // the clean body's under +-0.5 mm of skin noise.
   const ShippedBody* body = shipped_body("female_average.ply");
   ASSERT_TRUE(body);
   const TriangleMesh* mesh = &body->mesh;
@@ -600,13 +600,12 @@ TEST(BodyMeasurements, TheSettledVertexMovesWithTheProfileNotWithItsSamples) {
 TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNoise) {
   // A scan's surface errs in gentle swells (tests/support/skin_noise.hpp): here two
   // fields, at 40 and 10 mm, each 0.25 mm RMS, eight seeds. The elbow's outer point
-  // was the middle of the flattest stretch of the cut's outer side, and slid round
-  // the arm: up to 5.9 mm on male_average, taking the outer arm length up to 4.7 mm
-  // with it. It is now where the ray from the cut's centre straight out leaves it.
-  // The waist was the middle of the run of 2 mm cuts within 2 mm of the narrowest,
-  // and moved up to 3.4 mm on female_average (back neck to waist 2.7); it is now the
-  // centroid of the girth profile's dip. The elbow's centre was the cut where the
-  // arm's axis bends; it is now where the axes of upper arm and forearm meet.
+  // is where the ray from the cut's centre straight out leaves the cut: the middle
+  // of the flattest stretch of its outer side would slide round the arm, and the
+  // outer arm length with it. The waist is the centroid of the girth profile's dip,
+  // not the middle of the run of cuts near the narrowest, which moves with the noise.
+  // The elbow's centre is where the axes of upper arm and forearm meet, not the cut
+  // where the arm's axis bends.
   for (const std::string body : {"male_average", "female_average"}) {
     const bool male = body == "male_average";
     under_smooth_skin_noise(body, [&](const BodyMeasurements& b, const BodyMeasurements& clean, uint64_t seed) {
@@ -616,9 +615,8 @@ TEST(BodyMeasurements, TheElbowTheWaistAndTheUnderBustStayPutUnderSmoothSkinNois
       auto diff = [&](const std::string& name) {
         return std::abs(b.find(name)->value_mm - clean.find(name)->value_mm);
       };
-      // female_average's elbow bends gently, and where along the arm it bends moved
-      // up to 4.5 mm under this noise while the elbow's centre was the bend's cut
-      // (3 mm apart); where the axes of upper arm and forearm meet, 2.1 at most.
+      // A woman's elbow bends gently, so where along the arm it bends is loosely
+      // held; where the axes of upper arm and forearm meet is held within 2.5 mm.
       for (const char* side : {"left", "right"}) {
         const std::string elbow = std::string("elbow_point_") + side;
         EXPECT_LT(moved(elbow), male ? 1.5 : 2.5) << body << " " << elbow << ", seed " << seed;
@@ -736,11 +734,11 @@ TEST(BodyMeasurements, DespikedDropsShortBumpsAndKeepsASmoothProfile) {
 
 TEST(BodyMeasurements, AShortBumpOnTheChestIsNotTheBust) {
   // A stray stripe's skin 1-3 mm proud and one or two 2 mm samples tall, on a heavy
-  // man's front flat within 0.5 mm over 40 mm, was the chest's foremost point: the
-  // bust's level moved 34 mm between two replays of one tiered scan of male_heavy
-  // (bust girth -1.5 and -5.5 mm off the truth). male_average, its edges split twice
-  // (about 1.4 mm long), with a bump 2.5 mm proud and 3-4 mm tall 8 mm below its
-  // chest's apex, over the left bust point, farther forward than the apex itself.
+  // man's front flat within 0.5 mm over 40 mm, must not be the chest's foremost
+  // point: it would move the bust's level by tens of mm between two scans. Here:
+  // male_average, its edges split twice (about 1.4 mm long), with a bump 2.5 mm
+  // proud and 3-4 mm tall 8 mm below its chest's apex, over the left bust point,
+  // farther forward than the apex itself.
   const ShippedBody* shipped = male_average();
   ASSERT_TRUE(shipped);
   const TriangleMesh fine = split_in_four(split_in_four(shipped->mesh));
@@ -770,7 +768,7 @@ std::vector<double> every_2mm_from(double first, size_t n) {
 }
 
 TEST(BodyMeasurements, AFlatChestsLevelIsTheVertexOverItsWholeTop) {
-  // The front's foremost Z every 2 mm up a tiered scan of male_heavy, still, its
+  // The front's foremost Z every 2 mm up a heavy man's tiered scan, still, its
   // stripes reprocessed with two sway estimates a few tenths of a millimetre apart
   // (despiked). The front lies within 1.5 mm of its foremost over 70-80 mm; a
   // parabola over 17 mm either side put the bust's level at 1138 and 1118 mm (bust
@@ -911,9 +909,8 @@ TEST(BodyMeasurements, TheShouldersTheWristsTheOuterArmsAndTheHipStayPutUnderSmo
 
 TEST(BodyMeasurements, TheMidThighIsHalfwayToTheKneesMeanLevelWhereTheKneesAreLevel) {
   // Each knee's level is a shallow profile's bottom and moves 1-2.5 mm RMS with a
-  // scan's noise, the two knees independently (tiered male_average, two scans: +1.67
-  // and -1.77 mm), and the mid-thigh's tape, halfway to it, 0.6-1.1 mm per mm of
-  // height with it. Standing, the knees are level: the mean of both is the level.
+  // scan's noise, the two knees independently, and the mid-thigh's tape, halfway to
+  // it, 0.6-1.1 mm per mm of height with it. Standing, the knees are level: the mean of both is the level.
   const ShippedBody* shipped = shipped_body("male_average.ply");
   ASSERT_TRUE(shipped);
   auto level = [](const BodyMeasurements& b, const std::string& side) {
@@ -960,10 +957,10 @@ TEST(BodyMeasurements, TheMidThighIsHalfwayToTheKneesMeanLevelWhereTheKneesAreLe
 TEST(BodyMeasurements, TheThighsTapeIsWhereTheCrotchDoesNotPullIt) {
   // Right under the crotch a thigh's tape grows 1.5-2 mm per mm of height, and a
   // scan closes the gap between thighs that nearly touch a few mm early (the
-  // surface rounds the concave corner): taken 0.5 % of the height below the crotch,
-  // female_average's thighs came out -9.6/-9.2 mm on a tiered-rig scan, where the
-  // tape grows 1.6 mm per mm of height (male_average 0.6). An inch below it (1.5 %
-  // of the height) it grows 1.1 mm per mm (0.4).
+  // surface rounds the concave corner): 0.5 % of the height below the crotch a
+  // woman's thigh tape grows about 1.6 mm per mm of height, so that early close
+  // takes several mm off it. An inch below it (1.5 % of the height) it grows
+  // 1.1 mm per mm, a man's less.
   for (const char* body : {"female_average", "male_average"}) {
     const ShippedBody* shipped = shipped_body(std::string(body) + ".ply");
     ASSERT_TRUE(shipped) << body;
@@ -1004,7 +1001,7 @@ TriangleMesh with_crotch_wall(const ShippedBody& body, double half_length, doubl
 
 TEST(BodyMeasurements, ANarrowSaddleUnderTheCrotchIsNoCrotch) {
   // A scan rounds the corner where measured thighs meet, closing their gap a few mm
-  // below the crotch (female_average, tiered rig: 5.4 mm) in a saddle 5-30 mm long
+  // below the crotch in a saddle 5-30 mm long
   // front to back; a true crotch's floor is 15-70 mm long where the legs first meet.
   // Here measured skin 16 mm long and 8 mm tall joins the true body's thighs under
   // its crotch: the crotch is still where the join is 1.5 % of the height long,
@@ -1021,7 +1018,7 @@ TEST(BodyMeasurements, ANarrowSaddleUnderTheCrotchIsNoCrotch) {
 
 TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
   // Where the thighs nearly touch no camera sees between them, and hole filling
-  // bridges the gap below the real crotch (male_heavy, tiered rig: 21 mm below it).
+  // bridges the gap below the real crotch, tens of mm below it on a heavy body.
   // Here a thin wall 25 mm tall stands between the thighs of the true body, its top
   // 5 mm above the crotch, inside the trunk. Marked measured, it is taken for the
   // crotch (the legs join at its foot); marked invented by hole filling, as a scan's
@@ -1043,8 +1040,7 @@ TEST(BodyMeasurements, AFilledBridgeBetweenTheThighsIsNoCrotch) {
 TEST(BodyMeasurements, AMeasuredIslandOnTheBridgeIsNoCrotchAndAStretchOfSkinIs) {
   // Where a scan's bridge meets the skin, the midline's crossing runs in and out of
   // the filled patch: islands of measured surface 0.5-1.25 mm tall lie below the
-  // skin, up to 5 mm below it (male_heavy, tiered rig: at 817.5 and 821 mm, the skin
-  // from 822.6). Here the filled wall of AFilledBridgeBetweenTheThighsIsNoCrotch, in
+  // skin, up to 5 mm below it. Here the filled wall of AFilledBridgeBetweenTheThighsIsNoCrotch, in
   // rows 0.25 mm apart, is measured only in rows `from` to `to` mm above its foot.
   // An island of three rows (the interpolated confidence at least 0.5 over 0.75
   // mm, 2.6-3.4 mm above the foot) is no crotch: it stays where the skin joins, 25
@@ -1083,7 +1079,7 @@ TriangleMesh with_invented_above(TriangleMesh mesh, const std::vector<Eigen::Vec
 
 TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
   // No camera sees the top of the armpit, and hole filling can join arm and flank
-  // below it (male_average, tiered rig: 9 mm below the truth's junction). Here the
+  // below it, several mm below the truth's junction. Here the
   // true body's skin round both junctions is marked invented for 6 mm above them:
   // the armpits rise to where it is measured again, and the chest, cut just under
   // the armpits, stays below both arms' own loops. Marked for 30 mm (beyond 1 %
@@ -1109,8 +1105,7 @@ TEST(BodyMeasurements, AnArmpitsFilledTopIsLookedAboveWithinReach) {
 
 TEST(BodyMeasurements, OneArmpitReadHigherMovesTheChestHalfAsFar) {
   // Each armpit's vault is read where a scan's measured skin begins, a few mm off
-  // on either side, independently (male_heavy, tiered rig: the left 1.9 mm apart
-  // between two scans, the right 0.7). The chest is cut under the two vaults' mean
+  // on either side, independently between two scans. The chest is cut under the two vaults' mean
   // level, so one side's error moves it half as far, and still under both arms'
   // own loops. Here one armpit's skin is marked invented for 6 mm above its
   // junction: that armpit rises about 5.5 mm, the chest half that.
@@ -1169,7 +1164,7 @@ TEST(BodyMeasurements, AThighsTapeThroughAFilledBridgeGoesRoundItsMeasuredSkin) 
 TEST(BodyMeasurements, ALegCutInPiecesIsNoLevelToMeasureAt) {
   // A scan can leave a slit behind the ankle that cuts the heel off in the
   // horizontal cuts there; the piece nearer the midline was taken for the leg, and
-  // the minimum leg girth came out 33 mm small (male_muscular, left). A loop beside
+  // the minimum leg girth came out tens of mm small. A loop beside
   // the ankle, inside it, stands for that piece.
   const ShippedBody* body = male_average();
   ASSERT_TRUE(body);

@@ -195,9 +195,9 @@ TEST(HeavyBodyPosture, ElbowsAndShouldersKeepToTheirSkin) {
 // shoulder point keeps to its skin whatever the other does. The arm against the
 // body cannot be followed; its slope is read from its outer side, which a heavy
 // arm's bulges tilt outward, or from the other arm mirrored, which hangs no
-// closer in than one touching the flank. male_heavy's arm at 18 degrees lies
-// against the flank; taking the other's 30 degrees put its shoulder point 19 mm
-// out along the skin, and its outer side alone (36 degrees at 15) 32 mm.
+// closer in than one touching the flank. Here male_heavy's arm at 18 degrees lies
+// against the flank while the other is at 30: taking the other's slope, or the
+// outer side's alone, would put its shoulder point tens of mm out along the skin.
 TEST(HeavyBodyPosture, AnArmAgainstTheFlankKeepsItsShoulderWhateverTheOtherDoes) {
   const Posed& rest = posed("male_heavy.ply", 0, 0);
   int one_against = 0;

@@ -109,10 +109,9 @@ TEST(MeshGirth, ACavityInsideTheBodyIsNeverTheLoop) {
 }
 
 TEST(MeshGirth, LoopsThatCrossAreOnePartAndTheTapeGoesRoundBoth) {
-  // A reconstructed surface can pass through itself: on a thesis-rig scan of
-  // male_muscular a hole's fill ran through the right ankle, whose cut 72 mm up
-  // became two overlapping loops (heel and front), and the tape went round one:
-  // 208 mm where the true ankle is 270. Two crossing ovals here: the tape goes
+  // A reconstructed surface can pass through itself: a hole's fill can run through
+  // an ankle, whose cut then becomes two overlapping loops (heel and front), and a
+  // tape round one alone falls tens of mm short. Two crossing ovals here: the tape goes
   // round both, whichever is nearer the point; a part beside them stays apart.
   const TriangleMesh heel = prism(circle(40, {0, 0}, 360), {0, 0}, 0, 200);
   const TriangleMesh front = prism(circle(40, {50, 0}, 360), {50, 0}, 0, 200);
