@@ -51,6 +51,9 @@ std::string usage() {
          kSubjectOptionsHelp +
          "  --every N          scans use every Nth laser step unless asked otherwise\n"
          "                     (default 1)\n"
+         "  --repeatability MM two scans of one customer on one day may differ by MM\n"
+         "                     before the station suggests another (default: each\n"
+         "                     value's ISO 20685-1 allowance, 4-9 mm)\n"
          "  --retention-days N erase scans that started more than N days ago, at start\n"
          "                     and hourly (logged in the audit); default: keep them\n"
          "  --operator-dot-grid\n"
@@ -100,6 +103,12 @@ int run_serve(int argc, char** argv) {
   cl.option("--rig", &wo.rig);
   add_subject_options(&cl, &wo.subject);
   cl.option("--every", integer_between(1, 1000, [&wo](long long n) { wo.default_every = static_cast<int>(n); }));
+  cl.option("--repeatability", [&wo](const std::string& v) -> std::string {
+    const auto mm = parse_double(v);
+    if (!mm || *mm <= 0 || *mm > 100) return "expects millimetres, more than 0 and at most 100, got '" + v + "'";
+    wo.repeatability_mm = *mm;
+    return "";
+  });
   cl.option("--retention-days",
             integer_between(1, 36500, [&wo](long long n) { wo.retention_days = static_cast<int>(n); }));
   cl.flag("--operator-dot-grid", &wo.operator_dot_grid);

@@ -10,6 +10,7 @@
 #include "pipeline/archive_scan.hpp"
 #include "pipeline/cad_avatar.hpp"
 #include "pipeline/evaluate_measurement.hpp"
+#include "pipeline/repeat_scans.hpp"
 #include "recon/io/atomic_file.hpp"
 #include "server/api/api.hpp"
 #include "server/api/scan_views.hpp"
@@ -312,6 +313,31 @@ void add_scan_routes(std::vector<Api::Route>* routes) {
          if (!text.ok()) return error_response(text.status());
          return cached_json(**text, call.request);
        }});
+  // The scan against its customer's earlier scan the same day: the values that
+  // differ by more than the shop's repeatability (pipeline/repeat_scans.hpp).
+  routes->push_back({"GET", "/api/scans/{id}/repeat", kStaff, [](Workstation& ws, const Call& call) {
+                       const double shop_mm = ws.options().repeatability_mm;
+                       auto check = pipeline::check_repeat(ws.archive(), call.params.at("id"), shop_mm);
+                       if (!check.ok()) return error_response(check.status());
+                       nlohmann::json out = {{"earlier", nullptr},
+                                             {"repeatability_mm", shop_mm > 0 ? nlohmann::json(shop_mm) : nullptr}};
+                       if (*check) {
+                         const pipeline::RepeatCheck& c = **check;
+                         out["earlier"] = {{"id", c.earlier_scan}, {"started_at", c.earlier_started_at}};
+                         out["compared"] = c.compared;
+                         nlohmann::json beyond = nlohmann::json::array();
+                         for (const pipeline::RepeatDifference& d : c.beyond)
+                           beyond.push_back({{"name", d.name},
+                                             {"label", d.label},
+                                             {"kind", d.kind},
+                                             {"value_mm", d.value_mm},
+                                             {"earlier_mm", d.earlier_mm},
+                                             {"difference_mm", d.difference()},
+                                             {"tolerance_mm", d.tolerance_mm}});
+                         out["beyond"] = beyond;
+                       }
+                       return json_response(200, out);
+                     }});
   routes->push_back({"POST", "/api/scans/{id}/measure", kStaff, [](Workstation& ws, const Call& call) {
                        HttpResponse error;
                        auto body = json_body(call, &error);

@@ -43,6 +43,10 @@ struct WorkstationOptions {
   // open and every hour after (audit: "delete scan" by "retention"); 0 keeps
   // them until staff erase them.
   int retention_days = 0;
+  // How far two scans of one customer on one day may differ, mm, before the
+  // station asks for another (pipeline/repeat_scans.hpp); 0: each value's ISO
+  // 20685-1 allowance.
+  double repeatability_mm = 0;
   // Calibration asks a person to hold the lens dot-grid board before every real
   // camera (JobInfo::prompt). With this, before the simulated ones too: staff
   // training on the simulated rig (and the tests of the prompt).

@@ -1293,6 +1293,66 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/scans/{id}/repeat": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The scan against its customer's earlier scan the same day (the workstation's local day): the automatic values that differ by more than the shop's repeatability (bodyscan serve --repeatability), else each value's ISO 20685-1 allowance */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path: {
+                    id: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description the comparison; earlier is null when there is no earlier scan that day */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": {
+                            earlier?: {
+                                id?: string;
+                                started_at?: string;
+                            } | null;
+                            /** @description the shop's; null: each value's ISO 20685-1 allowance */
+                            repeatability_mm?: number | null;
+                            /** @description automatic values both scans have */
+                            compared?: number;
+                            beyond?: {
+                                name?: string;
+                                label?: string;
+                                kind?: string;
+                                value_mm?: number;
+                                earlier_mm?: number;
+                                /** @description this scan's minus the earlier's */
+                                difference_mm?: number;
+                                tolerance_mm?: number;
+                            }[];
+                        };
+                    };
+                };
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+                404: components["responses"]["NotFound"];
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/api/scans/{id}/measure": {
         parameters: {
             query?: never;

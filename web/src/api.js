@@ -305,6 +305,14 @@ const reprocess = (id) => post(at('/api/scans/{id}/reprocess', { id }), {});
 const getMeasurements = (id) => get(at('/api/scans/{id}/measurements', { id }));
 
 /**
+ * The scan against its customer's earlier scan the same day: the values that
+ * differ by more than the shop's repeatability.
+ * @param {string} id
+ * @returns {Promise<Answer<'/api/scans/{id}/repeat', 'get', 200>>}
+ */
+const getRepeat = (id) => get(at('/api/scans/{id}/repeat', { id }));
+
+/**
  * @param {string} id the scan's
  * @param {Body<'/api/scans/{id}/measure', 'post'>} measureRequest
  * @returns {Promise<Answer<'/api/scans/{id}/measure', 'post', 200>>}
@@ -409,6 +417,7 @@ export const api = {
   getShare,
   getShareModel,
   getShareSheet,
+  getRepeat,
 };
 
 // A query string from an object, skipping empty values.

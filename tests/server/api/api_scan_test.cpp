@@ -8,10 +8,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <set>
 #include <sstream>
 #include <thread>
 
+#include "pipeline/repeat_scans.hpp"
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/measure/girth.hpp"
 #include "storage/formats/draco_files.hpp"
@@ -361,6 +363,89 @@ TEST(ApiScan, AShareLinkGivesTheCustomerTheirSheet) {
   EXPECT_EQ(http(s.port, "GET", pinned_at).status, 401);
   EXPECT_EQ(http(s.port, "GET", pinned_at, {{"X-Share-PIN", parse(pinned)["pin_code"].get<std::string>()}}).status,
             200);
+}
+
+// A body archived as a complete scan of `customer` (its surface the body, its
+// measurements the automatic set's on it); returns the scan's id.
+std::string archive_body_scan(ServerUnderTest& s, const std::string& customer, const TriangleMesh& body) {
+  pipeline::ScanJobResult r;
+  r.mesh = body;
+  r.cloud.positions = body.vertices;
+  auto measured = measure_body(body);
+  EXPECT_TRUE(measured.ok());
+  if (measured.ok()) r.body = std::move(*measured);
+  auto id = s.ws->archive().begin_scan(customer, "test", nlohmann::json::object(), "");
+  EXPECT_TRUE(id.ok());
+  EXPECT_TRUE(pipeline::archive_scan(s.ws->archive(), *id, r, {}).ok());
+  return *id;
+}
+
+// A customer scanned twice in one visit: the second scan is compared with the
+// first value by value, and the values that differ by more than their tolerance
+// are named. The second body is the first widened 2 % (X and Z): every girth
+// grows 2 %, the heights stay.
+TEST(ApiScan, ASecondScanTheSameDayNamesTheValuesThatMoved) {
+  ServerUnderTest s;
+  Client op = s.as("op");
+  TriangleMesh wider = s.body;
+  for (Vec3f& v : wider.vertices) v.x() *= 1.02f, v.z() *= 1.02f;
+  const std::string second = archive_body_scan(s, s.customer_id, wider);
+
+  const HttpReply r = op.get("/api/scans/" + second + "/repeat");
+  ASSERT_EQ(r.status, 200) << r.body;
+  const nlohmann::json check = parse(r);
+  EXPECT_EQ(check["earlier"]["id"], s.scan_id);
+  EXPECT_TRUE(check["repeatability_mm"].is_null()) << "the ISO allowance, value by value";
+  const nlohmann::json first_values = parse(op.get("/api/scans/" + s.scan_id + "/measurements"));
+  const nlohmann::json second_values = parse(op.get("/api/scans/" + second + "/measurements"));
+  std::map<std::string, nlohmann::json> before, after;
+  for (const auto& m : first_values["measurements"]) before[m["name"]] = m;
+  for (const auto& m : second_values["measurements"]) after[m["name"]] = m;
+  size_t both = 0;
+  for (const auto& [name, m] : after) both += before.count(name);
+  EXPECT_EQ(check["compared"], both);
+  std::set<std::string> named;
+  for (const auto& d : check["beyond"]) {
+    const std::string name = d["name"];
+    named.insert(name);
+    // The values are the archive's, the change the second's minus the first's.
+    EXPECT_DOUBLE_EQ(d["value_mm"].get<double>(), after[name]["value_mm"].get<double>()) << name;
+    EXPECT_DOUBLE_EQ(d["earlier_mm"].get<double>(), before[name]["value_mm"].get<double>()) << name;
+    EXPECT_NEAR(d["difference_mm"].get<double>(), d["value_mm"].get<double>() - d["earlier_mm"].get<double>(), 1e-9);
+    EXPECT_GT(std::abs(d["difference_mm"].get<double>()), d["tolerance_mm"].get<double>()) << name;
+    storage::MeasurementRecord as_stored;
+    as_stored.name = name, as_stored.kind = after[name]["kind"];
+    EXPECT_EQ(d["tolerance_mm"].get<double>(), pipeline::repeat_tolerance_mm(as_stored, 0)) << name;
+  }
+  // The torso's girths grow 2 % (18-22 mm) past their 9 mm; no height moves.
+  for (const char* girth : {"waist_girth", "hip_girth", "chest_girth"}) EXPECT_EQ(named.count(girth), 1u) << girth;
+  for (const char* height : {"stature", "crotch_height", "waist_height"}) EXPECT_EQ(named.count(height), 0u) << height;
+  // Every value the check leaves out is within its tolerance.
+  for (const auto& [name, m] : after)
+    if (before.count(name) && !named.count(name) && m["source"] == "automatic") {
+      const double allowed = m["kind"] == "girth" ? 9.0 : 5.0;  // at most the largest allowance of its kind
+      EXPECT_LE(std::abs(m["value_mm"].get<double>() - before[name]["value_mm"].get<double>()), allowed) << name;
+    }
+
+  // The first scan has nothing earlier; another customer's scan is not compared.
+  EXPECT_TRUE(parse(op.get("/api/scans/" + s.scan_id + "/repeat"))["earlier"].is_null());
+  auto other = s.ws->archive().add_customer(std::string("Someone Else"), std::nullopt, "test");
+  ASSERT_TRUE(other.ok());
+  const std::string theirs = archive_body_scan(s, other->id, wider);
+  EXPECT_TRUE(parse(op.get("/api/scans/" + theirs + "/repeat"))["earlier"].is_null());
+  EXPECT_EQ(op.get("/api/scans/no-such-scan/repeat").status, 404);
+  EXPECT_EQ(http(s.port, "GET", "/api/scans/" + second + "/repeat").status, 401);
+}
+
+// The shop's own repeatability replaces the allowance for every value.
+TEST(ApiScan, TheShopsRepeatabilityHoldsEveryValue) {
+  ServerUnderTest s(12, {}, [](server::WorkstationOptions& o) { o.repeatability_mm = 50; });
+  TriangleMesh wider = s.body;
+  for (Vec3f& v : wider.vertices) v.x() *= 1.02f, v.z() *= 1.02f;
+  const std::string second = archive_body_scan(s, s.customer_id, wider);
+  const nlohmann::json check = parse(s.as("tailor").get("/api/scans/" + second + "/repeat"));
+  EXPECT_EQ(check["repeatability_mm"], 50.0);
+  EXPECT_EQ(check["beyond"].size(), 0u) << check.dump();
 }
 
 // Avatars for CAD tools: the scan's surface decimated to the budget asked for,

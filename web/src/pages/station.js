@@ -11,7 +11,7 @@ import { api, enc } from '../api.js';
 import { overallFraction, stageText, timeLeftText } from '../progress.js';
 import { ago, clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 import { postureCheckCard, wantedPostureCard } from '../viewer/posture.js';
-import { preferredUnit } from '../units.js';
+import { formatDifference, formatLength, preferredUnit } from '../units.js';
 import { shareDialog } from './share-dialog.js';
 
 /** @typedef {import('../api.js').Job} Job */
@@ -37,7 +37,9 @@ export async function mount(container, _params, ctx) {
     /** @type {Map<string, string>} customer id to name, for the job card */ names: new Map(),
     /** @type {Map<string, HTMLImageElement>} */ previews: new Map(),
     /** @type {string | null} the job this page started */ myJob: null,
+    /** @type {{ scanId: string, customerId: string, check: any } | null} this page's scan that differs from the customer's earlier one today */ repeat: null,
   };
+  let disposed = false;
   const rigBox = h('div', { class: 'card rig-card', id: 'rig-status' });
   const jobBox = h('div', { class: 'card job-card', id: 'job', 'aria-live': 'polite' });
   const formBox = h('div', { class: 'card scan-card' });
@@ -397,11 +399,87 @@ export async function mount(container, _params, ctx) {
       j.kind === 'scan' || j.kind === 'posture_check' ? previewGrid : null,
       // The lasers' stop stays in view wherever the page is scrolled.
       running ? h('div', { class: 'cancel-bar' }, h('button', { type: 'button', class: 'danger big', id: 'cancel-job', onclick: () => cancel(j) }, 'Cancel')) : null,
-      !running && j.scan_id && j.state === 'complete' ? h('a', { class: 'button primary', href: `/scans/${enc(j.scan_id)}` }, 'Open the result') : null,
+      !running && j.scan_id && j.state === 'complete' && state.repeat?.scanId === j.scan_id ? repeatCard(state.repeat) : null,
+      !running && j.scan_id && j.state === 'complete' && state.repeat?.scanId !== j.scan_id ? h('a', { class: 'button primary', href: `/scans/${enc(j.scan_id)}` }, 'Open the result') : null,
     );
     // A new request to the person at the rig comes into view, wherever the page was.
     if (prompt && state.shownPrompt !== j.prompt.id) prompt.scrollIntoView({ block: 'center', behavior: 'smooth' });
     state.shownPrompt = prompt ? j.prompt.id : null;
+  }
+
+  // This station's scan is done: the result opens, unless it differs from the
+  // customer's earlier scan today by more than the shop allows; then the station
+  // stays, says which values, and offers another scan while the customer is here.
+  async function finished(job) {
+    let check = null;
+    try {
+      check = await api.getRepeat(job.scan_id);
+    } catch {
+      // The comparison is an aid: without it the result opens as before.
+    }
+    if (disposed) return;
+    if (check?.earlier && check.beyond?.length) {
+      state.repeat = { scanId: job.scan_id, customerId: job.customer_id, check };
+      renderJob();
+      document.getElementById('repeat-check')?.scrollIntoView({ block: 'center' });
+      return;
+    }
+    toast('Scan done; opening the result.', 'ok');
+    ctx.router.navigate(`/scans/${enc(job.scan_id)}`);
+  }
+
+  /** @param {{ scanId: string, customerId: string, check: any }} r */
+  function repeatCard(r) {
+    const unit = preferredUnit();
+    const who = customerName(r.customerId);
+    const at = new Date(r.check.earlier.started_at).toLocaleTimeString(undefined, { hour: '2-digit', minute: '2-digit' });
+    const n = r.check.beyond.length;
+    return h(
+      'div',
+      { class: 'repeat-check', id: 'repeat-check', role: 'alert', dataset: { beyond: String(n) } },
+      h('h3', {}, `${n} of ${r.check.compared} values differ from ${who}’s scan at ${at}`),
+      h(
+        'p',
+        {},
+        `By more than the shop allows between two scans (${r.check.repeatability_mm ? formatLength(r.check.repeatability_mm, unit) : 'the ISO 20685-1 allowance'}): the customer may have moved or stood differently. Scan again while they are here?`,
+      ),
+      h(
+        'table',
+        { class: 'measurements compact' },
+        h('thead', {}, h('tr', {}, h('th', { scope: 'col' }, 'Measurement'), h('th', { scope: 'col', class: 'num' }, 'Earlier'), h('th', { scope: 'col', class: 'num' }, 'Now'), h('th', { scope: 'col', class: 'num' }, 'Change (allowed)'))),
+        h(
+          'tbody',
+          {},
+          r.check.beyond.map((d) =>
+            h(
+              'tr',
+              { dataset: { name: d.name } },
+              h('td', {}, d.label || d.name),
+              h('td', { class: 'num' }, formatLength(d.earlier_mm, unit)),
+              h('td', { class: 'num' }, formatLength(d.value_mm, unit)),
+              h('td', { class: 'num' }, `${formatDifference(d.difference_mm, unit)} (${formatLength(d.tolerance_mm, unit)})`),
+            ),
+          ),
+        ),
+      ),
+      h(
+        'div',
+        { class: 'row' },
+        h('button', { type: 'button', class: 'primary', id: 'scan-again', onclick: () => scanAgain(r.customerId, who) }, `Scan ${who} again`),
+        h('a', { class: 'button', href: `/scans/${enc(r.scanId)}` }, 'Open the result'),
+      ),
+    );
+  }
+
+  // The customer picked for another scan, as a returning customer: the operator
+  // then presses Start and confirms, as for anyone.
+  async function scanAgain(customerId, who) {
+    /** @type {HTMLElement} */ (modeSwitch.children[1]).click();
+    search.value = who;
+    await findCustomers();
+    /** @type {HTMLElement | null} */ (results.querySelector(`[data-customer="${CSS.escape(customerId)}"]`))?.click();
+    startButton.scrollIntoView({ block: 'center' });
+    startButton.focus();
   }
 
   // The name of the customer a job scans; looked up once when this page did not
@@ -547,10 +625,7 @@ export async function mount(container, _params, ctx) {
       case 'scan_finished':
         setJob(msg.job);
         renderRecent();
-        if (msg.job.state === 'complete' && msg.job.id === state.myJob && msg.job.scan_id) {
-          toast('Scan done; opening the result.', 'ok');
-          ctx.router.navigate(`/scans/${enc(msg.job.scan_id)}`);
-        }
+        if (msg.job.state === 'complete' && msg.job.id === state.myJob && msg.job.scan_id) finished(msg.job);
         break;
       default:
     }
@@ -571,6 +646,7 @@ export async function mount(container, _params, ctx) {
     toast(errorText(e), 'error');
   }
   return () => {
+    disposed = true;
     stop();
     clearTimeout(searchTimer);
   };

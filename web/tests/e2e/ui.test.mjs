@@ -54,8 +54,9 @@ async function runScanFromStation(label, who) {
   let maxProgress = 0;
   const started = Date.now();
   await startScanFor(who);
-  // Watch the live progress until the page moves to the result.
-  while (!/\/scans\//.test(page.url())) {
+  // Watch the live progress until the page moves to the result, or the station
+  // stays to say the scan differs from the customer's earlier one today.
+  while (!/\/scans\//.test(page.url()) && (await page.locator('#repeat-check').count()) === 0) {
     const s = await page
       .locator('#job .job-state')
       .getAttribute('data-stage', { timeout: 1000 })
@@ -118,7 +119,12 @@ function nextMeasure() {
 
 describe('the browser UI', { timeout: 1_800_000 }, () => {
   before(async () => {
-    await openSuite(suite, { contextOptions: { viewport: { width: 1366, height: 1024 }, acceptDownloads: true, hasTouch: true } });
+    // A repeatability far below what two scans hold, so that the second scan of
+    // a customer always differs from the first and the station says so.
+    await openSuite(suite, {
+      serverOptions: { extraArgs: ['--repeatability', '0.01'] },
+      contextOptions: { viewport: { width: 1366, height: 1024 }, acceptDownloads: true, hasTouch: true },
+    });
     ({ server, browser, page } = suite);
   });
 
@@ -589,6 +595,20 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await page.click('.pick-list button:has-text("Ada Lovelace")');
     const run = await runScanFromStation('second', 'Ada Lovelace');
     console.log(`second scan through the UI: ${run.seconds.toFixed(0)} s`);
+    // Her second scan today differs from the first beyond the shop's repeatability:
+    // the station stays, names the values, and offers another scan of her.
+    const repeat = page.locator('#repeat-check');
+    assert.match(await repeat.locator('h3').innerText(), /^\d+ of \d+ values differ from Ada Lovelace’s scan at /);
+    const flaggedRows = await repeat.locator('tbody tr').count();
+    assert.ok(flaggedRows > 0);
+    assert.equal(String(flaggedRows), await repeat.getAttribute('data-beyond'));
+    assert.match(await repeat.innerText(), /By more than the shop allows between two scans \(0(\.0+)? (mm|cm|in)\)/);
+    await shot(page, 'station-repeat-check');
+    await page.click('#scan-again');
+    await page.locator('.pick-list [aria-selected=true]:has-text("Ada Lovelace")').waitFor();
+    assert.equal(await page.locator('#scan-subject').innerText(), 'Scanning: Ada Lovelace');
+    assert.equal(await page.locator('#job .job-state[data-state=running]').count(), 0, 'nothing started until Start and the confirmation');
+    await Promise.all([page.waitForURL('**/scans/**'), repeat.locator('a:has-text("Open the result")').click()]);
     state.scanB = /\/scans\/([^/?]+)/.exec(page.url())[1];
     assert.notEqual(state.scanB, state.scanA);
     await openedModel();
