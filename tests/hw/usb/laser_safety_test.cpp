@@ -1,5 +1,5 @@
 // Laser safety on every failure path the simulation can produce, each in a child
-// process that opens the rig's TMCL controller over a pseudo-terminal, switches a
+// process (tests/hw/usb/laser_death_child.cpp) that opens the rig's TMCL controller over a pseudo-terminal, switches a
 // laser on and then dies a different way. The board (here, in the parent) must
 // see the laser off:
 // - by the process's own emergency stop (crash signals, a stack overflow on the
@@ -7,11 +7,13 @@
 //   board's watchdog set to a minute, so only that path can have done it, and fast;
 // - by the board's watchdog when nothing in the process can run (SIGKILL).
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <signal.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <iterator>
+#include <string>
 #include <thread>
 
 #include "hw/controller.hpp"
@@ -19,7 +21,6 @@
 #include "hw/usb/serial_link.hpp"
 #include "hw/usb/sim_tmcl_board.hpp"
 #include "hw/usb/tmcl_controller.hpp"
-#include "tests/deaths.hpp"
 #include "tests/hw/usb/tmcl_rig.hpp"
 
 namespace bodyscan::hw::usb {
@@ -40,74 +41,58 @@ enum class Death {
   kStackOverflowOnOtherThread,  // on a thread that asked for an alternate stack
 };
 
-using bodyscan::testing::overflow_stack;
+// The child's name for each death (tests/hw/usb/laser_death_child.cpp).
+const char* child_death(Death death) {
+  static const char* const names[] = {"segfault",
+                                      "abort",
+                                      "terminate",
+                                      "sigterm",
+                                      "sigint",
+                                      "sigkill",
+                                      "sighup",
+                                      "stack-overflow",
+                                      "stack-overflow-on-rig-thread",
+                                      "stack-overflow-on-other-thread"};
+  return names[static_cast<int>(death)];
+}
 
-// Runs the child; returns its wait status. `laser_output` is the board output of
-// laser 0.
+// Starts the child (fork, then only exec in it: this process has threads), waits
+// up to a minute for it to switch the laser on, lets it die and returns its wait
+// status. `laser_output` is the board output of laser 0.
 int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoard& board, int laser_output,
               bool* was_on) {
   int ready[2], go[2];
   if (pipe(ready) != 0 || pipe(go) != 0) return -1;
+  const std::string args[] = {LASER_DEATH_CHILD,           port,
+                              std::to_string(watchdog_ms), child_death(death),
+                              std::to_string(ready[1]),    std::to_string(go[0])};
+  char* argv[std::size(args) + 1] = {};
+  for (size_t i = 0; i < std::size(args); ++i) argv[i] = const_cast<char*>(args[i].c_str());
   const pid_t pid = fork();
   if (pid == 0) {
     close(ready[0]);
     close(go[1]);
-    // No core files; and a main-thread stack that overflows at 8 MiB even where
-    // the limit is larger or unlimited.
-    const rlimit no_core{0, 0};
-    setrlimit(RLIMIT_CORE, &no_core);
-    rlimit stack{};
-    if (getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur > (8u << 20)) {
-      stack.rlim_cur = 8u << 20;
-      setrlimit(RLIMIT_STACK, &stack);
-    }
-    install_laser_safety_handlers(true);
-    auto c = TmclController::open(testing::tmcl_rig(port, watchdog_ms));
-    if (!c.ok()) _exit(3);
-    auto switch_on_and_wait = [&] {
-      if (!(*c)->set_laser(0, true).ok()) _exit(3);
-      const char one = 1;
-      (void)!write(ready[1], &one, 1);
-      char wait_for_parent = 0;
-      (void)!read(go[0], &wait_for_parent, 1);  // until the parent has seen the laser on
-    };
-    switch (death) {
-      case Death::kStackOverflowOnRigThread:
-        std::thread([&] {
-          switch_on_and_wait();
-          overflow_stack(0);
-        }).join();
-        break;
-      case Death::kStackOverflowOnOtherThread:
-        switch_on_and_wait();
-        std::thread([] {
-          ensure_alternate_signal_stack();
-          overflow_stack(0);
-        }).join();
-        break;
-      default: switch_on_and_wait(); break;
-    }
-    switch (death) {
-      case Death::kSegfault: raise(SIGSEGV); break;
-      case Death::kAbort: std::abort();
-      case Death::kTerminate: std::terminate();
-      case Death::kStackOverflow: overflow_stack(0); break;
-      default: break;
-    }
-    for (;;) pause();  // the parent signals it
+    execv(argv[0], argv);
+    _exit(127);
   }
   close(ready[1]);
   close(go[0]);
   char byte = 0;
-  const bool started = read(ready[0], &byte, 1) == 1;
+  pollfd p{ready[0], POLLIN, 0};
+  const bool started = pid > 0 && poll(&p, 1, 60000) == 1 && read(ready[0], &byte, 1) == 1;
   close(ready[0]);
   *was_on = started && board.output(laser_output);
-  (void)!write(go[1], &byte, 1);
+  if (started) {
+    (void)!write(go[1], &byte, 1);
+  } else if (pid > 0) {
+    kill(pid, SIGKILL);
+  }
   close(go[1]);
-  if (death == Death::kSigterm) kill(pid, SIGTERM);
-  if (death == Death::kSigint) kill(pid, SIGINT);
-  if (death == Death::kSigkill) kill(pid, SIGKILL);
-  if (death == Death::kSighup) kill(pid, SIGHUP);
+  if (pid <= 0) return -1;
+  if (started && death == Death::kSigterm) kill(pid, SIGTERM);
+  if (started && death == Death::kSigint) kill(pid, SIGINT);
+  if (started && death == Death::kSigkill) kill(pid, SIGKILL);
+  if (started && death == Death::kSighup) kill(pid, SIGHUP);
   int status = 0;
   waitpid(pid, &status, 0);
   return status;
@@ -149,7 +134,7 @@ TEST_P(LaserSafety, LaserGoesOffWhenTheProcessDies) {
   const bool uncatchable = death == Death::kSigkill;
   bool was_on = false;
   const int status = run_child((*pty)->path(), uncatchable ? 300 : 60000, death, board, output, &was_on);
-  ASSERT_TRUE(was_on) << "the child never switched the laser on";
+  ASSERT_TRUE(was_on) << "the child never switched the laser on, status " << status;
   ASSERT_TRUE(WIFSIGNALED(status)) << "the child should die of its signal, status " << status;
   EXPECT_EQ(WTERMSIG(status), expected_signal);
   if (uncatchable) {
