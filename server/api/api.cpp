@@ -124,6 +124,7 @@ Api::Api(Workstation& ws, ApiOptions options) : ws_(ws), options_(std::move(opti
   add_rig_routes(&routes_);
   add_scan_routes(&routes_);
   add_share_routes(&routes_, options_);
+  add_validation_routes(&routes_, options_);
 }
 
 std::optional<HttpResponse> Api::refuse_events(const HttpRequest& request, Session* session) {

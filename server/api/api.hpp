@@ -84,6 +84,7 @@ void add_account_routes(std::vector<Api::Route>* routes, const ApiOptions& optio
 void add_rig_routes(std::vector<Api::Route>* routes);
 void add_scan_routes(std::vector<Api::Route>* routes);
 void add_share_routes(std::vector<Api::Route>* routes, const ApiOptions& options);
+void add_validation_routes(std::vector<Api::Route>* routes, const ApiOptions& options);
 
 // Parses a JSON request body (object); nullopt and *error set when it is not one.
 std::optional<nlohmann::json> json_body(const Call& call, HttpResponse* error);

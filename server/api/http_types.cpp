@@ -11,6 +11,12 @@ HttpResponse json_response(int status, const nlohmann::json& body) {
   return r;
 }
 
+HttpResponse no_content() {
+  HttpResponse r;
+  r.status = 204;
+  return r;
+}
+
 namespace {
 const char* reason_code(int status) {
   switch (status) {

@@ -59,6 +59,8 @@ struct HttpResponse {
 };
 
 HttpResponse json_response(int status, const nlohmann::json& body);
+// 204, no body.
+HttpResponse no_content();
 // {"error": {"status": 409, "code": "conflict", "message": "..."}}.
 HttpResponse error_response(int status, const std::string& message);
 // A Status's HTTP status: invalid argument 400, not found 404, failed

@@ -118,12 +118,6 @@ HttpResponse cached_json(const Workstation::CachedText& text, const HttpRequest&
   return out;
 }
 
-HttpResponse no_content() {
-  HttpResponse r;
-  r.status = 204;
-  return r;
-}
-
 HttpResponse sheet(Workstation& ws, const Call& call, const std::string& format) {
   // A CSV's layout is the export profile's (storage/formats/export_profiles.hpp),
   // its unit the profile's own unless one is asked for.

@@ -126,6 +126,12 @@ nlohmann::json to_json(const MeasurementRecord& m) {
           {"created_at", m.created_at}};
 }
 
+nlohmann::json to_json(const TapeMeasurement& t) {
+  return {{"scan_id", t.scan_id},       {"name", t.name},
+          {"value_mm", t.value_mm},     {"measured_by", t.measured_by},
+          {"entered_by", t.entered_by}, {"entered_at", t.entered_at}};
+}
+
 struct Archive::Impl {
   fs::path dir;
   int lock_fd = -1;
@@ -191,6 +197,11 @@ struct Archive::Impl {
         customer_id TEXT NOT NULL REFERENCES customers(id) ON DELETE CASCADE,
         given_at TEXT NOT NULL, recorded_by TEXT NOT NULL, terms TEXT NOT NULL);
       CREATE INDEX IF NOT EXISTS consents_customer ON consents(customer_id);
+      CREATE TABLE IF NOT EXISTS tape_measurements(
+        scan_id TEXT NOT NULL REFERENCES scans(id) ON DELETE CASCADE,
+        name TEXT NOT NULL, value_mm REAL NOT NULL, measured_by TEXT NOT NULL,
+        entered_by TEXT NOT NULL, entered_at TEXT NOT NULL,
+        PRIMARY KEY(scan_id, name));
     )sql"));
     ASSIGN_OR_RETURN(Statement get, db.prepare("SELECT value FROM meta WHERE key = 'schema'"));
     ASSIGN_OR_RETURN(bool row, get.step());
@@ -907,6 +918,69 @@ Status Archive::delete_measurement(const std::string& scan_id, int64_t id, const
   return tx.commit();
 }
 
+// --- tape measurements -------------------------------------------------------
+
+StatusOr<std::vector<TapeMeasurement>> Archive::tape_measurements(const std::string& scan_id) const {
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Statement st,
+                   impl_->db.prepare("SELECT t.scan_id, s.customer_id, t.name, t.value_mm, t.measured_by, "
+                                     "t.entered_by, t.entered_at FROM tape_measurements t JOIN scans s "
+                                     "ON s.id = t.scan_id WHERE ?1 = '' OR t.scan_id = ?1 "
+                                     "ORDER BY t.entered_at, t.scan_id, t.name"));
+  st.bind(1, scan_id);
+  std::vector<TapeMeasurement> out;
+  for (;;) {
+    ASSIGN_OR_RETURN(bool row, st.step());
+    if (!row) break;
+    out.push_back({st.text(0), st.text(1), st.text(2), st.real(3), st.text(4), st.text(5), st.text(6)});
+  }
+  return out;
+}
+
+Status Archive::put_tape_measurement(const TapeMeasurement& t, const std::string& actor) {
+  impl_->revision.fetch_add(1);
+  if (!(t.value_mm >= 1 && t.value_mm <= 3000))
+    return invalid_argument("archive: a tape measurement is between 1 mm and 3 m");
+  if (t.measured_by.empty() || t.measured_by.size() > 200)
+    return invalid_argument("archive: a tape measurement needs who took it (up to 200 characters)");
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(ScanRecord r, impl_->record(t.scan_id));
+  if (r.status != ScanStatus::kComplete)
+    return failed_precondition("archive: scan '" + t.scan_id + "' has no measurements to compare with");
+  ASSIGN_OR_RETURN(Statement known, impl_->db.prepare("SELECT 1 FROM measurements WHERE scan_id = ? AND version = ? "
+                                                      "AND source = 'automatic' AND name = ?"));
+  known.bind(1, t.scan_id).bind(2, r.current_version).bind(3, t.name);
+  ASSIGN_OR_RETURN(bool found, known.step());
+  if (!found) return not_found("archive: scan '" + t.scan_id + "' has no automatic measurement '" + t.name + "'");
+  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("INSERT OR REPLACE INTO tape_measurements(scan_id, name, value_mm, "
+                                                   "measured_by, entered_by, entered_at) VALUES (?, ?, ?, ?, ?, ?)"));
+  RETURN_IF_ERROR(st.bind(1, t.scan_id)
+                      .bind(2, t.name)
+                      .bind(3, t.value_mm)
+                      .bind(4, t.measured_by)
+                      .bind(5, actor)
+                      .bind(6, now_iso())
+                      .run());
+  char detail[64];
+  std::snprintf(detail, sizeof detail, " %.1f mm", t.value_mm);
+  RETURN_IF_ERROR(
+      impl_->log(actor, "enter tape measurement", "scan", t.scan_id, t.name + detail + " by " + t.measured_by));
+  return tx.commit();
+}
+
+Status Archive::delete_tape_measurement(const std::string& scan_id, const std::string& name, const std::string& actor) {
+  impl_->revision.fetch_add(1);
+  std::lock_guard lock(impl_->mu);
+  ASSIGN_OR_RETURN(Transaction tx, Transaction::begin(impl_->db));
+  ASSIGN_OR_RETURN(Statement st, impl_->db.prepare("DELETE FROM tape_measurements WHERE scan_id = ? AND name = ?"));
+  RETURN_IF_ERROR(st.bind(1, scan_id).bind(2, name).run());
+  if (sqlite3_changes(impl_->db.handle()) == 0)
+    return not_found("archive: scan '" + scan_id + "' has no tape measurement '" + name + "'");
+  RETURN_IF_ERROR(impl_->log(actor, "delete tape measurement", "scan", scan_id, name));
+  return tx.commit();
+}
+
 // --- audit, export, verify ---------------------------------------------------
 
 StatusOr<std::vector<AuditEntry>> Archive::audit(const std::string& target_id, int limit) const {
@@ -978,6 +1052,9 @@ Status Archive::export_customer(const std::string& id, const std::string& dest, 
                fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
       if (ec) return io_error("archive: cannot copy scan " + r.id + " to " + dest + ": " + ec.message());
     }
+    ASSIGN_OR_RETURN(std::vector<TapeMeasurement> tape, tape_measurements(r.id));
+    s["tape_measurements"] = nlohmann::json::array();
+    for (const TapeMeasurement& t : tape) s["tape_measurements"].push_back(to_json(t));
     doc["scans"].push_back(std::move(s));
     RETURN_IF_ERROR(add_audit(r.id));
   }

@@ -95,6 +95,20 @@ struct MeasurementRecord {
 // field but scan_id.
 nlohmann::json to_json(const MeasurementRecord& m);
 
+// A value a member of staff measured on the customer by hand (tape, anthropometer)
+// for one of a scan's automatic measurements: the reference ISO 20685-1 compares
+// scan-derived values with. One per scan and measurement; entering it again
+// replaces it.
+struct TapeMeasurement {
+  std::string scan_id, customer_id;  // customer_id: filled in when read
+  std::string name;                  // the automatic measurement's name, e.g. "waist_girth"
+  double value_mm = 0;
+  std::string measured_by;  // who took it
+  std::string entered_by, entered_at;
+};
+
+nlohmann::json to_json(const TapeMeasurement& t);
+
 struct AuditEntry {
   int64_t id = 0;
   std::string at, actor, action, target_kind, target_id, detail;
@@ -178,6 +192,13 @@ class Archive {
   StatusOr<std::vector<MeasurementRecord>> measurements(const std::string& scan_id, int version = 0) const;
   StatusOr<int64_t> save_measurement(const MeasurementRecord& m, const std::string& actor);
   Status delete_measurement(const std::string& scan_id, int64_t id, const std::string& actor);
+
+  // Tape measurements: a scan's, or every scan's (scan_id ""), oldest first. Adding
+  // one for a measurement the scan already has replaces it; the name must be one of
+  // the scan's automatic measurements, the value between 1 mm and 3 m.
+  StatusOr<std::vector<TapeMeasurement>> tape_measurements(const std::string& scan_id = "") const;
+  Status put_tape_measurement(const TapeMeasurement& t, const std::string& actor);
+  Status delete_tape_measurement(const std::string& scan_id, const std::string& name, const std::string& actor);
 
   // Changes whenever a scan, its versions or measurements change (through this
   // object): what is derived from them can be cached against it.

@@ -315,6 +315,7 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
   MeasurementRecord m;
   m.scan_id = scans[0], m.name = "zora_special", m.label = "Zora's line", m.kind = "girth", m.value_mm = 1;
   ASSERT_TRUE(ar.save_measurement(m, "tailor").ok());
+  ASSERT_TRUE(ar.put_tape_measurement({scans[0], "", "waist_girth", 777.5, "ZORA-TAPER", "", ""}, "tailor").ok());
 
   // Exporting first: everything held about her.
   const std::string out = testing::temp_dir();
@@ -330,6 +331,9 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
     for (const auto& mm : s["measurements"]) user_lines += mm["source"] == "user";
   for (const auto& e : doc["audit"]) audit_for_scans += e["target_kind"] == "scan";
   EXPECT_EQ(user_lines, 1u);
+  EXPECT_EQ(doc["scans"][0]["tape_measurements"].size() + doc["scans"][1]["tape_measurements"].size() +
+                doc["scans"][2]["tape_measurements"].size(),
+            1u);
   EXPECT_GE(audit_for_scans, 6u);  // started and completed, each
   for (const std::string& s : scans) {
     EXPECT_EQ(slurp(fs::path(out) / "scans" / s / "v1" / "mesh.glb"), slurp(*ar.file_path(s, 0, "mesh.glb")));
@@ -347,7 +351,7 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
   const std::string all = everything(dir);
   for (const std::string& needle :
        {std::string("Zora Quintrell"), std::string("zora.q@example.org"), gone.id, scans[0], scans[1], scans[2],
-        std::string("ZORA-RAW-"), std::string("zora_special"), std::string("ZORA-TERMS")})
+        std::string("ZORA-RAW-"), std::string("zora_special"), std::string("ZORA-TERMS"), std::string("ZORA-TAPER")})
     EXPECT_EQ(all.find(needle), std::string::npos) << needle;
   // The others are untouched, and the log says an erasure happened, by whom.
   EXPECT_EQ(ar.scan(kept_scan)->status, ScanStatus::kComplete);
@@ -359,6 +363,40 @@ TEST(Archive, DeletingACustomerLeavesNothingOfThem) {
   EXPECT_EQ(log->front().actor, "admin");
   EXPECT_TRUE(ar.verify().ok()) << ar.verify().message();
   EXPECT_EQ(ar.delete_customer(gone.id, "admin").code(), StatusCode::kNotFound);
+}
+
+// Tape values: one per scan and measurement (entering again replaces it), only
+// for the scan's automatic measurements, within 1 mm to 3 m, with who measured.
+TEST(Archive, KeepsOneTapeValuePerScanAndMeasurement) {
+  auto a = Archive::open(testing::temp_dir());
+  ASSERT_TRUE(a.ok());
+  Archive& ar = **a;
+  const Customer c = *ar.add_customer("Tape Person", std::nullopt, "op");
+  const std::string scan = *ar.begin_scan(c.id, "op", kRig, "");
+  EXPECT_EQ(ar.put_tape_measurement({scan, "", "waist_girth", 800, "Ada", "", ""}, "op").code(),
+            StatusCode::kFailedPrecondition)
+      << "a running scan has no values to compare with";
+  ASSERT_TRUE(ar.complete_scan(scan, results(1)).ok());
+  ASSERT_TRUE(ar.put_tape_measurement({scan, "", "waist_girth", 800, "Ada", "", ""}, "op").ok());
+  ASSERT_TRUE(ar.put_tape_measurement({scan, "", "waist_girth", 805, "Ben", "", ""}, "tailor").ok());
+  EXPECT_EQ(ar.put_tape_measurement({scan, "", "hip_girth", 900, "Ada", "", ""}, "op").code(), StatusCode::kNotFound);
+  EXPECT_EQ(ar.put_tape_measurement({scan, "", "waist_girth", 0.5, "Ada", "", ""}, "op").code(),
+            StatusCode::kInvalidArgument);
+  EXPECT_EQ(ar.put_tape_measurement({scan, "", "waist_girth", 3001, "Ada", "", ""}, "op").code(),
+            StatusCode::kInvalidArgument);
+  EXPECT_EQ(ar.put_tape_measurement({scan, "", "waist_girth", 800, "", "", ""}, "op").code(),
+            StatusCode::kInvalidArgument);
+  auto tape = ar.tape_measurements(scan);
+  ASSERT_TRUE(tape.ok());
+  ASSERT_EQ(tape->size(), 1u);
+  EXPECT_EQ((*tape)[0].customer_id, c.id);
+  EXPECT_EQ((*tape)[0].value_mm, 805);
+  EXPECT_EQ((*tape)[0].measured_by, "Ben");
+  EXPECT_EQ((*tape)[0].entered_by, "tailor");
+  EXPECT_EQ(ar.audit(scan, 1)->front().action, "enter tape measurement");
+  ASSERT_TRUE(ar.delete_tape_measurement(scan, "waist_girth", "op").ok());
+  EXPECT_EQ(ar.delete_tape_measurement(scan, "waist_girth", "op").code(), StatusCode::kNotFound);
+  EXPECT_TRUE(ar.tape_measurements()->empty());
 }
 
 // A customer's consent: the terms word for word, when, and who recorded it; the

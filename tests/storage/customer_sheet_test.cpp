@@ -9,6 +9,7 @@
 
 #include "recon/io/ply.hpp"
 #include "recon/io/png_image.hpp"
+#include "tests/storage/pdf_text.hpp"
 #include "tests/test_data.hpp"
 
 namespace bodyscan::storage {
@@ -33,20 +34,7 @@ const Fixture& fixture() {
   return f;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string pdf_text(const std::string& pdf) {
-  const std::string dir = testing::temp_dir();
-  { std::ofstream(dir + "/customer.pdf", std::ios::binary) << pdf; }
-  const std::string cmd = "pdftotext " + dir + "/customer.pdf " + dir + "/customer.txt 2>&1";
-  EXPECT_EQ(std::system(cmd.c_str()), 0) << "pdftotext (poppler-utils) reads the sheet back";
-  return slurp(dir + "/customer.txt");
-}
+using testing::pdf_text;
 
 const SheetEntry& entry(const std::vector<SheetEntry>& entries, const std::string& name) {
   for (const SheetEntry& e : entries)

@@ -10,6 +10,7 @@
 
 #include "recon/io/ply.hpp"
 #include "storage/formats/export_profiles.hpp"
+#include "tests/storage/pdf_text.hpp"
 #include "tests/test_data.hpp"
 
 namespace bodyscan::storage {
@@ -177,16 +178,7 @@ TEST(MeasurementSheet, JsonCarriesTheSameValues) {
   EXPECT_EQ(j["by_clause"]["5.1.1"], "stature");
 }
 
-std::string pdf_text(const std::string& pdf) {
-  const std::string dir = testing::temp_dir();
-  { std::ofstream(dir + "/sheet.pdf", std::ios::binary) << pdf; }
-  const std::string cmd = "pdftotext -layout " + dir + "/sheet.pdf " + dir + "/sheet.txt 2>&1";
-  EXPECT_EQ(std::system(cmd.c_str()), 0) << "pdftotext (poppler-utils) reads the sheet back";
-  std::ifstream in(dir + "/sheet.txt");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string pdf_text(const std::string& pdf) { return testing::pdf_text(pdf, true); }
 
 TEST(MeasurementSheet, PdfShowsTheCustomerTheTableAndTheSilhouettes) {
   const Fixture& f = fixture();

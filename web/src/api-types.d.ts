@@ -2094,6 +2094,232 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/api/scans/{id}/tape": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The tape measurements staff entered for the scan */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path: {
+                    id: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description the scan's tape values */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": {
+                            scan_id: string;
+                            tape: components["schemas"]["TapeMeasurement"][];
+                        };
+                    };
+                };
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+                404: components["responses"]["NotFound"];
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/scans/{id}/tape/{name}": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        /** Enter (or replace) the tape value of one of the scan's automatic measurements */
+        put: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path: {
+                    id: string;
+                    /** @description an automatic measurement's name */
+                    name: string;
+                };
+                cookie?: never;
+            };
+            requestBody: {
+                content: {
+                    "application/json": {
+                        /** @description the tape's reading, 1 to 3000 mm */
+                        value_mm: number;
+                        /** @description who took it (up to 200 characters); default the caller */
+                        measured_by?: string;
+                    };
+                };
+            };
+            responses: {
+                /** @description the scan's tape values */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": {
+                            scan_id: string;
+                            tape: components["schemas"]["TapeMeasurement"][];
+                        };
+                    };
+                };
+                400: components["responses"]["BadRequest"];
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+                404: components["responses"]["NotFound"];
+                409: components["responses"]["Conflict"];
+            };
+        };
+        post?: never;
+        /** Remove the tape value of one measurement */
+        delete: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path: {
+                    id: string;
+                    name: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description removed */
+                204: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+                404: components["responses"]["NotFound"];
+            };
+        };
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/validation": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** ISO 20685-1 validation: per measurement, the mean scan-minus-tape difference over the customers with tape values, its 95 % confidence interval and whether it lies within the standard's allowance */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description the report */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": {
+                            customers: number;
+                            tape_values: number;
+                            confidence: number;
+                            measurements: {
+                                name: string;
+                                label: string;
+                                kind: string;
+                                iso_clause: string;
+                                /** @description ISO 20685-1's: 9 large girths; 4 small girths, heights, breadths; 5 lengths, depths */
+                                allowance_mm: number;
+                                /** @description customers compared, each once (their newest scan with a tape value) */
+                                subjects: number;
+                                /** @description mean of scan minus tape */
+                                mean_difference_mm: number;
+                                sd_mm: number | null;
+                                /** @description 95 % confidence interval of the mean (Student t); null below two customers */
+                                ci_low_mm: number | null;
+                                ci_high_mm: number | null;
+                                /** @enum {string} */
+                                verdict: "within" | "more_subjects" | "outside" | "too_few";
+                                /** @description more_subjects: customers still needed for the interval to fit if mean and spread hold; too_few: still needed for a first interval */
+                                more_subjects: number;
+                                measured_by: string[];
+                            }[];
+                        };
+                    };
+                };
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/api/validation.pdf": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The validation report as A4 pages for the shop's files */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description the report (Content-Disposition: attachment) */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/pdf": string;
+                    };
+                };
+                401: components["responses"]["Unauthorized"];
+                403: components["responses"]["Forbidden"];
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
 }
 export type webhooks = Record<string, never>;
 export interface components {
@@ -2307,6 +2533,18 @@ export interface components {
             given_at?: string;
             recorded_by?: string;
             terms?: string;
+        };
+        /** @description A value staff measured on the customer by hand for one of the scan's automatic measurements (ISO 20685-1 validation) */
+        TapeMeasurement: {
+            scan_id: string;
+            /** @description the automatic measurement's name, e.g. waist_girth */
+            name: string;
+            value_mm: number;
+            /** @description who took it */
+            measured_by: string;
+            entered_by: string;
+            /** Format: date-time */
+            entered_at: string;
         };
     };
     responses: {

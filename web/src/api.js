@@ -312,6 +312,32 @@ const getMeasurements = (id) => get(at('/api/scans/{id}/measurements', { id }));
  */
 const getRepeat = (id) => get(at('/api/scans/{id}/repeat', { id }));
 
+// ---- ISO 20685-1 validation: tape measurements and the report
+
+/**
+ * @param {string} id the scan's
+ * @returns {Promise<Answer<'/api/scans/{id}/tape', 'get', 200>>}
+ */
+const getTape = (id) => get(at('/api/scans/{id}/tape', { id }));
+
+/**
+ * Enters (or replaces) the tape value of one automatic measurement.
+ * @param {string} id the scan's
+ * @param {string} name the measurement's
+ * @param {Body<'/api/scans/{id}/tape/{name}', 'put'>} entry
+ * @returns {Promise<Answer<'/api/scans/{id}/tape/{name}', 'put', 200>>}
+ */
+const putTape = (id, name, entry) => put(at('/api/scans/{id}/tape/{name}', { id, name }), entry);
+
+/**
+ * @param {string} id the scan's
+ * @param {string} name the measurement's
+ */
+const deleteTape = (id, name) => del(at('/api/scans/{id}/tape/{name}', { id, name }));
+
+/** @returns {Promise<Answer<'/api/validation', 'get', 200>>} */
+const getValidation = () => get('/api/validation');
+
 /**
  * @param {string} id the scan's
  * @param {Body<'/api/scans/{id}/measure', 'post'>} measureRequest
@@ -418,6 +444,10 @@ export const api = {
   getShareModel,
   getShareSheet,
   getRepeat,
+  getTape,
+  putTape,
+  deleteTape,
+  getValidation,
 };
 
 // A query string from an object, skipping empty values.

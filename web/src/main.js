@@ -16,6 +16,7 @@ const routes = [
   { path: '/customers/:id', title: 'Customer', roles: staff, navActive: 'Archive', load: () => import('./pages/customer-scans.js') },
   { path: '/scans/:id', title: 'Scan', roles: staff, navActive: 'Archive', load: () => import('./pages/viewer.js') },
   { path: '/compare/:a/:b', title: 'Compare scans', roles: staff, navActive: 'Archive', load: () => import('./pages/compare.js') },
+  { path: '/validation', title: 'Validation', roles: staff, nav: 'Validation', load: () => import('./pages/validation.js') },
   { path: '/accounts', title: 'Accounts', roles: ['admin'], nav: 'Accounts', load: () => import('./pages/accounts.js') },
   { path: '*', notFound: true, title: 'Not found', public: true, load: () => import('./pages/not-found.js') },
 ];

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -436,6 +437,81 @@ TEST(ApiScan, ASecondScanTheSameDayNamesTheValuesThatMoved) {
   EXPECT_TRUE(parse(op.get("/api/scans/" + theirs + "/repeat"))["earlier"].is_null());
   EXPECT_EQ(op.get("/api/scans/no-such-scan/repeat").status, 404);
   EXPECT_EQ(http(s.port, "GET", "/api/scans/" + second + "/repeat").status, 401);
+}
+
+// ISO 20685-1 validation: staff enter tape values for scans; the report's mean
+// scan-minus-tape difference and 95 % interval match the statistics worked out
+// here from the values entered and a printed t value, and the PDF is a PDF.
+TEST(ApiScan, TapeMeasurementsValidateTheScannerAsIso20685Does) {
+  ServerUnderTest s;
+  Client tailor = s.as("tailor");
+  auto waist_of = [&](const std::string& scan) {
+    const nlohmann::json values = parse(tailor.get("/api/scans/" + scan + "/measurements"));
+    for (const auto& m : values["measurements"])
+      if (m["name"] == "waist_girth") return m["value_mm"].get<double>();
+    ADD_FAILURE() << "no waist on " << scan;
+    return 0.0;
+  };
+  // Four customers; scan minus tape for the waist 3, -2, 4, 1.
+  std::vector<std::string> scans = {s.scan_id};
+  for (int i = 1; i < 4; ++i) {
+    auto c = s.ws->archive().add_customer("Customer " + std::to_string(i), std::nullopt, "test");
+    ASSERT_TRUE(c.ok());
+    scans.push_back(archive_body_scan(s, c->id, s.body));
+  }
+  const double differences[] = {3, -2, 4, 1};
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const std::string body = "{\"value_mm\": " + std::to_string(waist_of(scans[i]) - differences[i]) +
+                             (i < 2 ? R"(, "measured_by": "Ada Tailor"})" : "}");
+    const HttpReply r = tailor.put("/api/scans/" + scans[i] + "/tape/waist_girth", body);
+    ASSERT_EQ(r.status, 200) << r.body;
+  }
+  const nlohmann::json listed = parse(tailor.get("/api/scans/" + scans[3] + "/tape"));
+  ASSERT_EQ(listed["tape"].size(), 1u);
+  EXPECT_EQ(listed["tape"][0]["measured_by"], "tailor") << "who measured defaults to the caller";
+  EXPECT_EQ(listed["tape"][0]["entered_by"], "tailor");
+  EXPECT_NEAR(listed["tape"][0]["value_mm"].get<double>(), waist_of(scans[3]) - 1, 1e-6);
+
+  // Refused: not a number, out of range, a measurement the scan has not, a scan
+  // that does not exist, no session.
+  const std::string tape = "/api/scans/" + scans[0] + "/tape/";
+  EXPECT_EQ(tailor.put(tape + "waist_girth", R"({"value_mm": "80"})").status, 400);
+  EXPECT_EQ(tailor.put(tape + "waist_girth", R"({"value_mm": 0.5})").status, 400);
+  EXPECT_EQ(tailor.put(tape + "waist_girth", R"({"value_mm": 800, "measured_by": ""})").status, 400);
+  EXPECT_EQ(tailor.put(tape + "no_such_girth", R"({"value_mm": 800})").status, 404);
+  EXPECT_EQ(tailor.put("/api/scans/s_none/tape/waist_girth", R"({"value_mm": 800})").status, 404);
+  EXPECT_EQ(http(s.port, "GET", "/api/validation").status, 401);
+
+  nlohmann::json report = parse(tailor.get("/api/validation"));
+  EXPECT_EQ(report["customers"], 4);
+  EXPECT_EQ(report["tape_values"], 4);
+  ASSERT_EQ(report["measurements"].size(), 1u);
+  const nlohmann::json& waist = report["measurements"][0];
+  EXPECT_EQ(waist["name"], "waist_girth");
+  EXPECT_EQ(waist["allowance_mm"], 9.0);
+  EXPECT_EQ(waist["subjects"], 4);
+  // Mean 1.5; squares about it 2.25 + 12.25 + 6.25 + 0.25 = 21, sd = sqrt(7);
+  // half width t(0.975, 3) sd / 2 with t = 3.1824463.
+  const double half = 3.1824463 * std::sqrt(7.0) / 2;
+  EXPECT_NEAR(waist["mean_difference_mm"].get<double>(), 1.5, 1e-4);
+  EXPECT_NEAR(waist["sd_mm"].get<double>(), std::sqrt(7.0), 1e-4);
+  EXPECT_NEAR(waist["ci_low_mm"].get<double>(), 1.5 - half, 1e-4);
+  EXPECT_NEAR(waist["ci_high_mm"].get<double>(), 1.5 + half, 1e-4);
+  EXPECT_EQ(waist["verdict"], "within");
+  EXPECT_EQ(waist["measured_by"], nlohmann::json({"Ada Tailor", "tailor"}));
+
+  const HttpReply pdf = tailor.get("/api/validation.pdf");
+  ASSERT_EQ(pdf.status, 200);
+  EXPECT_EQ(pdf.header("content-type"), "application/pdf");
+  EXPECT_EQ(pdf.body.rfind("%PDF-", 0), 0u);
+
+  // A reading removed, and a scan erased, leave the report.
+  EXPECT_EQ(tailor.del(tape + "waist_girth").status, 204);
+  EXPECT_EQ(tailor.del(tape + "waist_girth").status, 404);
+  EXPECT_EQ(s.as("admin").del("/api/scans/" + scans[1]).status, 204);
+  report = parse(tailor.get("/api/validation"));
+  EXPECT_EQ(report["customers"], 2);
+  EXPECT_EQ(report["measurements"][0]["subjects"], 2);
 }
 
 // The shop's own repeatability replaces the allowance for every value.

@@ -10,6 +10,7 @@ import { arcEndsMoved, COLOURS, drawMeasurement, KIND_LABEL, measurementTable, s
 import { postureCard } from '../viewer/posture.js';
 import { avatarDialog } from './avatar-dialog.js';
 import { shareDialog } from './share-dialog.js';
+import { tapeDialog } from './tape-dialog.js';
 
 /** @typedef {import('../api.js').Customer} Customer */
 /** @typedef {import('../api.js').MeasureRequest} MeasureRequest */
@@ -339,6 +340,7 @@ export async function mount(container, { id }, ctx) {
         h('a', { class: 'button', href: `/api/scans/${enc(id)}/sheet.pdf?unit=${u}`, download: `${id}-measurements.pdf` }, 'Export PDF'),
         h('button', { type: 'button', onclick: () => avatarDialog(id, state.unit) }, 'Avatar for CAD…'),
         ctx.can.share(role) ? h('button', { type: 'button', onclick: () => shareDialog(id, state.measurements, state.unit) }, 'Share with customer…') : null,
+        h('button', { type: 'button', onclick: () => tapeDialog(id, state.measurements, state.unit, ctx.session.user.username) }, 'Tape measurements…'),
       ),
       ctx.can.deleteRecords(role)
         ? h(

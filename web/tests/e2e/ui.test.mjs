@@ -453,6 +453,46 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     await avatar.locator('button:has-text("Close")').click();
   });
 
+  it('takes tape values for the scan and reports the scanner against them (ISO 20685-1)', async () => {
+    const scanPath = new URL(page.url()).pathname;
+    const values = await page.evaluate(async (path) => (await (await fetch(`/api${path}/measurements`)).json()).measurements, scanPath);
+    const waist = values.find((m) => m.name === 'waist_girth');
+    await page.click('button:has-text("Tape measurements")');
+    const dialog = page.locator('dialog[open]');
+    await dialog.locator('input[name=measured_by]').fill('Ada Tailor');
+    // In the viewer's unit (cm): the tape reads about 5 mm under the scan.
+    const tapeCm = (waist.value_mm / 10 - 0.5).toFixed(1);
+    const field = dialog.locator('input[name=waist_girth]');
+    await field.fill(tapeCm);
+    const differenceMm = waist.value_mm - Number(tapeCm) * 10;
+    assert.equal(await dialog.locator('tr[data-name=waist_girth] td').last().innerText(), `+${(differenceMm / 10).toFixed(1)} cm`);
+    const saved = page.waitForResponse((r) => r.url().endsWith('/tape/waist_girth') && r.request().method() === 'PUT');
+    await dialog.locator('button:has-text("Save")').click();
+    assert.equal((await saved).status(), 200);
+    await dialog.waitFor({ state: 'detached' });
+    // Entered again, the reading is there.
+    await page.click('button:has-text("Tape measurements")');
+    assert.equal(await page.locator('dialog[open] input[name=waist_girth]').inputValue(), tapeCm);
+    assert.equal(await page.locator('dialog[open] input[name=measured_by]').inputValue(), 'Ada Tailor');
+    await page.locator('dialog[open] button:has-text("Cancel")').click();
+
+    await page.click('#topnav a:has-text("Validation")');
+    const row = page.locator('tr[data-name=waist_girth]');
+    await row.waitFor();
+    assert.equal(await row.getAttribute('data-verdict'), 'too_few');
+    const cells = await row.locator('td').allInnerTexts();
+    assert.equal(cells[0], '1');
+    assert.equal(cells[1], `+${differenceMm.toFixed(1)}`);
+    assert.equal(cells[3], '±9');
+    assert.match(cells[4], /needs 1 more customer/);
+    assert.equal(cells[5], 'Ada Tailor');
+    const [report] = await Promise.all([page.waitForEvent('download'), page.click('a:has-text("Report (PDF)")')]);
+    assert.equal(readFileSync(await report.path()).subarray(0, 5).toString(), '%PDF-');
+    assert.deepEqual(await accessibilityProblems(page), [], 'axe-core on the validation page');
+    await page.goBack();
+    await page.locator('button:has-text("Share with customer")').waitFor();
+  });
+
   it('makes a share link the customer opens on a phone, which shows that scan and reaches nothing else', async () => {
     await page.click('button:has-text("Share with customer")');
     const dialog = page.locator('dialog[open]');
