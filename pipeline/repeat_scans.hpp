@@ -29,7 +29,7 @@ struct RepeatCheck {
 
 // How far two scans of one customer in one visit may differ: `shop_mm` when the
 // shop set one (> 0), else the value's ISO 20685-1 allowance (9 mm for the torso's
-// girths, 4 for the other girths and the heights, 5 for lengths and distances),
+// girths, 4 for the other girths, the heights and the breadths, 5 for lengths),
 // which is what a scanner must hold against the tape.
 double repeat_tolerance_mm(const storage::MeasurementRecord& m, double shop_mm);
 

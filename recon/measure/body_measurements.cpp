@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <iterator>
 #include <optional>
+#include <string_view>
 
 #include "recon/measure/rules/arms.hpp"
 #include "recon/measure/rules/body_cuts.hpp"
@@ -31,7 +32,10 @@ double iso20685_allowance_mm(const BodyMeasurement& m) {
   static const char* const kTorso[] = {"chest_girth", "bust_girth", "underbust_girth",
                                        "waist_girth", "hip_girth",  "max_hip_girth"};
   if (m.kind == "girth") return std::find(std::begin(kTorso), std::end(kTorso), m.name) != std::end(kTorso) ? 9 : 4;
-  return m.kind == "height" ? 4 : 5;
+  const std::string_view breadth = "_breadth";
+  const bool is_breadth =
+      m.name.size() > breadth.size() && m.name.compare(m.name.size() - breadth.size(), breadth.size(), breadth) == 0;
+  return m.kind == "height" || is_breadth ? 4 : 5;
 }
 
 StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeasureOptions& options) {

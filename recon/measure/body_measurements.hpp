@@ -105,8 +105,9 @@ struct BodyMeasurements {
 
 // How far ISO 20685-1 lets a scan-derived value of the automatic set lie from the
 // same value measured by hand, mm: 9 for the torso's girths, 4 for the other
-// girths and the heights, 5 for lengths and distances. The benchmarks judge the
-// set by it.
+// girths, the heights and the breadths (a name ending "_breadth"), 5 for lengths
+// and other distances. The benchmarks and the validation against tape
+// (pipeline/tape_validation.hpp) judge the set by it.
 double iso20685_allowance_mm(const BodyMeasurement& m);
 
 // Errors when the mesh is empty or the body's main parts (legs, torso, arms, neck)

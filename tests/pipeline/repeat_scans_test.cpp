@@ -50,15 +50,17 @@ TEST(RepeatScans, TheSameDayIsTheWorkstationsLocalDay) {
 }
 
 TEST(RepeatScans, TheToleranceIsTheShopsElseTheIsoAllowance) {
-  storage::MeasurementRecord waist, wrist, stature, arm;
+  storage::MeasurementRecord waist, wrist, stature, arm, shoulders;
   waist.name = "waist_girth", waist.kind = "girth";
   wrist.name = "wrist_girth_left", wrist.kind = "girth";
   stature.name = "stature", stature.kind = "height";
   arm.name = "outer_arm_length_left", arm.kind = "surface_length";
+  shoulders.name = "biacromial_breadth", shoulders.kind = "distance";
   EXPECT_EQ(repeat_tolerance_mm(waist, 0), 9);
   EXPECT_EQ(repeat_tolerance_mm(wrist, 0), 4);
   EXPECT_EQ(repeat_tolerance_mm(stature, 0), 4);
   EXPECT_EQ(repeat_tolerance_mm(arm, 0), 5);
+  EXPECT_EQ(repeat_tolerance_mm(shoulders, 0), 4);  // a body breadth
   EXPECT_EQ(repeat_tolerance_mm(waist, 2.5), 2.5);
 }
 
