@@ -265,6 +265,9 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
 
   std::printf("\n%-24s %6s %8s %8s %7s %6s  %s\n", "automatic set", "ISO", "truth", "scan", "diff", "allow", "");
   size_t n = 0, iso = 0, must = 0, aim = 0;
+  // The fill's marks: values over filled skin, those marked as estimates, and how
+  // the differences compare with the bound (recon/measure/fill_bound.hpp).
+  size_t crossing = 0, marked = 0, unmarked_over = 0, marked_past_bound = 0;
   for (const BodyMeasurement& m : truth->measurements) {
     const BodyMeasurement* s = scan_body.find(m.name);
     if (!s) {
@@ -276,13 +279,25 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
     iso += std::abs(d) <= al;
     must += std::abs(d) <= al / 2;
     aim += std::abs(d) <= al / 6;
+    crossing += s->crosses_filled_hole();
+    marked += s->estimated();
+    unmarked_over += !s->estimated() && std::abs(d) > al;
+    // Past its bound by more than half the allowance (the scan's own error on seen skin).
+    marked_past_bound += s->estimated() && s->fill_bound_mm && std::abs(d) > *s->fill_bound_mm + al / 2;
+    char fill[48] = "";
+    if (s->estimated())
+      s->fill_bound_mm ? std::snprintf(fill, sizeof fill, "  (estimate, fill bound %.1f)", *s->fill_bound_mm)
+                       : std::snprintf(fill, sizeof fill, "  (estimate, fill bound not known)");
     std::printf("%-24s %6s %8.1f %8.1f %+7.2f %6.1f  %s%s%s\n", m.name.c_str(), m.iso_clause.c_str(), m.value_mm,
-                s->value_mm, d, al, std::abs(d) <= al ? (std::abs(d) <= al / 2 ? mark(d, al) : "iso") : "OVER",
-                s->crosses_filled_hole() ? "  (crosses fill)" : "",
+                s->value_mm, d, al, std::abs(d) <= al ? (std::abs(d) <= al / 2 ? mark(d, al) : "iso") : "OVER", fill,
                 m.outside_posture || s->outside_posture ? "  (outside posture)" : "");
   }
   std::printf("%zu measurements: %zu within the ISO allowance, %zu within half, %zu within a sixth\n", n, iso, must,
               aim);
+  std::printf(
+      "filled skin: %zu cross it, %zu marked as estimates (bound over %.0f mm or not known); %zu unmarked "
+      "over their allowance, %zu marked off by more than their bound and half the allowance\n",
+      crossing, marked, kEstimateThresholdMm, unmarked_over, marked_past_bound);
   for (const std::string& k : scan_body.skipped) std::printf("skipped on the scan: %s\n", k.c_str());
 
   if (second) {

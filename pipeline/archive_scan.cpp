@@ -79,7 +79,8 @@ StatusOr<storage::MeasurementSheet> archived_sheet(const storage::Archive& archi
     storage::SheetEntry e;
     e.iso_clause = m.iso_clause, e.name = m.name, e.label = m.label.empty() ? m.name : m.label, e.kind = m.kind;
     e.value_mm = m.value_mm;
-    e.flagged = m.geometry.value("crosses_filled_hole", false);
+    // Scans archived before "estimated" existed flag every line over filled skin.
+    e.flagged = m.geometry.value("estimated", m.geometry.value("crosses_filled_hole", false));
     e.source = m.source == "user" ? "saved by " + m.created_by : "automatic";
     if (m.geometry.contains("path") && m.geometry["path"].is_array())
       for (const auto& p : m.geometry["path"])

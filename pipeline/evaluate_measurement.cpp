@@ -29,8 +29,6 @@ StatusOr<Eigen::Vector3d> vec3(const nlohmann::json& j, const std::string& field
   return p;
 }
 
-bool crosses_fill(float min_confidence) { return min_confidence < 0.5f; }
-
 }  // namespace
 
 StatusOr<Plane> request_plane(const nlohmann::json& request) {
@@ -75,7 +73,6 @@ StatusOr<nlohmann::json> evaluate_measurement(const TriangleMesh& mesh, const nl
     ASSIGN_OR_RETURN(SurfacePath p, mesh_surface_path(mesh, a, b));
     nlohmann::json j = to_json(p, "surface length");
     j.erase("name");
-    j["crosses_filled_hole"] = crosses_fill(p.min_confidence);
     return j;
   }
   if (kind == "girth") {
@@ -96,9 +93,8 @@ StatusOr<nlohmann::json> evaluate_measurement(const TriangleMesh& mesh, const nl
                         {"loop", polyline_json(g.loop)},
                         {"loop_length_mm", g.loop_length_mm},
                         {"loops_cut", g.loops_cut},
-                        {"min_confidence", g.min_confidence},
-                        {"crosses_filled_hole", crosses_fill(g.min_confidence)},
                         {"algorithm", kGirthAlgorithm}};
+    add_fill_fields(g.min_confidence, g.fill_bound_mm, &j);
     if (near) j["near"] = point_json(*near);
     return j;
   }
@@ -107,18 +103,19 @@ StatusOr<nlohmann::json> evaluate_measurement(const TriangleMesh& mesh, const nl
     ASSIGN_OR_RETURN(Eigen::Vector3d a, vec3(request, "from"));
     ASSIGN_OR_RETURN(Eigen::Vector3d b, vec3(request, "to"));
     ASSIGN_OR_RETURN(Arc arc, mesh_arc(mesh, plane, a, b));
-    return nlohmann::json{{"kind", "arc"},
-                          {"value_mm", arc.value_mm},
-                          {"other_way_mm", arc.other_way_mm},
-                          {"from", point_json(a)},
-                          {"to", point_json(b)},
-                          {"path", polyline_json(arc.path)},
-                          {"closed", false},
-                          {"plane", plane_json(plane)},
-                          {"girth_mm", arc.girth.value_mm},
-                          {"min_confidence", arc.girth.min_confidence},
-                          {"crosses_filled_hole", crosses_fill(arc.girth.min_confidence)},
-                          {"algorithm", kGirthAlgorithm}};
+    nlohmann::json j = {{"kind", "arc"},
+                        {"value_mm", arc.value_mm},
+                        {"other_way_mm", arc.other_way_mm},
+                        {"from", point_json(a)},
+                        {"to", point_json(b)},
+                        {"path", polyline_json(arc.path)},
+                        {"closed", false},
+                        {"plane", plane_json(plane)},
+                        {"girth_mm", arc.girth.value_mm},
+                        {"algorithm", kGirthAlgorithm}};
+    // The whole loop's: the arc covers part of it, so this is an upper bound.
+    add_fill_fields(arc.girth.min_confidence, arc.girth.fill_bound_mm, &j);
+    return j;
   }
   return invalid_argument("'kind' must be girth, arc, surface or distance");
 }

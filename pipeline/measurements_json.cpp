@@ -25,6 +25,14 @@ nlohmann::json plane_json(const Plane& plane) {
           {"normal", nlohmann::json::array({plane.normal.x(), plane.normal.y(), plane.normal.z()})}};
 }
 
+void add_fill_fields(float min_confidence, const std::optional<double>& fill_bound_mm, nlohmann::json* j) {
+  const bool crosses = min_confidence < kMeasuredConfidence;
+  (*j)["min_confidence"] = min_confidence;
+  (*j)["crosses_filled_hole"] = crosses;
+  (*j)["fill_bound_mm"] = fill_bound_mm ? nlohmann::json(crosses ? *fill_bound_mm : 0.0) : nlohmann::json();
+  (*j)["estimated"] = crosses && (!fill_bound_mm || *fill_bound_mm > kEstimateThresholdMm);
+}
+
 nlohmann::json measurements_document(const std::string& file, const std::string& kind) {
   return {{"schema", kMeasurementsSchema}, {"file", file}, {"kind", kind}, {"measurements", nlohmann::json::array()}};
 }
@@ -39,12 +47,11 @@ nlohmann::json to_json(const BodyMeasurement& m) {
                       {"closed", m.closed},
                       {"landmarks", m.landmarks},
                       {"definition", m.definition},
-                      {"min_confidence", m.min_confidence},
-                      {"crosses_filled_hole", m.crosses_filled_hole()},
                       {"algorithm", std::string(kBodyMeasurementsAlgorithm) + "/" +
                                         (m.kind == "girth" && m.plane                 ? kGirthAlgorithm
                                          : m.kind == "height" || m.kind == "distance" ? "straight-1"
                                                                                       : kSurfaceAlgorithm)}};
+  add_fill_fields(m.min_confidence, m.fill_bound_mm, &j);
   if (m.plane) j["plane"] = plane_json(*m.plane);
   if (!m.loop.empty()) j["loop"] = polyline_json(m.loop);
   if (!m.posture_assumed.empty()) {
@@ -86,17 +93,17 @@ void add_body_measurements(const BodyMeasurements& body, nlohmann::json* documen
 }
 
 nlohmann::json to_json(const SurfacePath& p, const std::string& name) {
-  return {{"name", name},
-          {"kind", "surface_length"},
-          {"value_mm", p.value_mm},
-          {"straight_mm", p.straight_mm},
-          {"from", point_json(p.from)},
-          {"to", point_json(p.to)},
-          {"path", polyline_json(p.path)},
-          {"closed", false},
-          {"min_confidence", p.min_confidence},
-          {"crosses_filled_hole", p.min_confidence < 0.5f},
-          {"algorithm", kSurfaceAlgorithm}};
+  nlohmann::json j = {{"name", name},
+                      {"kind", "surface_length"},
+                      {"value_mm", p.value_mm},
+                      {"straight_mm", p.straight_mm},
+                      {"from", point_json(p.from)},
+                      {"to", point_json(p.to)},
+                      {"path", polyline_json(p.path)},
+                      {"closed", false},
+                      {"algorithm", kSurfaceAlgorithm}};
+  add_fill_fields(p.min_confidence, p.fill_bound_mm, &j);
+  return j;
 }
 
 }  // namespace bodyscan::pipeline

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 
 #include "recon/measure/body_measurements.hpp"
@@ -20,6 +21,12 @@ inline constexpr const char* kSurfaceAlgorithm = "surface/geodesic-funnel-2";
 nlohmann::json point_json(const Eigen::Vector3d& p);
 nlohmann::json polyline_json(const std::vector<Eigen::Vector3d>& points);
 nlohmann::json plane_json(const Plane& plane);
+
+// What filled-in skin does to a value (recon/measure/fill_bound.hpp):
+// "min_confidence", "crosses_filled_hole", "fill_bound_mm" (how far the fill
+// could move it; null where not known) and "estimated" (by more than
+// kEstimateThresholdMm, or by an amount not known).
+void add_fill_fields(float min_confidence, const std::optional<double>& fill_bound_mm, nlohmann::json* j);
 
 // A document with no measurements yet: schema, file, kind ("mesh" or "points").
 nlohmann::json measurements_document(const std::string& file, const std::string& kind);

@@ -38,6 +38,7 @@
 #include "recon/measure/body_frame.hpp"
 #include "recon/measure/body_posture.hpp"
 #include "recon/measure/body_slicer.hpp"
+#include "recon/measure/fill_bound.hpp"
 #include "recon/measure/girth.hpp"
 #include "recon/measure/plane_section.hpp"
 #include "recon/measure/profile.hpp"
@@ -45,10 +46,6 @@
 namespace bodyscan {
 
 inline constexpr const char* kBodyMeasurementsAlgorithm = "iso8559-auto-16";
-
-// A mesh vertex at or above this confidence is measured skin; below, hole filling
-// invented it.
-inline constexpr float kMeasuredConfidence = 0.5f;
 
 struct BodyLandmark {
   std::string name;                                    // e.g. "crotch", "armpit_left", "back_neck_point"
@@ -74,6 +71,12 @@ struct BodyMeasurement {
   std::string definition;              // how it was taken, one sentence
   float min_confidence = 1;            // lowest mesh confidence along it and at its landmarks
   bool crosses_filled_hole() const { return min_confidence < kMeasuredConfidence; }
+  // How far the skin the cameras did not see could move the value, mm
+  // (fill_bound.hpp); nullopt where that is not known.
+  std::optional<double> fill_bound_mm = 0.0;
+  // An estimate: filled skin could move it by more than kEstimateThresholdMm, or
+  // by an amount not known.
+  bool estimated() const { return crosses_filled_hole() && (!fill_bound_mm || *fill_bound_mm > kEstimateThresholdMm); }
   // What its definition assumes of the posture ("" nothing), and whether the body
   // stood outside that (body_posture.hpp): then the value is not the standard's.
   std::string posture_assumed;

@@ -6,6 +6,8 @@
 #include <limits>
 #include <numeric>
 
+#include "recon/measure/fill_bound.hpp"
+
 namespace bodyscan {
 
 namespace {
@@ -192,6 +194,7 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
   g.loop = loops[best].points;
   g.loop_length_mm = closed_length(g.loop);
   g.min_confidence = *std::min_element(loops[best].confidence.begin(), loops[best].confidence.end());
+  g.fill_bound_mm = filled_stretch_excess_mm(g.loop, loops[best].confidence, true);
   // Loops that cross the one meant are the same part: a reconstructed surface that
   // passes through itself (a hole's fill through the skin) cuts one ankle as two
   // overlapping loops, and the tape goes round both (drop_nested_loops may have
@@ -213,6 +216,8 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
     for (size_t i = 0; i < closed.size(); ++i) {
       if (!taken[i] || meant[i]) continue;
       crossing.insert(crossing.end(), closed[i].points.begin(), closed[i].points.end());
+      if (*std::min_element(closed[i].confidence.begin(), closed[i].confidence.end()) < kMeasuredConfidence)
+        g.fill_bound_mm.reset();
       g.min_confidence =
           std::min(g.min_confidence, *std::min_element(closed[i].confidence.begin(), closed[i].confidence.end()));
     }

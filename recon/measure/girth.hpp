@@ -29,7 +29,10 @@ struct Girth {
   std::vector<Eigen::Vector3d> tape;  // the hull's corners in order: the tape's path
   double loop_length_mm = 0;          // along the skin, hollows followed
   float min_confidence = 1;           // lowest mesh confidence along the loop (1: all measured)
-  size_t loops_cut = 0;               // how many loops the plane cut (arms, legs, torso...)
+  // How far filled skin under the loop could move the tape (fill_bound.hpp);
+  // nullopt where that is not known (the tape goes round crossing loops too).
+  std::optional<double> fill_bound_mm = 0.0;
+  size_t loops_cut = 0;  // how many loops the plane cut (arms, legs, torso...)
 };
 
 // The girth in `plane` around the closed section loop that encircles `near` (a

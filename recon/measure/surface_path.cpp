@@ -8,6 +8,7 @@
 #include <queue>
 
 #include "recon/geometry/mesh_distance.hpp"
+#include "recon/measure/fill_bound.hpp"
 
 namespace bodyscan {
 
@@ -533,8 +534,14 @@ class SurfacePaths::Impl {
              SurfacePath* out) const {
     const bool has_conf = mesh_.confidence.size() == mesh_.vertices.size();
     auto conf = [&](uint32_t v) { return has_conf ? mesh_.confidence[v] : 1.f; };
+    std::vector<float> along;  // the confidence at each point of out->path
     auto push = [&](const Eigen::Vector3d& p, float c) {
-      if (out->path.empty() || (out->path.back() - p).norm() > 1e-9) out->path.push_back(p);
+      if (out->path.empty() || (out->path.back() - p).norm() > 1e-9) {
+        out->path.push_back(p);
+        along.push_back(c);
+      } else {
+        along.back() = std::min(along.back(), c);
+      }
       out->min_confidence = std::min(out->min_confidence, c);
     };
     // Confidence at the ends: their triangles' corners (the path starts inside them).
@@ -563,6 +570,7 @@ class SurfacePaths::Impl {
       }
     }
     push(out->to, tri_conf(strip.back()));
+    out->fill_bound_mm = filled_stretch_excess_mm(out->path, along, false).value_or(0);
   }
 
   const TriangleMesh& mesh_;

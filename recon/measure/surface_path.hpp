@@ -37,6 +37,7 @@ struct SurfacePath {
   std::vector<Eigen::Vector3d> path;  // on the surface, from the first end to the second
   Eigen::Vector3d from = Eigen::Vector3d::Zero(), to = Eigen::Vector3d::Zero();  // the ends as snapped
   float min_confidence = 1;  // lowest mesh confidence along the path (1: all measured)
+  double fill_bound_mm = 0;  // how far filled skin under it could move it (fill_bound.hpp)
   size_t reroutes = 0;       // vertex re-routings step 4 made (both searches)
 };
 

@@ -50,7 +50,7 @@ std::vector<SheetEntry> sheet_entries(const BodyMeasurements& body) {
     SheetEntry e;
     e.iso_clause = m.iso_clause, e.name = m.name, e.label = m.label, e.kind = m.kind;
     e.value_mm = m.value_mm;
-    e.flagged = m.crosses_filled_hole();
+    e.flagged = m.estimated();
     e.path = m.path, e.closed = m.closed;
     out.push_back(std::move(e));
   }
@@ -180,8 +180,10 @@ StatusOr<std::string> sheet_pdf(const MeasurementSheet& sheet, const TriangleMes
     }
     if (next >= sheet.entries.size() && any_flagged) {
       cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
-      page.text(table_x, y + 6, "\u2020 passes over a part of the body the cameras did not see", 6.5);
-      page.text(table_x, y + 14, "  (the surface there is filled in); check it by hand", 6.5);
+      page.text(table_x, y + 6, "\u2020 an estimate: skin the cameras did not see (filled in) could move it", 6.5);
+      char amount[64];
+      std::snprintf(amount, sizeof amount, "  by more than %g mm; check it by hand", kEstimateThresholdMm);
+      page.text(table_x, y + 14, amount, 6.5);
     }
     cairo_set_source_rgb(cr, 0.4, 0.4, 0.4);
     page.text(kMargin, kPageH - 30, "bodyscan - 3-D body scan measurements (ISO 20685-1 scan-derived)", 6.5);

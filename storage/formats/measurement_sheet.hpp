@@ -33,7 +33,7 @@ struct SheetEntry {
   std::string label;       // for people, e.g. "Waist girth"
   std::string kind;        // "girth", "height", "surface_length", "distance", "arc"
   double value_mm = 0;
-  bool flagged = false;               // crosses a hole-filled (invented) region of the surface
+  bool flagged = false;               // an estimate: filled-in skin could move it past kEstimateThresholdMm
   std::string source = "automatic";   // or "saved by <user>"
   std::vector<Eigen::Vector3d> path;  // what to draw on the silhouettes (mm)
   bool closed = false;

@@ -88,6 +88,8 @@ TEST(MeasureCli, SurfaceLengthsAndTheAutomaticSet) {
   EXPECT_NEAR(m["straight_mm"].get<double>(), 200.0, 0.05);
   EXPECT_GE(m["path"].size(), 2u);
   EXPECT_EQ(m["crosses_filled_hole"], false);
+  EXPECT_EQ(m["fill_bound_mm"], 0.0);
+  EXPECT_EQ(m["estimated"], false);
 
   // The whole set on the shipped demo body: the document the scan job writes.
   const std::string body = BODYSCAN_SOURCE_DIR "/hw/sim/bodies/male_average.ply";

@@ -2449,6 +2449,10 @@ export interface components {
             path?: number[][];
             closed?: boolean;
             crosses_filled_hole?: boolean;
+            /** @description how far skin the cameras did not see (filled in) could move the value, mm: along the line, each filled stretch's length beyond the straight chord between the seen skin either side; at a landmark on filled skin, its offset from the nearest seen skin in the direction the value is read (docs/measurements.md); null where not known */
+            fill_bound_mm?: number | null;
+            /** @description an estimate: the line crosses filled-in skin that could move it by more than 2 mm (or by an amount not known) */
+            estimated?: boolean;
             algorithm?: string;
             /** @description what the definition assumes of the posture (automatic set; absent when nothing) */
             posture_assumed?: string;

@@ -59,6 +59,9 @@ std::optional<Girth> side_tape(const Ring& ring, double mid_x, Side side, bool m
     g.loop.push_back(ring.points[i]);
     flat.emplace_back(ring.points[i].x(), ring.points[i].z());
   }
+  // The tape bridges this side's unseen skin on a hull of the seen: how far the
+  // real skin could move it is not known.
+  if (g.min_confidence < kMeasuredConfidence) g.fill_bound_mm.reset();
   const std::vector<Eigen::Vector2d> hull = convex_hull(std::move(flat));
   if (hull.size() < 3) return std::nullopt;
   g.value_mm = closed_length(hull);

@@ -29,8 +29,19 @@ BodyMeasurement* MeasurementSheet::last(const std::string& name) {
 }
 
 void MeasurementSheet::add(BodyMeasurement m) {
+  // A height is read vertically at its landmark, a straight distance along its
+  // line: a landmark on filled skin moves it by its offset from the seen skin in
+  // that direction. Girths and surface lengths bring their own line's bound.
+  const bool from_landmarks = m.kind == "height" || (m.kind == "distance" && m.path.size() == 2);
+  const Eigen::Vector3d direction = m.kind == "height" ? Eigen::Vector3d::UnitY()
+                                    : from_landmarks   ? (m.path[1] - m.path[0]).normalized()
+                                                       : Eigen::Vector3d::Zero();
   for (const std::string& l : m.landmarks)
-    if (const BodyLandmark* b = out_->landmark(l)) m.min_confidence = std::min(m.min_confidence, b->confidence);
+    if (const BodyLandmark* b = out_->landmark(l)) {
+      m.min_confidence = std::min(m.min_confidence, b->confidence);
+      if (from_landmarks && b->confidence < kMeasuredConfidence && m.fill_bound_mm)
+        *m.fill_bound_mm += landmark_fill_offset_mm(body_, b->position, direction);
+    }
   out_->measurements.push_back(std::move(m));
 }
 
@@ -67,6 +78,7 @@ void MeasurementSheet::girth(const std::string& name, const std::string& label, 
   m.landmarks = std::move(landmarks);
   m.definition = definition;
   m.min_confidence = g->min_confidence;
+  m.fill_bound_mm = g->fill_bound_mm;
   add(std::move(m));
 }
 
@@ -84,6 +96,7 @@ void MeasurementSheet::surface(const std::string& name, const std::string& label
     }
     m.value_mm += p->value_mm;
     m.min_confidence = std::min(m.min_confidence, p->min_confidence);
+    *m.fill_bound_mm += p->fill_bound_mm;
     m.path.insert(m.path.end(), p->path.begin() + (m.path.empty() ? 0 : 1), p->path.end());
   }
   m.landmarks = std::move(landmarks);

@@ -5,7 +5,7 @@ import { preferredUnit } from '../units.js';
 import { unitSelect } from '../ui/unit-select.js';
 import { clear, errorText, h, when } from '../ui/dom.js';
 import { BodyView } from '../viewer/body-view.js';
-import { COLOURS, drawMeasurement, measurementTable } from '../viewer/measurement-table.js';
+import { COLOURS, drawMeasurement, measurementTable, tableLegend } from '../viewer/measurement-table.js';
 
 export async function mount(container, { a, b }) {
   let unit = preferredUnit();
@@ -87,6 +87,7 @@ export async function mount(container, { a, b }) {
           render();
         },
       }),
+      tableLegend(rows),
     );
   }
   try {

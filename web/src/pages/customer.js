@@ -8,7 +8,7 @@ import { unitSelect } from '../ui/unit-select.js';
 import { clear, errorText, h } from '../ui/dom.js';
 import { customerLocale, customerWords, formatWhen } from '../i18n.js';
 import { BodyView } from '../viewer/body-view.js';
-import { COLOURS, drawMeasurement, measurementTable } from '../viewer/measurement-table.js';
+import { COLOURS, drawMeasurement, isEstimate, measurementTable } from '../viewer/measurement-table.js';
 
 export async function mount(container, { token }) {
   const t0 = performance.now();
@@ -170,7 +170,7 @@ function render(container, { token, pin, share, locale, t0, unit }, onLocale, on
             },
           })
         : h('p', { class: 'muted' }, words.noMeasurements),
-      share.measurements.some((m) => m.geometry?.crosses_filled_hole) ? h('p', { class: 'estimated-note' }, words.estimated) : null,
+      share.measurements.some((m) => isEstimate(m.geometry || {})) ? h('p', { class: 'estimated-note' }, words.estimated) : null,
     );
   }
   renderTable();

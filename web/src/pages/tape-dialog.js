@@ -12,7 +12,7 @@ import { errorText, h, toast } from '../ui/dom.js';
  * @param {string} scanId
  * @param {StoredMeasurement[]} measurements the scan's; the automatic ones are offered
  * @param {string} unit as the viewer shows lengths
- * @param {string} username the default for who measured
+ * @param {string} username who measured, unless the scan has readings already
  */
 export async function tapeDialog(scanId, measurements, unit, username) {
   const automatic = measurements.filter((m) => m.source === 'automatic');
@@ -24,8 +24,9 @@ export async function tapeDialog(scanId, measurements, unit, username) {
     toast(`The tape measurements did not load: ${errorText(e)}`, 'error');
     return null;
   }
-  const step = (1 / UNITS[unit].perMm / 10 ** UNITS[unit].digits).toPrecision(3);
-  const who = h('input', { name: 'measured_by', required: true, maxlength: 200, value: username, autocomplete: 'name' });
+  // Whoever took this scan's readings so far, else the user.
+  const earlier = [...entered.values()].at(-1);
+  const who = h('input', { name: 'measured_by', required: true, maxlength: 200, value: earlier ? earlier.measured_by : username, autocomplete: 'name' });
   const error = h('p', { class: 'form-error', role: 'alert' });
   const rows = automatic.map((m) => {
     const before = entered.get(m.name);
@@ -33,9 +34,10 @@ export async function tapeDialog(scanId, measurements, unit, username) {
       type: 'number',
       name: m.name,
       class: 'short',
-      min: String(convert(1, unit)),
+      // Any reading (a tape's 0.5 cm too); the server keeps it within 1 mm to 3 m.
+      min: '0',
       max: String(convert(3000, unit)),
-      step,
+      step: 'any',
       inputmode: 'decimal',
       value: before ? convert(before.value_mm, unit).toFixed(UNITS[unit].digits) : '',
       'aria-label': `${m.label} by tape, ${UNITS[unit].label}`,

@@ -6,7 +6,7 @@ import { unitSelect } from '../ui/unit-select.js';
 import { clear, confirmDialog, errorText, h, toast, when } from '../ui/dom.js';
 import { BodyView, ModelDecoding } from '../viewer/body-view.js';
 import { MeasureTool, TOOLS } from '../viewer/measure-tool.js';
-import { arcEndsMoved, COLOURS, drawMeasurement, KIND_LABEL, measurementTable, sideShowing, slug } from '../viewer/measurement-table.js';
+import { arcEndsMoved, COLOURS, drawMeasurement, fillBoundText, isEstimate, KIND_LABEL, measurementTable, sideShowing, slug, tableLegend } from '../viewer/measurement-table.js';
 import { postureCard } from '../viewer/posture.js';
 import { avatarDialog } from './avatar-dialog.js';
 import { shareDialog } from './share-dialog.js';
@@ -175,13 +175,16 @@ export async function mount(container, { id }, ctx) {
     clear(
       tableBox,
       state.measurements.length
-        ? measurementTable({
-            measurements: state.measurements,
-            unit: state.unit,
-            selected: state.selected,
-            onSelect: (m) => select(m),
-            onDelete: ctx.can.saveMeasurements(role) ? (m) => removeMeasurement(m) : null,
-          })
+        ? [
+            measurementTable({
+              measurements: state.measurements,
+              unit: state.unit,
+              selected: state.selected,
+              onSelect: (m) => select(m),
+              onDelete: ctx.can.saveMeasurements(role) ? (m) => removeMeasurement(m) : null,
+            }),
+            tableLegend(state.measurements),
+          ]
         : h('p', { class: 'muted' }, 'No measurements yet.'),
     );
   }
@@ -248,7 +251,7 @@ export async function mount(container, { id }, ctx) {
     clear(
       resultBox,
       h('p', { class: 'result-value', dataset: { valueMm: String(r.value_mm) } }, h('strong', {}, formatLength(r.value_mm, state.unit)), ` ${KIND_LABEL[r.kind] || r.kind}`),
-      r.crosses_filled_hole ? h('p', { class: 'badge warn' }, 'crosses skin the cameras did not see') : null,
+      isEstimate(r) ? h('p', { class: 'badge warn' }, `an estimate: skin the cameras did not see could move it ${fillBoundText(r, state.unit)}`) : null,
       arcNote(r),
       canSave
         ? h(

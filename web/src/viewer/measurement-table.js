@@ -13,7 +13,46 @@ export const KIND_LABEL = {
   arc: 'along tape',
 };
 
-export const FILLED_NOTE = 'Part of this line crosses skin the cameras did not see (filled in by the reconstruction): check it with a tape if it matters.';
+// Values within this of their reading whatever the filled-in skin under them is
+// are not marked (the server's kEstimateThresholdMm, recon/measure/fill_bound.hpp).
+export const ESTIMATE_THRESHOLD_MM = 2;
+
+export const FILLED_NOTE = `An estimate: skin the cameras did not see (filled in by the reconstruction) lies under its line and could move it by about the amount shown; check it with a tape if it matters.`;
+
+/**
+ * Whether a value is an estimate: the server says so, or (scans archived before it
+ * did) its line crosses filled-in skin at all.
+ * @param {{ estimated?: boolean, crosses_filled_hole?: boolean }} g the measurement's geometry
+ */
+export function isEstimate(g) {
+  return g.estimated ?? !!g.crosses_filled_hole;
+}
+
+/**
+ * "±6 mm", "±0.6 cm"; "±?" where the server could not say how much.
+ * @param {{ fill_bound_mm?: number | null }} g
+ * @param {string} unit
+ */
+export function fillBoundText(g, unit) {
+  return typeof g.fill_bound_mm === 'number' ? `±${formatLength(g.fill_bound_mm, unit)}` : '±?';
+}
+
+/**
+ * What the marks in a table of `measurements` mean, in sight under it (a tooltip
+ * is out of reach on a touch screen); null when no row carries one.
+ * @param {StoredMeasurement[]} measurements
+ */
+export function tableLegend(measurements) {
+  const estimates = measurements.some((m) => isEstimate(m.geometry || {}));
+  const posture = measurements.some((m) => (m.geometry || {}).outside_posture);
+  if (!estimates && !posture) return null;
+  return h(
+    'dl',
+    { class: 'table-legend' },
+    estimates ? [h('dt', {}, '≈ ±x'), h('dd', {}, `an estimate: skin the cameras did not see lies under its line and could move it by about x. Values it could move by ${ESTIMATE_THRESHOLD_MM} mm or less are not marked.`)] : null,
+    posture ? [h('dt', {}, '⚑'), h('dd', {}, 'taken outside the posture its definition assumes: not the standard’s value.')] : null,
+  );
+}
 
 export const POSTURE_NOTE = 'Taken outside the posture its definition assumes (see Posture): not the standard’s value.';
 
@@ -127,7 +166,7 @@ const has = (m) => Number.isFinite(m.value_mm);
  * @param {string} [options.caption]
  * @param {Record<string, string>} [options.groups] the heading of each source's rows
  * @param {boolean} [options.plain] the customer's table: plain names (`plain_label`), no kinds or
- *   clauses, no posture flag, a line that crosses filled-in skin starred (the page says why in a sentence)
+ *   clauses, no posture flag, an estimate starred (the page says why in a sentence)
  * @param {string} [options.locale] the values' decimal mark and the headings' language
  * @param {[string, string]} [options.headings] the name and value columns' headings
  */
@@ -170,8 +209,9 @@ export function measurementTable({
       'td',
       { class: 'num value' },
       g.outside_posture && !plain ? h('span', { class: 'posture-flag', title: POSTURE_NOTE, 'aria-label': POSTURE_NOTE }, '⚑ ') : null,
-      g.crosses_filled_hole && !plain ? h('span', { class: 'filled', title: FILLED_NOTE }, '≈ ') : null,
+      isEstimate(g) && !plain ? h('span', { class: 'filled', title: FILLED_NOTE }, '≈ ') : null,
       has(m) ? formatLength(m.value_mm, unit, { locale }) : '—',
+      isEstimate(g) && !plain && has(m) ? h('small', { class: 'fill-bound', 'aria-label': `could be off by ${fillBoundText(g, unit).slice(1)}` }, fillBoundText(g, unit)) : null,
     );
     const otherCell = compareWith ? h('td', { class: 'num' }, other ? formatLength(other.value_mm, unit) : '—') : null;
     const row = h(
@@ -194,7 +234,7 @@ export function measurementTable({
         {},
         h('span', { class: 'm-label' }, (plain && m.plain_label) || m.label || m.name),
         plain
-          ? g.crosses_filled_hole
+          ? isEstimate(g)
             ? h('span', { class: 'estimated' }, ' *')
             : null
           : h('small', { class: 'muted' }, ` ${KIND_LABEL[m.kind] || m.kind}${m.iso_clause ? ` · ISO ${m.iso_clause}` : ''}`),

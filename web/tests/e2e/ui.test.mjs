@@ -457,6 +457,13 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     const scanPath = new URL(page.url()).pathname;
     const values = await page.evaluate(async (path) => (await (await fetch(`/api${path}/measurements`)).json()).measurements, scanPath);
     const waist = values.find((m) => m.name === 'waist_girth');
+    // The estimates, and only they, carry "≈" with how far the fill could move them;
+    // the legend under the table says what that means.
+    const estimates = values.filter((m) => m.geometry.estimated);
+    assert.equal(await page.locator('.table-box table.measurements .filled').count(), estimates.length);
+    for (const m of estimates) assert.match(await page.locator(`tr[data-name=${m.name}] .fill-bound`).innerText(), /^±(\d|\?)/);
+    assert.equal(await page.locator('.table-box .table-legend').count(), estimates.length > 0 ? 1 : 0);
+    assert.ok(values.every((m) => m.geometry.estimated === (m.geometry.crosses_filled_hole && (m.geometry.fill_bound_mm === null || m.geometry.fill_bound_mm > 2))), 'estimated: over filled skin that could move it more than 2 mm');
     await page.click('button:has-text("Tape measurements")');
     const dialog = page.locator('dialog[open]');
     await dialog.locator('input[name=measured_by]').fill('Ada Tailor');
@@ -662,7 +669,8 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     // Two scans of one body on one rig: the waist agrees within 2 cm, and each is
     // within 3 cm of the true body's (every 6th laser step is a coarse scan).
     // In the order of the bodies: the earlier scan's value, then the later's.
-    const [earlier, later] = [cells[1], cells[2]].map((t) => Number(t.replace(/[^0-9.]/g, '')));
+    // (A value's first number: an estimate's "±x" follows it.)
+    const [earlier, later] = [cells[1], cells[2]].map((t) => Number(t.match(/\d+(\.\d+)?/)[0]));
     assert.match(await page.locator('table.measurements thead th').nth(1).innerText(), /^Earlier/);
     assert.match(cells[3], /\d/, `the change, later − earlier: ${cells.join(' | ')}`);
     // The earlier scan's saved line is there too, without a later value.
