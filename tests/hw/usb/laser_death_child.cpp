@@ -15,21 +15,22 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
-#include <iterator>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include "hw/safety.hpp"
 #include "hw/usb/tmcl_controller.hpp"
 #include "tests/deaths.hpp"
+#include "tests/hw/usb/laser_deaths.hpp"
 #include "tests/hw/usb/tmcl_rig.hpp"
 
 namespace {
 
+using bodyscan::hw::testing::Death;
 using bodyscan::testing::overflow_stack;
 
 // No core files; and a main-thread stack that overflows at 8 MiB even where the
@@ -53,21 +54,11 @@ int main(int argc, char** argv) {
   }
   const std::string port = argv[1];
   const int watchdog_ms = std::atoi(argv[2]);
-  const std::string death = argv[3];
+  const std::optional<Death> death = bodyscan::hw::testing::parse_death(argv[3]);
   const int ready = std::atoi(argv[4]);
   const int go = std::atoi(argv[5]);
-  static const char* const kDeaths[] = {"segfault",
-                                        "abort",
-                                        "terminate",
-                                        "sigterm",
-                                        "sigint",
-                                        "sigkill",
-                                        "sighup",
-                                        "stack-overflow",
-                                        "stack-overflow-on-rig-thread",
-                                        "stack-overflow-on-other-thread"};
-  if (std::find(std::begin(kDeaths), std::end(kDeaths), death) == std::end(kDeaths)) {
-    std::fprintf(stderr, "laser_death_child: no death called '%s'\n", death.c_str());
+  if (!death) {
+    std::fprintf(stderr, "laser_death_child: no death called '%s'\n", argv[3]);
     return 2;
   }
   limit_resources();
@@ -81,13 +72,13 @@ int main(int argc, char** argv) {
     char wait_for_parent = 0;
     (void)!read(go, &wait_for_parent, 1);
   };
-  if (death == "stack-overflow-on-rig-thread") {
+  if (*death == Death::kStackOverflowOnRigThread) {
     // The thread that switched the laser on overflows.
     std::thread([&] {
       switch_on_and_wait();
       overflow_stack(0);
     }).join();
-  } else if (death == "stack-overflow-on-other-thread") {
+  } else if (*death == Death::kStackOverflowOnOtherThread) {
     // A thread that never touched the rig, but asked for an alternate stack.
     switch_on_and_wait();
     std::thread([] {
@@ -97,9 +88,9 @@ int main(int argc, char** argv) {
   } else {
     switch_on_and_wait();
   }
-  if (death == "segfault") raise(SIGSEGV);
-  if (death == "abort") std::abort();
-  if (death == "terminate") std::terminate();
-  if (death == "stack-overflow") overflow_stack(0);
+  if (*death == Death::kSegfault) raise(SIGSEGV);
+  if (*death == Death::kAbort) std::abort();
+  if (*death == Death::kTerminate) std::terminate();
+  if (*death == Death::kStackOverflow) overflow_stack(0);
   for (;;) pause();  // the signal deaths: the test sends the signal
 }

@@ -21,6 +21,7 @@
 #include "hw/usb/serial_link.hpp"
 #include "hw/usb/sim_tmcl_board.hpp"
 #include "hw/usb/tmcl_controller.hpp"
+#include "tests/hw/usb/laser_deaths.hpp"
 #include "tests/hw/usb/tmcl_rig.hpp"
 
 namespace bodyscan::hw::usb {
@@ -28,33 +29,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-enum class Death {
-  kSegfault,
-  kAbort,
-  kTerminate,
-  kSigterm,
-  kSigint,
-  kSigkill,
-  kSighup,
-  kStackOverflow,               // on the main thread, which installed the handlers
-  kStackOverflowOnRigThread,    // on a thread that switched the laser on
-  kStackOverflowOnOtherThread,  // on a thread that asked for an alternate stack
-};
-
-// The child's name for each death (tests/hw/usb/laser_death_child.cpp).
-const char* child_death(Death death) {
-  static const char* const names[] = {"segfault",
-                                      "abort",
-                                      "terminate",
-                                      "sigterm",
-                                      "sigint",
-                                      "sigkill",
-                                      "sighup",
-                                      "stack-overflow",
-                                      "stack-overflow-on-rig-thread",
-                                      "stack-overflow-on-other-thread"};
-  return names[static_cast<int>(death)];
-}
+using testing::Death;
 
 // Starts the child (fork, then only exec in it: this process has threads), waits
 // up to a minute for it to switch the laser on, lets it die and returns its wait
@@ -64,7 +39,7 @@ int run_child(const std::string& port, int watchdog_ms, Death death, SimTmclBoar
   int ready[2], go[2];
   if (pipe(ready) != 0 || pipe(go) != 0) return -1;
   const std::string args[] = {LASER_DEATH_CHILD,           port,
-                              std::to_string(watchdog_ms), child_death(death),
+                              std::to_string(watchdog_ms), testing::death_name(death),
                               std::to_string(ready[1]),    std::to_string(go[0])};
   char* argv[std::size(args) + 1] = {};
   for (size_t i = 0; i < std::size(args); ++i) argv[i] = const_cast<char*>(args[i].c_str());
