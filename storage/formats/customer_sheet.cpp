@@ -228,13 +228,9 @@ StatusOr<std::string> customer_sheet_pdf(const CustomerSheet& sheet, const Trian
   cairo_set_source_rgb(cr, 0.45, 0.45, 0.45);
   page.text(kMargin, kPageH - 28, w.footer + (sheet.shop_name.empty() ? "" : " · " + sheet.shop_name), 7);
 
-  cairo_destroy(cr);
-  cairo_surface_finish(surface);
-  const cairo_status_t status = cairo_surface_status(surface);
-  cairo_surface_destroy(surface);
+  const Status finished = drawing::finish_pdf(cr, surface, "sheet");
   if (!drawn.ok()) return drawn;
-  if (status != CAIRO_STATUS_SUCCESS)
-    return internal_error(std::string("sheet: Cairo failed: ") + cairo_status_to_string(status));
+  if (!finished.ok()) return finished;
   return out;
 }
 

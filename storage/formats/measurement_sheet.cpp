@@ -190,12 +190,8 @@ StatusOr<std::string> sheet_pdf(const MeasurementSheet& sheet, const TriangleMes
     ++page_no;
   } while (next < sheet.entries.size());
 
-  cairo_destroy(cr);
-  cairo_surface_finish(surface);
-  const cairo_status_t status = cairo_surface_status(surface);
-  cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS)
-    return internal_error(std::string("sheet: Cairo failed: ") + cairo_status_to_string(status));
+  const Status finished = drawing::finish_pdf(cr, surface, "sheet");
+  if (!finished.ok()) return finished;
   return out;
 }
 

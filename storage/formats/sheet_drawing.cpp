@@ -85,6 +85,16 @@ cairo_status_t append_to_string(void* closure, const unsigned char* data, unsign
   return CAIRO_STATUS_SUCCESS;
 }
 
+Status finish_pdf(cairo_t* cr, cairo_surface_t* surface, const char* what) {
+  cairo_destroy(cr);
+  cairo_surface_finish(surface);
+  const cairo_status_t status = cairo_surface_status(surface);
+  cairo_surface_destroy(surface);
+  if (status != CAIRO_STATUS_SUCCESS)
+    return internal_error(std::string(what) + ": Cairo failed: " + cairo_status_to_string(status));
+  return Status::Ok();
+}
+
 void Page::text(double x, double y, const std::string& s, double size, bool bold, bool right) {
   cairo_select_font_face(cr_, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL,
                          bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);

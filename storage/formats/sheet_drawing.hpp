@@ -19,6 +19,10 @@ constexpr double kPageW = 595.276, kPageH = 841.89, kMargin = 40;  // A4 in poin
 // A cairo write function that appends the PDF to the std::string `closure`.
 cairo_status_t append_to_string(void* closure, const unsigned char* data, unsigned int length);
 
+// Ends a PDF drawn with `cr` on `surface` (both destroyed): Ok, or Cairo's
+// error, named with `what` ("sheet", "validation report").
+Status finish_pdf(cairo_t* cr, cairo_surface_t* surface, const char* what);
+
 class Page {
  public:
   explicit Page(cairo_t* cr) : cr_(cr) {}

@@ -147,12 +147,8 @@ StatusOr<std::string> validation_report_pdf(const nlohmann::json& report, const 
   cairo_set_source_rgb(cr, 0.45, 0.45, 0.45);
   page.text(kMargin, kPageH - 28,
             "bodyscan · one customer counts once per measurement, with their newest scan's tape value", 7);
-  cairo_destroy(cr);
-  cairo_surface_finish(surface);
-  const cairo_status_t status = cairo_surface_status(surface);
-  cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS)
-    return internal_error(std::string("validation report: Cairo failed: ") + cairo_status_to_string(status));
+  const Status finished = drawing::finish_pdf(cr, surface, "validation report");
+  if (!finished.ok()) return finished;
   return out;
 }
 
