@@ -100,8 +100,9 @@ StatusOr<ValidationReport> validate_against_tape(const storage::Archive& archive
   ValidationReport report;
   for (const auto& [key, c] : chosen) {
     const std::vector<storage::MeasurementRecord>& ms = values[c.tape->scan_id];
-    const auto m = std::find_if(ms.begin(), ms.end(), [&](const storage::MeasurementRecord& r) {
-      return r.source == "automatic" && r.name == c.tape->name;
+    const std::string& name = c.tape->name;  // a lambda may not capture a structured binding
+    const auto m = std::find_if(ms.begin(), ms.end(), [&name](const storage::MeasurementRecord& r) {
+      return r.source == "automatic" && r.name == name;
     });
     if (m == ms.end()) continue;  // a reprocessed scan without that measurement
     Gathered& g = by_name[c.tape->name];
