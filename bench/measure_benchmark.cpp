@@ -8,6 +8,7 @@
 //   measure_benchmark [--rig thesis|square|tiered|FILE]... [--body BODY.ply]... [--repeat]
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR | --saved DIR]
 //                     [--resurface] [--seed N] [--min-weight W] [--posture ARMS,FEET,TURN]
+//                     [--json OUT.json]
 //   measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body BODY.ply...
 //
 // --save writes each scan's surface, its point cloud and the posed true body as PLY
@@ -39,6 +40,11 @@
 // over surface hole filling invented, "outside posture" where the body stood
 // outside the posture the value's definition assumes (body_posture.hpp), as the
 // truth's set or the scan's reads it. The posture both sets read is printed too.
+// --json OUT.json also writes, per rig and body, the automatic set of the truth and
+// the scan value by value with the allowance and the fill's marks, the fixed
+// planes' largest difference and the repeat pair's differences; it is rewritten
+// after each body. bench/measure_table.py renders docs/benchmarks.md §7's tables
+// from it.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -49,6 +55,8 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "core/command_line.hpp"
 #include "hw/sim/scene.hpp"
@@ -130,6 +138,8 @@ std::string sway_error(const SwayEstimate& est, const std::vector<int32_t>& fram
 // surface here (the scans', the coarse one, --resurface's) is built with them.
 ReconstructOptions g_surface = pipeline::body_surface_options();
 std::string g_save;
+std::string g_json_out;
+nlohmann::json g_json = nlohmann::json::array();
 bool g_resurface = false;
 uint64_t g_seed = 1;
 // --posture: applied over every scan's rig description.
@@ -196,6 +206,33 @@ std::string posture_pair(const std::optional<double>& truth, const std::optional
   return std::string(t) + " / " + s;
 }
 
+nlohmann::json posture_json(const BodyPosture& p) {
+  auto value = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); };
+  return {{"turn_deg", p.turn_deg},
+          {"arms_deg", {value(p.arm_abduction_deg[0]), value(p.arm_abduction_deg[1])}},
+          {"ankles_mm", value(p.ankle_distance_mm)}};
+}
+
+// A body file's name without its folder and ".ply"; "demo" for the rig's own.
+std::string body_name(const std::string& path) {
+  if (path.empty()) return "demo";
+  std::string name = path.substr(path.find_last_of('/') + 1);
+  if (name.size() > 4 && name.compare(name.size() - 4, 4, ".ply") == 0) name.resize(name.size() - 4);
+  return name;
+}
+
+// Keeps a body's record (when it was measured) and rewrites --json's file, so a long
+// run leaves what it has finished; passes `rc` through.
+int finish(nlohmann::json& record, int rc) {
+  if (rc == 0) g_json.push_back(std::move(record));
+  if (!g_json_out.empty()) {
+    std::ofstream out(g_json_out);
+    out << g_json.dump(1) << "\n";
+    if (!out) std::fprintf(stderr, "--json: cannot write %s\n", g_json_out.c_str());
+  }
+  return rc;
+}
+
 const char* mark(double diff, double allow) {
   const double d = std::abs(diff);
   return d <= allow / 6 ? "aim" : d <= allow / 2 ? "must" : "FAIL";
@@ -203,8 +240,9 @@ const char* mark(double diff, double allow) {
 
 // Fixed planes, the automatic set against the truth's, and (with a second scan's
 // set) the repeatability.
+// `record` gains the --json fields.
 int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyMeasurements& scan_body, double floor,
-           const BodyMeasurements* second, double sway) {
+           const BodyMeasurements* second, double sway, nlohmann::json& record) {
   BodyMeasureOptions mo;
   mo.floor_y = floor;
   auto t0 = Clock::now();
@@ -262,6 +300,9 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
                 mark(d, 9), gs->min_confidence < 0.5f ? "  (crosses fill)" : "");
   }
   std::printf("largest fixed-plane difference %.2f mm\n", worst_fixed);
+  record["fixed_planes_largest_mm"] = worst_fixed;
+  record["posture"] = {{"truth", posture_json(tp)}, {"scan", posture_json(sp)}};
+  nlohmann::json& values = record["measurements"] = nlohmann::json::array();
 
   std::printf("\n%-24s %6s %8s %8s %7s %6s  %s\n", "automatic set", "ISO", "truth", "scan", "diff", "allow", "");
   size_t n = 0, iso = 0, must = 0, aim = 0;
@@ -272,6 +313,7 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
     const BodyMeasurement* s = scan_body.find(m.name);
     if (!s) {
       std::printf("%-24s missing on the scan\n", m.name.c_str());
+      values.push_back({{"name", m.name}, {"truth_mm", m.value_mm}, {"scan_mm", nullptr}});
       continue;
     }
     const double d = s->value_mm - m.value_mm, al = iso20685_allowance_mm(m);
@@ -284,6 +326,15 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
     unmarked_over += !s->estimated() && std::abs(d) > al;
     // Past its bound by more than half the allowance (the scan's own error on seen skin).
     marked_past_bound += s->estimated() && s->fill_bound_mm && std::abs(d) > *s->fill_bound_mm + al / 2;
+    values.push_back({{"name", m.name},
+                      {"iso_clause", m.iso_clause},
+                      {"truth_mm", m.value_mm},
+                      {"scan_mm", s->value_mm},
+                      {"allowance_mm", al},
+                      {"crosses_fill", s->crosses_filled_hole()},
+                      {"estimated", s->estimated()},
+                      {"fill_bound_mm", s->fill_bound_mm ? nlohmann::json(*s->fill_bound_mm) : nlohmann::json()},
+                      {"outside_posture", m.outside_posture || s->outside_posture}});
     char fill[48] = "";
     if (s->estimated())
       s->fill_bound_mm ? std::snprintf(fill, sizeof fill, "  (estimate, fill bound %.1f)", *s->fill_bound_mm)
@@ -312,6 +363,11 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
       if (d > worst) worst = d, worst_name = m.name;
     }
     std::sort(diffs.begin(), diffs.end());
+    record["repeat"] = {{"sway_mm", sway},
+                        {"count", diffs.size()},
+                        {"median_mm", diffs.empty() ? 0.0 : diffs[diffs.size() / 2]},
+                        {"largest_mm", worst},
+                        {"largest", worst_name}};
     std::printf("\nrepeatability (seed +1, sway %.0f mm): %zu measurements, median %.2f mm, largest %.2f mm (%s)\n",
                 sway, diffs.size(), diffs.empty() ? 0.0 : diffs[diffs.size() / 2], worst, worst_name.c_str());
     for (const BodyMeasurement& m : scan_body.measurements)
@@ -330,7 +386,8 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
   auto t0 = Clock::now();
   auto a = scan(rig, body, g_seed, 0, every);
   if (!a.ok()) return std::fprintf(stderr, "scan: %s\n", a.status().message().c_str()), 1;
-  std::printf("scan job %.0f s, mesh %zu triangles\n", secs(t0), a->mesh.triangles.size());
+  const double scan_seconds = secs(t0);
+  std::printf("scan job %.0f s, mesh %zu triangles\n", scan_seconds, a->mesh.triangles.size());
   const std::string stem =
       g_save + "/" + (body.empty() ? std::string("demo") : body.substr(body.find_last_of('/') + 1));
   if (!g_save.empty()) {
@@ -364,7 +421,12 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
     if (!s->sway.empty()) std::printf("second scan's sway, as estimated: %s\n", s->sway.c_str());
     b = std::move(*s);
   }
-  return report(a->truth, a->mesh, *a->body, a->floor, b ? &*b->body : nullptr, sway);
+  nlohmann::json record = {{"rig", rig}, {"body", body_name(body)}, {"scan_seconds", scan_seconds}};
+  if (g_subject.turn_deg)
+    record["posed"] = {{"arms_deg", *g_subject.posture.arm_abduction_deg[0]},
+                       {"ankles_mm", *g_subject.posture.ankle_distance_mm},
+                       {"turn_deg", *g_subject.turn_deg}};
+  return finish(record, report(a->truth, a->mesh, *a->body, a->floor, b ? &*b->body : nullptr, sway, record));
 }
 
 // A saved scan's surface: B-scanN.ply, or with --resurface one built again from
@@ -406,7 +468,8 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
     if (!m.ok()) return std::fprintf(stderr, "second scan set: %s\n", m.status().message().c_str()), 1;
     b = std::move(*m);
   }
-  return report(*truth, *mesh, *a, floor, b ? &*b : nullptr, sway);
+  nlohmann::json record = {{"rig", rig}, {"body", body_name(body)}, {"saved", dir}};
+  return finish(record, report(*truth, *mesh, *a, floor, b ? &*b : nullptr, sway, record));
 }
 
 // How far each rule of the automatic set moves when the skin moves a little: the
@@ -479,7 +542,7 @@ int main(int argc, char** argv) {
   CommandLine cl("measure_benchmark",
                  "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
                  "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W] "
-                 "[--posture ARMS,FEET,TURN]\n"
+                 "[--posture ARMS,FEET,TURN] [--json OUT]\n"
                  "       measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body B...\n");
   cl.option("--rig", &rigs);
   cl.option("--body", &bodies);
@@ -494,6 +557,7 @@ int main(int argc, char** argv) {
   cl.option("--noise-rms", &noise_rms);
   cl.option("--noisy-out", &noisy_out);
   cl.option("--seed", &g_seed);
+  cl.option("--json", &g_json_out);
   cl.option("--min-weight", &g_surface.min_relative_weight);
   cl.option("--posture", parse_posture);
   cl.option("--fairing", [](const std::string& f) -> std::string {
