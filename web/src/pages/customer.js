@@ -52,10 +52,18 @@ export async function mount(container, { token }) {
     view = render(
       container,
       { token, pin, share, locale, t0, unit },
-      (next) => {
+      // Rejects, with the page left in the language it was in, when the labels in
+      // the other language do not load.
+      async (next) => {
+        const before = locale;
         locale = next;
+        try {
+          await show();
+        } catch (e) {
+          locale = before;
+          throw e;
+        }
         rememberLocale(next);
-        show();
       },
       (u) => {
         unit = u;
@@ -71,20 +79,34 @@ const chosenLocale = () => globalThis.localStorage?.getItem(LOCALE_KEY) || undef
 const rememberLocale = (locale) => globalThis.localStorage?.setItem(LOCALE_KEY, locale);
 
 // The page in `locale`; returns its 3-D view. `onLocale` is called with a language
-// the customer picks, `onUnit` with a unit.
+// the customer picks (the page says so if its promise rejects), `onUnit` with a unit.
 /**
  * @param {HTMLElement} container
  * @param {{ token: string, pin: string | undefined, share: import('../api.js').ShareView, locale: import('../i18n.js').Locale, t0: number, unit: string }} state
- * @param {(locale: import('../i18n.js').Locale) => void} onLocale
+ * @param {(locale: import('../i18n.js').Locale) => Promise<void>} onLocale
  * @param {(unit: string) => void} onUnit
  */
 function render(container, { token, pin, share, locale, t0, unit }, onLocale, onUnit) {
   let selected = null;
   const words = customerWords(locale);
   document.documentElement.lang = locale;
+  const languageError = h('p', { class: 'form-error', role: 'alert' });
   const languages = h(
     'select',
-    { class: 'language', 'aria-label': words.language, onchange: (e) => onLocale(customerLocale(e.target.value)) },
+    {
+      class: 'language',
+      'aria-label': words.language,
+      onchange: async (e) => {
+        const picked = customerLocale(e.target.value);
+        languageError.textContent = '';
+        try {
+          await onLocale(picked);
+        } catch (err) {
+          e.target.value = locale;
+          languageError.textContent = `${customerWords(picked).languageFailed} ${errorText(err)}`;
+        }
+      },
+    },
     h('option', { value: 'en', selected: locale === 'en', lang: 'en' }, 'English'),
     h('option', { value: 'de', selected: locale === 'de', lang: 'de' }, 'Deutsch'),
   );
@@ -122,6 +144,7 @@ function render(container, { token, pin, share, locale, t0, unit }, onLocale, on
         { class: 'customer-head' },
         h('div', { class: 'row customer-top' }, share.shop ? h('p', { class: 'shop-name' }, share.shop) : h('span'), languages),
         h('h1', {}, words.title),
+        languageError,
         h('p', { class: 'muted' }, words.taken(formatWhen(share.taken_at, locale), formatWhen(new Date(share.expires_at * 1000).toISOString(), locale))),
       ),
       h('div', { class: 'viewer-main' }, viewport, h('p', { class: 'hint' }, words.hint)),

@@ -567,6 +567,14 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.deepEqual(await accessibilityProblems(customer), [], "axe-core on the customer's page in German");
     await customer.selectOption('select.language', 'en');
     await customer.locator('h1:has-text("Your body scan")').waitFor();
+    // The other language's labels do not load: the page stays as it was and says so.
+    const refuse = (route) => route.fulfill({ status: 503, contentType: 'application/json', body: '{"error":"unavailable"}' });
+    await customer.route('**/api/share/*?locale=de', refuse);
+    await customer.selectOption('select.language', 'de');
+    await customer.locator('[role=alert]:has-text("Die Seite konnte nicht auf Deutsch umgestellt werden")').waitFor();
+    assert.equal(await customer.locator('select.language').inputValue(), 'en');
+    assert.equal(await customer.locator('h1').innerText(), 'Your body scan');
+    await customer.unroute('**/api/share/*?locale=de', refuse);
     // Nothing else: no staff API, no other scan's model, no staff page.
     const probes = await customer.evaluate(async (scan) => {
       const status = async (u) => (await fetch(u)).status;
