@@ -7,13 +7,26 @@ HttpResponse json_response(int status, const nlohmann::json& body) {
   r.status = status;
   r.body = body.dump();
   r.set("Content-Type", "application/json");
-  r.set("Cache-Control", "no-store");
+  r.set("Cache-Control", "private, no-store");
   return r;
 }
 
 HttpResponse no_content() {
   HttpResponse r;
   r.status = 204;
+  return r;
+}
+
+HttpResponse file_response(std::string body, const std::string& content_type, const std::string& filename,
+                           const char* disposition) {
+  std::string name;
+  for (const char c : filename)
+    if (c != '"' && c != '\\' && static_cast<unsigned char>(c) >= 0x20 && c != 0x7f) name += c;
+  HttpResponse r;
+  r.body = std::move(body);
+  r.set("Content-Type", content_type);
+  r.set("Content-Disposition", std::string(disposition) + "; filename=\"" + name + "\"");
+  r.set("Cache-Control", "private, no-store");
   return r;
 }
 

@@ -61,6 +61,11 @@ struct HttpResponse {
 HttpResponse json_response(int status, const nlohmann::json& body);
 // 204, no body.
 HttpResponse no_content();
+// A file for the browser to save ("attachment") or to show ("inline"): the body,
+// its media type, the name it is saved under (quotes and control characters
+// dropped), and cached nowhere (every export holds personal data).
+HttpResponse file_response(std::string body, const std::string& content_type, const std::string& filename,
+                           const char* disposition = "attachment");
 // {"error": {"status": 409, "code": "conflict", "message": "..."}}.
 HttpResponse error_response(int status, const std::string& message);
 // A Status's HTTP status: invalid argument 400, not found 404, failed

@@ -130,24 +130,20 @@ HttpResponse sheet(Workstation& ws, const Call& call, const std::string& format)
   const std::string& id = call.params.at("id");
   auto s = pipeline::archived_sheet(ws.archive(), id);
   if (!s.ok()) return error_response(s.status());
-  HttpResponse out;
+  std::string body, type;
   if (format == "csv") {
-    out.body = storage::profile_csv(*s, *profile, *unit);
-    out.set("Content-Type", "text/csv; charset=utf-8");
+    body = storage::profile_csv(*s, *profile, *unit), type = "text/csv; charset=utf-8";
   } else if (format == "json") {
-    out.body = storage::sheet_json(*s, *unit).dump(1);
-    out.set("Content-Type", "application/json");
+    body = storage::sheet_json(*s, *unit).dump(1), type = "application/json";
   } else {
     auto mesh = ws.surface(id);
     const TriangleMesh empty;
     auto pdf = storage::sheet_pdf(*s, mesh.ok() ? **mesh : empty, *unit);
     if (!pdf.ok()) return error_response(pdf.status());
-    out.body = std::move(*pdf);
-    out.set("Content-Type", "application/pdf");
+    body = std::move(*pdf), type = "application/pdf";
   }
   const std::string suffix = profile->id == "sheet" ? "measurements" : profile->id;
-  out.set("Content-Disposition", "attachment; filename=\"" + id + "-" + suffix + "." + format + "\"");
-  out.set("Cache-Control", "no-store");
+  HttpResponse out = file_response(std::move(body), type, id + "-" + suffix + "." + format);
   ws.archive().log(call.actor(), "export sheet", "scan", id,
                    profile->id == "sheet" ? format : format + ", " + profile->id);
   return out;
@@ -178,11 +174,9 @@ HttpResponse avatar(Workstation& ws, const Call& call, pipeline::AvatarFormat fo
   auto a = pipeline::make_avatar(**mesh, options);
   if (!a.ok()) return error_response(a.status());
   const char* ext = format == pipeline::AvatarFormat::kObj ? "obj" : "glb";
-  HttpResponse out;
-  out.body = std::move(a->bytes);
-  out.set("Content-Type", format == pipeline::AvatarFormat::kObj ? "model/obj" : "model/gltf-binary");
-  out.set("Content-Disposition", "attachment; filename=\"" + id + "-avatar." + ext + "\"");
-  out.set("Cache-Control", "no-store");
+  HttpResponse out =
+      file_response(std::move(a->bytes), format == pipeline::AvatarFormat::kObj ? "model/obj" : "model/gltf-binary",
+                    id + "-avatar." + ext);
   out.set("X-Avatar-Triangles", std::to_string(a->triangles));
   out.set("X-Avatar-Closed", a->closed ? "true" : "false");
   char deviation[32];

@@ -81,11 +81,7 @@ HttpResponse customer_sheet(Workstation& ws, const Call& call, const ApiOptions&
   if (!mesh.ok()) return error_response(mesh.status());
   auto pdf = storage::customer_sheet_pdf(sheet, *mesh, *unit);
   if (!pdf.ok()) return error_response(pdf.status());
-  HttpResponse out;
-  out.body = std::move(*pdf);
-  out.set("Content-Type", "application/pdf");
-  out.set("Content-Disposition", "inline; filename=\"body-measurements.pdf\"");
-  out.set("Cache-Control", "private, no-store");
+  HttpResponse out = file_response(std::move(*pdf), "application/pdf", "body-measurements.pdf", "inline");
   out.set("Referrer-Policy", "no-referrer");
   return out;
 }

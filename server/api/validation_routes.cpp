@@ -69,11 +69,7 @@ void add_validation_routes(std::vector<Api::Route>* routes, const ApiOptions& op
          auto pdf =
              storage::validation_report_pdf(pipeline::to_json(*report), shop, storage::iso8601_utc(std::time(nullptr)));
          if (!pdf.ok()) return error_response(pdf.status());
-         HttpResponse out;
-         out.body = std::move(*pdf);
-         out.set("Content-Type", "application/pdf");
-         out.set("Content-Disposition", "attachment; filename=\"validation-iso-20685-1.pdf\"");
-         out.set("Cache-Control", "no-store");
+         HttpResponse out = file_response(std::move(*pdf), "application/pdf", "validation-iso-20685-1.pdf");
          ws.archive().log(call.actor(), "export validation report", "archive", "", "pdf");
          return out;
        }});
