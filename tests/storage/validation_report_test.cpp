@@ -42,7 +42,7 @@ TEST(ValidationReport, ManyRowsGoOnMorePages) {
 }
 
 TEST(ValidationReport, AnIncompleteRowIsAnError) {
-  nlohmann::json rows = {row("Waist girth", "within", 0)};
+  nlohmann::json rows = nlohmann::json::array({row("Waist girth", "within", 0)});
   rows[0].erase("allowance_mm");
   EXPECT_EQ(validation_report_pdf({{"measurements", rows}}, "", "").status().code(), StatusCode::kInvalidArgument);
   EXPECT_EQ(validation_report_pdf(nlohmann::json::array(), "", "").status().code(), StatusCode::kInvalidArgument);
