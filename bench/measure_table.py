@@ -35,9 +35,10 @@ def differences(r):
 
 
 def accuracy_table(records):
+    pairs = any("repeat" in r for r in records)  # the repeat pair's column only where one was scanned
     print("| scan | values | within the allowance | within half | within a sixth | fixed planes: largest (mm) "
-          "| over the allowance (scan − truth, mm) | repeat pair: median, largest (mm) |")
-    print("|---|---:|---:|---:|---:|---:|---|---|")
+          "| over the allowance (scan − truth, mm) |" + (" repeat pair: median, largest (mm) |" if pairs else ""))
+    print("|---|---:|---:|---:|---:|---:|---|" + ("---|" if pairs else ""))
     for r in records:
         d = differences(r)
         over = [f"{label(m['name'])} {signed(x)}" for m, x, a in d if abs(x) > a]
@@ -46,8 +47,8 @@ def accuracy_table(records):
         pair_cell = f"{pair['median_mm']:.2f}, {label(pair['largest'])} {pair['largest_mm']:.2f}" if pair else "—"
         print(f"| {r['body']}{posed(r)} | {len(d)} | {sum(abs(x) <= a for _, x, a in d)} "
               f"| {sum(abs(x) <= a / 2 for _, x, a in d)} | {sum(abs(x) <= a / 6 for _, x, a in d)} "
-              f"| {r['fixed_planes_largest_mm']:.2f} | {'; '.join(over + [n + ' missing' for n in missing]) or '—'} "
-              f"| {pair_cell} |")
+              f"| {r['fixed_planes_largest_mm']:.2f} | {'; '.join(over + [n + ' missing' for n in missing]) or '—'} |"
+              + (f" {pair_cell} |" if pairs else ""))
 
 
 def fill_table(records):

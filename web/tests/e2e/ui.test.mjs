@@ -567,8 +567,10 @@ describe('the browser UI', { timeout: 1_800_000 }, () => {
     assert.deepEqual(await accessibilityProblems(customer), [], "axe-core on the customer's page in German");
     await customer.selectOption('select.language', 'en');
     await customer.locator('h1:has-text("Your body scan")').waitFor();
-    // The other language's labels do not load: the page stays as it was and says so.
-    const refuse = (route) => route.fulfill({ status: 503, contentType: 'application/json', body: '{"error":"unavailable"}' });
+    // The other language's labels do not load (the link ran out meanwhile): the page
+    // stays as it was and says so.
+    const refuse = (route) =>
+      route.fulfill({ status: 404, contentType: 'application/json', body: '{"error":{"status":404,"code":"not_found","message":"this link has expired"}}' });
     await customer.route('**/api/share/*?locale=de', refuse);
     await customer.selectOption('select.language', 'de');
     await customer.locator('[role=alert]:has-text("Die Seite konnte nicht auf Deutsch umgestellt werden")').waitFor();
