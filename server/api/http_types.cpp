@@ -7,7 +7,7 @@ HttpResponse json_response(int status, const nlohmann::json& body) {
   r.status = status;
   r.body = body.dump();
   r.set("Content-Type", "application/json");
-  r.set("Cache-Control", "private, no-store");
+  r.set("Cache-Control", "no-store");
   return r;
 }
 
