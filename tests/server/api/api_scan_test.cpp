@@ -685,7 +685,8 @@ TEST(ApiScan, AnOperatorAnswersTheCalibrationsPrompts) {
   const std::string job = parse(cal)["job"]["id"];
   EXPECT_TRUE(parse(cal)["job"]["prompt"].is_null());
   std::vector<nlohmann::json> prompts;
-  const auto until = std::chrono::steady_clock::now() + 240s;
+  // Generous: under the sanitizers (deploy/sanitize.sh) a calibration takes minutes.
+  const auto until = std::chrono::steady_clock::now() + 600s;
   for (;;) {
     const nlohmann::json j = parse(op.get("/api/jobs/" + job))["job"];
     if (j["state"] != "running") {
