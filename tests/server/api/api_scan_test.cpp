@@ -25,7 +25,10 @@ namespace {
 
 using namespace std::chrono_literals;
 
-nlohmann::json wait_job(const Client& c, const std::string& id, double timeout_s = 300) {
+// The job once it has ended, or as it stands after `timeout_s`. The default is
+// generous: under the sanitizers on a loaded machine a calibration alone has taken
+// over five minutes (deploy/sanitize.sh).
+nlohmann::json wait_job(const Client& c, const std::string& id, double timeout_s = 600) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   nlohmann::json j;
   while (std::chrono::steady_clock::now() < until) {
