@@ -34,28 +34,31 @@ Vec2d CameraModel::distort(const Vec2d& u) const {
 
 std::optional<Vec2d> CameraModel::undistort(const Vec2d& d) const {
   if (dist_.is_zero()) return d;
-  Vec2d u = d;
+  // Plain scalars rather than Eigen's 2x2 types: every simulated frame undistorts
+  // each pixel, and a build that does not inline Eigen (the sanitizers') spends
+  // most of its time here otherwise.
+  const double k1 = dist_.k1, k2 = dist_.k2, k3 = dist_.k3, p1 = dist_.p1, p2 = dist_.p2;
+  double x = d.x(), y = d.y();
   for (int it = 0; it < 50; ++it) {
-    const double x = u.x(), y = u.y();
     const double r2 = x * x + y * y;
-    const double radial = 1 + r2 * (dist_.k1 + r2 * (dist_.k2 + r2 * dist_.k3));
-    const double dradial = dist_.k1 + r2 * (2 * dist_.k2 + 3 * r2 * dist_.k3);  // d radial / d r2
-    const Vec2d f = distort(u) - d;
-    Eigen::Matrix2d j;
-    j(0, 0) = radial + 2 * x * x * dradial + 2 * dist_.p1 * y + 6 * dist_.p2 * x;
-    j(0, 1) = 2 * x * y * dradial + 2 * dist_.p1 * x + 2 * dist_.p2 * y;
-    j(1, 0) = 2 * x * y * dradial + 2 * dist_.p1 * x + 2 * dist_.p2 * y;
-    j(1, 1) = radial + 2 * y * y * dradial + 6 * dist_.p1 * y + 2 * dist_.p2 * x;
-    const double det = j.determinant();
-    if (f.norm() < 1e-13) {
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double dradial = k1 + r2 * (2 * k2 + 3 * r2 * k3);  // d radial / d r2
+    const double fx = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x) - d.x();
+    const double fy = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y - d.y();
+    const double j00 = radial + 2 * x * x * dradial + 2 * p1 * y + 6 * p2 * x;
+    const double j01 = 2 * x * y * dradial + 2 * p1 * x + 2 * p2 * y;
+    const double j11 = radial + 2 * y * y * dradial + 6 * p1 * y + 2 * p2 * x;
+    const double det = j00 * j11 - j01 * j01;  // the Jacobian is symmetric
+    if (std::sqrt(fx * fx + fy * fy) < 1e-13) {
       // A root past the lens's fold (where the image radius turns back) is not the
       // point that was imaged: there the mapping is no longer one-to-one.
-      if (radial > 0 && det > 0) return u;
+      if (radial > 0 && det > 0) return Vec2d(x, y);
       return std::nullopt;
     }
     if (!(std::abs(det) > 1e-12)) return std::nullopt;
-    u -= j.inverse() * f;
-    if (!u.allFinite() || u.norm() > 100) return std::nullopt;
+    x -= (j11 * fx - j01 * fy) / det;
+    y -= (j00 * fy - j01 * fx) / det;
+    if (!std::isfinite(x) || !std::isfinite(y) || std::sqrt(x * x + y * y) > 100) return std::nullopt;
   }
   return std::nullopt;
 }
