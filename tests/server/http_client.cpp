@@ -228,6 +228,9 @@ std::optional<std::string> EventStream::next(std::chrono::milliseconds timeout) 
   for (;;) {
     std::string h;
     if (!c_->read_exact(&h, 2, timeout)) return std::nullopt;
+    // `timeout` is for a message to begin; one that has begun gets the time it needs
+    // to arrive whole (a short wait must not cut a frame in two).
+    timeout = std::max(timeout, std::chrono::milliseconds(5000));
     const bool fin = h[0] & 0x80;
     const int opcode = h[0] & 0x0f;
     uint64_t len = static_cast<unsigned char>(h[1]) & 0x7f;
