@@ -24,12 +24,24 @@ CameraModel CameraModel::look_at(int width, int height, double focal_mm, double 
   return CameraModel(width, height, f, f, 0.5 * (width - 1), 0.5 * (height - 1), d, r, centre);
 }
 
-Vec2d CameraModel::distort(const Vec2d& u) const {
-  const double x = u.x(), y = u.y();
+namespace {
+
+// The distortion polynomial at (x, y), with its radial factor (undistort needs it too).
+struct Distorted {
+  double x, y, radial;
+};
+Distorted distort_xy(const Distortion& d, double x, double y) {
   const double r2 = x * x + y * y;
-  const double radial = 1 + r2 * (dist_.k1 + r2 * (dist_.k2 + r2 * dist_.k3));
-  return {x * radial + 2 * dist_.p1 * x * y + dist_.p2 * (r2 + 2 * x * x),
-          y * radial + dist_.p1 * (r2 + 2 * y * y) + 2 * dist_.p2 * x * y};
+  const double radial = 1 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  return {x * radial + 2 * d.p1 * x * y + d.p2 * (r2 + 2 * x * x),
+          y * radial + d.p1 * (r2 + 2 * y * y) + 2 * d.p2 * x * y, radial};
+}
+
+}  // namespace
+
+Vec2d CameraModel::distort(const Vec2d& u) const {
+  const Distorted d = distort_xy(dist_, u.x(), u.y());
+  return {d.x, d.y};
 }
 
 std::optional<Vec2d> CameraModel::undistort(const Vec2d& d) const {
@@ -41,10 +53,10 @@ std::optional<Vec2d> CameraModel::undistort(const Vec2d& d) const {
   double x = d.x(), y = d.y();
   for (int it = 0; it < 50; ++it) {
     const double r2 = x * x + y * y;
-    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const Distorted at = distort_xy(dist_, x, y);
+    const double radial = at.radial;
     const double dradial = k1 + r2 * (2 * k2 + 3 * r2 * k3);  // d radial / d r2
-    const double fx = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x) - d.x();
-    const double fy = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y - d.y();
+    const double fx = at.x - d.x(), fy = at.y - d.y();
     const double j00 = radial + 2 * x * x * dradial + 2 * p1 * y + 6 * p2 * x;
     const double j01 = 2 * x * y * dradial + 2 * p1 * x + 2 * p2 * y;
     const double j11 = radial + 2 * y * y * dradial + 6 * p1 * y + 2 * p2 * x;

@@ -129,26 +129,24 @@ class PlateSpline {
     double r2 = 0;
     for (const Vector2d& p : from) r2 += (p - s.centre_).squaredNorm();
     s.scale_ = r2 > 0 ? 1 / std::sqrt(r2 / static_cast<double>(n)) : 1.0;
-    s.sites_.resize(from.size());
-    for (Eigen::Index i = 0; i < n; ++i) s.sites_[i] = (from[i] - s.centre_) * s.scale_;
+    std::vector<Vector2d> sites(from.size());
+    for (Eigen::Index i = 0; i < n; ++i) sites[i] = (from[i] - s.centre_) * s.scale_;
     const Eigen::Index m = (degree + 1) * (degree + 2) / 2;
     Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n + m, n + m);
     Eigen::MatrixXd b = Eigen::MatrixXd::Zero(n + m, 2);
     for (Eigen::Index i = 0; i < n; ++i) {
-      for (Eigen::Index j = 0; j < i; ++j) a(i, j) = a(j, i) = kernel((s.sites_[i] - s.sites_[j]).squaredNorm());
+      for (Eigen::Index j = 0; j < i; ++j) a(i, j) = a(j, i) = kernel((sites[i] - sites[j]).squaredNorm());
       a(i, i) = smoothing;
-      const Eigen::VectorXd q = monomials(s.sites_[i], degree);
+      const Eigen::VectorXd q = monomials(sites[i], degree);
       a.block(i, n, 1, m) = q.transpose();
       a.block(n, i, m, 1) = q;
       b.row(i) = to[i].transpose();
     }
     const Eigen::MatrixXd x = a.partialPivLu().solve(b);
     if (!x.allFinite()) return std::nullopt;
-    s.weights_ = x.topRows(n);
     s.poly_ = x.bottomRows(m);
     s.kernel_terms_.resize(static_cast<size_t>(n));
-    for (Eigen::Index i = 0; i < n; ++i)
-      s.kernel_terms_[i] = {s.sites_[i].x(), s.sites_[i].y(), s.weights_(i, 0), s.weights_(i, 1)};
+    for (Eigen::Index i = 0; i < n; ++i) s.kernel_terms_[i] = {sites[i].x(), sites[i].y(), x(i, 0), x(i, 1)};
     return s;
   }
 
@@ -173,10 +171,9 @@ class PlateSpline {
   int degree_ = 1;
   Vector2d centre_;
   double scale_ = 1;
-  std::vector<Vector2d> sites_;
-  Eigen::Matrix<double, Eigen::Dynamic, 2> weights_, poly_;
+  Eigen::Matrix<double, Eigen::Dynamic, 2> poly_;
   struct KernelTerm {
-    double x, y, wx, wy;  // a site and its two weights
+    double x, y, wx, wy;  // a site (scaled) and its kernel's two weights
   };
   std::vector<KernelTerm> kernel_terms_;
 };
