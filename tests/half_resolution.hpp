@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 
 #include "hw/rig_description.hpp"
+#include "tests/test_data.hpp"
 
 namespace bodyscan::testing {
 
@@ -27,6 +29,14 @@ inline hw::RigDescription half_resolution_rig(const std::string& name = "thesis"
   if (!desc.ok()) return {};
   halve_resolution(*desc);
   return *desc;
+}
+
+// The thesis rig at half resolution as a rig file (in a new temporary folder), for
+// what takes a rig by path: `bodyscan scan --rig`, a workstation's options.
+inline std::string half_resolution_rig_file() {
+  const std::string path = temp_dir() + "/half-thesis.json";
+  std::ofstream(path) << hw::to_json(half_resolution_rig());
+  return path;
 }
 
 }  // namespace bodyscan::testing

@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -50,14 +51,23 @@ double standard_normal(uint64_t key) { return normal_table()[mix(key) & 0xffff];
 }  // namespace
 
 Renderer::Renderer(const CameraDescription& camera, const SimulationDescription& sim)
-    : camera_(camera), sim_(sim), model_(camera.model()) {
-  rays_.assign(static_cast<size_t>(camera.width) * camera.height, Vec3f::Zero());
-  tbb::parallel_for(0, camera.height, [&](int y) {
-    for (int x = 0; x < camera.width; ++x) {
-      const auto r = model_.ray(Vec2d(x, y));
-      if (r) rays_[static_cast<size_t>(y) * camera.width + x] = r->cast<float>();
-    }
+    : camera_(camera), sim_(sim), model_(camera.model()) {}
+
+const std::vector<Vec3f>& Renderer::rays() const {
+  // Isolated: while it waits for its rows, the thread inside call_once must not pick
+  // up another task that could ask for these rays again (a deadlock).
+  std::call_once(rays_once_, [this] {
+    rays_.assign(static_cast<size_t>(camera_.width) * camera_.height, Vec3f::Zero());
+    tbb::this_task_arena::isolate([this] {
+      tbb::parallel_for(0, camera_.height, [this](int y) {
+        for (int x = 0; x < camera_.width; ++x) {
+          const auto r = model_.ray(Vec2d(x, y));
+          if (r) rays_[static_cast<size_t>(y) * camera_.width + x] = r->cast<float>();
+        }
+      });
+    });
   });
+  return rays_;
 }
 
 Hit Renderer::surface_at(const Scene& scene, const Vec2d& pixel) const {
@@ -178,6 +188,7 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
   const int w = camera_.width, h = camera_.height;
   if (w < 2 || h < 2) return;
   const std::vector<CachedHit>& hit = hits(scene);
+  const std::vector<Vec3f>& pixel_rays = rays();
   const Vec3d& c = model_.centre();
   constexpr int k = kLaserSubpixels;
   const double psf = camera_.blur_px;
@@ -212,7 +223,7 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
         coarse = coarse || std::abs(plane_f[pi].head<3>().dot(ch.position) - plane_f[pi].w()) <
                                static_cast<float>(4 * planes[pi].sigma + 60);
       if (!coarse) continue;
-      const Vec3d p = ch.position.cast<double>(), n = ch.normal.cast<double>(), r = rays_[i].cast<double>();
+      const Vec3d p = ch.position.cast<double>(), n = ch.normal.cast<double>(), r = pixel_rays[i].cast<double>();
       const double footprint = (p - c).norm() / model_.fx() / std::max(0.05, std::abs(n.dot(r)));
       for (const LaserPlane& lp : planes)
         if (std::abs(lp.normal.dot(p) - lp.offset) < 4 * lp.sigma + 2 * footprint) near[i] = 1;
@@ -320,7 +331,7 @@ void Renderer::add_laser_light(const Scene& scene, const Lighting& lighting, std
       // The pixel's ray and its change per pixel (the lens's distortion is smooth
       // over a pixel, so sub-pixel rays are linear in the offset).
       const auto ray_at = [&](int xx, int yy) {
-        return rays_[static_cast<size_t>(std::clamp(yy, 0, h - 1)) * w + std::clamp(xx, 0, w - 1)].cast<double>();
+        return pixel_rays[static_cast<size_t>(std::clamp(yy, 0, h - 1)) * w + std::clamp(xx, 0, w - 1)].cast<double>();
       };
       const Vec3d r0 = ray_at(x, y);
       if (r0.isZero()) continue;
@@ -531,6 +542,7 @@ Frame Renderer::render(const Scene& scene, const Lighting& lighting, const Expos
 }
 
 const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Lighting& lighting) const {
+  const std::vector<Vec3f>& pixel_rays = rays();
   const std::vector<CachedHit>& hit = hits(scene);
   std::lock_guard<std::mutex> lock(cache_mutex_);
   const int key =
@@ -542,7 +554,7 @@ const std::vector<float>& Renderer::base_irradiance(const Scene& scene, const Li
   auto light = [&](int y, int x0, int x1) {
     for (int x = x0; x <= x1; ++x) {
       const size_t i = static_cast<size_t>(y) * w + x;
-      cache.unblurred[i] = static_cast<float>(light_at(scene, lighting, sim_, model_, rays_, hit[i], w, x, y));
+      cache.unblurred[i] = static_cast<float>(light_at(scene, lighting, sim_, model_, pixel_rays, hit[i], w, x, y));
     }
   };
   const bool blurs = camera_.blur_px > 0;
@@ -600,13 +612,14 @@ void Renderer::forget_lights() {
 }
 
 const std::vector<Renderer::CachedHit>& Renderer::hits(const Scene& scene) const {
+  const std::vector<Vec3f>& pixel_rays = rays();
   std::lock_guard<std::mutex> lock(cache_mutex_);
   if (hits_version_ == scene.version() && !hits_.empty()) return hits_;
   const int w = camera_.width, h = camera_.height;
   const size_t n = static_cast<size_t>(w) * h;
   auto cast = [&](size_t i) {
-    if (rays_[i].isZero()) return;
-    const Hit hh = scene.intersect(model_.centre(), rays_[i].cast<double>());
+    if (pixel_rays[i].isZero()) return;
+    const Hit hh = scene.intersect(model_.centre(), pixel_rays[i].cast<double>());
     hits_[i] = {hh.position.cast<float>(), hh.normal.cast<float>(), hh.surface};
   };
   // The same scene posed anew (each scene numbers its versions in a range of its

@@ -97,7 +97,12 @@ class Renderer {
   CameraDescription camera_;
   SimulationDescription sim_;
   CameraModel model_;
-  std::vector<Vec3f> rays_;  // per pixel, unit, world (zero where the lens model fails)
+  // Per pixel, unit, world (zero where the lens model fails), worked out on the first
+  // frame: a rig that is opened and never rendered (a server that only serves its
+  // archive) does not pay a lens inversion per pixel.
+  const std::vector<Vec3f>& rays() const;
+  mutable std::once_flag rays_once_;
+  mutable std::vector<Vec3f> rays_;
   mutable std::mutex cache_mutex_;
   mutable std::vector<CachedHit> hits_;
   mutable uint64_t hits_version_ = 0;

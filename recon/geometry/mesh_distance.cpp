@@ -126,13 +126,19 @@ Vec3<S> closest_on_triangle(const Vec3<S>& p, const Vec3<S>& a, const Vec3<S>& a
 struct Box {
   Vec3f lo = Vec3f::Constant(std::numeric_limits<float>::infinity());
   Vec3f hi = Vec3f::Constant(-std::numeric_limits<float>::infinity());
-  void grow(const Vec3f& p) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  void grow(const Box& b) {
-    lo = lo.cwiseMin(b.lo);
-    hi = hi.cwiseMax(b.hi);
+  // In plain floats: the tree's build grows boxes for every triangle at every
+  // level, and the sanitizers' build does not inline Eigen's small expressions.
+  void grow(const Vec3f& p) { grow(p, p); }
+  void grow(const Box& b) { grow(b.lo, b.hi); }
+  void grow(const Vec3f& low, const Vec3f& high) {
+    float* l = lo.data();
+    float* h = hi.data();
+    const float* a = low.data();
+    const float* b = high.data();
+    for (int k = 0; k < 3; ++k) {
+      l[k] = std::min(l[k], a[k]);
+      h[k] = std::max(h[k], b[k]);
+    }
   }
   // Half the surface area: the SAH only compares areas.
   float half_area() const {

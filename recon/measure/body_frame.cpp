@@ -58,12 +58,19 @@ std::vector<Vec2> resampled(const std::vector<Eigen::Vector3d>& loop, int n) {
 
 // Squared distance from p to the closed polyline `poly`: to the nearest vertex's
 // two segments.
+// The search runs over plain doubles: it is the frame search's inner loop, and the
+// sanitizers' build does not inline Eigen's small expressions.
 double squared_distance(const Vec2& p, const std::vector<Vec2>& poly) {
+  static_assert(sizeof(Vec2) == 2 * sizeof(double), "a polyline is x, z pairs back to back");
+  const double* xz = poly.data()->data();
+  const double px = p.x(), pz = p.y();
+  const size_t n = poly.size();
   size_t best = 0;
   double best_d = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < poly.size(); ++i)
-    if (const double d = (poly[i] - p).squaredNorm(); d < best_d) best_d = d, best = i;
-  const size_t n = poly.size();
+  for (size_t i = 0; i < n; ++i) {
+    const double dx = xz[2 * i] - px, dz = xz[2 * i + 1] - pz;
+    if (const double d = dx * dx + dz * dz; d < best_d) best_d = d, best = i;
+  }
   for (const size_t j : {(best + n - 1) % n, best}) {
     const Vec2 &a = poly[j], &b = poly[(j + 1) % n];
     const Vec2 ab = b - a;

@@ -20,8 +20,13 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
 std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& plane,
                                        const std::vector<uint32_t>* triangles) {
   const size_t nv = mesh.vertices.size();
+  // In plain doubles: this runs for every vertex of every cut, and the sanitizers'
+  // build does not inline Eigen's small expressions.
+  const double nx = plane.normal.x(), ny = plane.normal.y(), nz = plane.normal.z();
+  const double px = plane.point.x(), py = plane.point.y(), pz = plane.point.z();
   auto dist = [&](uint32_t i) {
-    const double x = plane.signed_distance(mesh.vertices[i].cast<double>());
+    const Vec3f& v = mesh.vertices[i];
+    const double x = nx * (v.x() - px) + ny * (v.y() - py) + nz * (v.z() - pz);
     return x == 0 ? 1e-12 : x;  // on the plane: a hair on the positive side
   };
   // Each crossed triangle gives one segment between two crossed edges. Link the

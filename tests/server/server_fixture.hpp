@@ -15,6 +15,7 @@
 #include "server/api/api.hpp"
 #include "server/net/http_server.hpp"
 #include "server/workstation/workstation.hpp"
+#include "tests/half_resolution.hpp"
 #include "tests/server/http_client.hpp"
 #include "tests/test_data.hpp"
 
@@ -23,6 +24,11 @@ namespace bodyscan::testing {
 inline constexpr const char* kPassword = "correct horse battery";
 
 inline std::string demo_body_path() { return std::string(BODYSCAN_SOURCE_DIR) + "/hw/sim/bodies/male_average.ply"; }
+
+// A ServerUnderTest tweak for tests of a job's course rather than its figures
+// (cancelling, a failing camera, prompts): the thesis rig at half resolution,
+// whose calibration renders four times fewer pixels.
+inline void on_half_resolution_rig(server::WorkstationOptions& o) { o.rig = half_resolution_rig_file(); }
 
 struct ServerUnderTest {
   std::string data, web;

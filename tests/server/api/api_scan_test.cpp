@@ -183,7 +183,7 @@ TEST(ApiScan, SimulatedScanThroughTheApiWithLiveEvents) {
 // Cancelling stops the scan at the next frame: the job and the archived scan say
 // who cancelled it, every laser is off, and the rig takes the next job.
 TEST(ApiScan, CancelStopsTheScanAndTurnsTheLasersOff) {
-  ServerUnderTest s(4);
+  ServerUnderTest s(4, {}, on_half_resolution_rig);
   Client op = s.as("op");
   const HttpReply started = op.post("/api/scans", "{\"customer_id\": \"" + s.customer_id + "\"}");
   ASSERT_EQ(started.status, 202) << started.body;
@@ -217,7 +217,7 @@ TEST(ApiScan, CancelStopsTheScanAndTurnsTheLasersOff) {
 // consent: given with the scan, it is recorded with the terms the station
 // showed, the time and the operator; once on record, later scans need no more.
 TEST(ApiScan, NoScanStartsWithoutTheCustomersConsent) {
-  ServerUnderTest s(12);
+  ServerUnderTest s(12, {}, on_half_resolution_rig);
   Client op = s.as("op");
   const nlohmann::json terms = parse(op.get("/api/consent"));
   ASSERT_TRUE(terms["terms"].is_string());
@@ -678,7 +678,10 @@ TEST(ApiScan, PostureCheckReadsHowTheCustomerStandsAndStoresNothing) {
 // the simulated rig, as for real cameras): the job and its events carry the
 // prompt, an operator answers it by id; a tailor may not, a stale id is refused.
 TEST(ApiScan, AnOperatorAnswersTheCalibrationsPrompts) {
-  ServerUnderTest s(12, {}, [](server::WorkstationOptions& o) { o.operator_dot_grid = true; });
+  ServerUnderTest s(12, {}, [](server::WorkstationOptions& o) {
+    on_half_resolution_rig(o);
+    o.operator_dot_grid = true;
+  });
   Client op = s.as("op");
   HttpReply refused;
   auto events = EventStream::open(s.port, op.cookie, &refused);
@@ -750,7 +753,7 @@ TEST(ApiScan, AnOperatorAnswersTheCalibrationsPrompts) {
 // marked failed with the reason, nothing else in the archive changes, the lasers
 // are off and the rig status shows the device error.
 TEST(ApiScan, ACameraThatStopsMidScanFailsTheJobClearly) {
-  ServerUnderTest s(12);
+  ServerUnderTest s(12, {}, on_half_resolution_rig);
   Client op = s.as("op");
   const size_t scans_before = parse(op.get("/api/scans"))["scans"].size();
   // Calibrated first, so that the camera fails in the scan proper, 30 frames in.
@@ -939,7 +942,7 @@ TEST(ApiScan, AdminErasesACustomer) {
 // writing their data); once the job ends, nothing of theirs is left in any file
 // of the data folder, write-ahead logs included.
 TEST(ApiScan, ErasureWaitsForTheRunningScanAndLeavesNothingBehind) {
-  ServerUnderTest s(12);
+  ServerUnderTest s(12, {}, on_half_resolution_rig);
   Client admin = s.as("admin");
   const std::string token = parse(admin.post("/api/scans/" + s.scan_id + "/shares", "{}"))["token"];
   ASSERT_FALSE(token.empty());

@@ -5,10 +5,8 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <fstream>
 #include <thread>
 
-#include "hw/rig_description.hpp"
 #include "server/workstation/workstation.hpp"
 #include "tests/half_resolution.hpp"
 #include "tests/test_data.hpp"
@@ -22,11 +20,13 @@ namespace {
 // scan.
 TEST(Workstation, StartsWithTheCalibrationOfTheNewestArchivedScanOnThisRig) {
   const std::string data = temp_dir();
-  const std::string cmd = std::string(BODYSCAN_BIN) + " scan --rig sim --every 12 --no-surface -q --archive '" + data +
-                          "' --new-customer Demo > /dev/null 2>&1";
+  const std::string rig_file = half_resolution_rig_file();
+  const std::string cmd = std::string(BODYSCAN_BIN) + " scan --rig '" + rig_file +
+                          "' --every 12 --no-surface -q --archive '" + data + "' --new-customer Demo > /dev/null 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   server::WorkstationOptions o;
   o.data_dir = data;
+  o.rig = rig_file;
   o.auth.opslimit = crypto_pwhash_OPSLIMIT_MIN;
   o.auth.memlimit = crypto_pwhash_MEMLIMIT_MIN;
   std::string scan_calibration;
@@ -49,13 +49,6 @@ TEST(Workstation, StartsWithTheCalibrationOfTheNewestArchivedScanOnThisRig) {
   auto other = server::Workstation::open(o);
   ASSERT_TRUE(other.ok()) << other.status().message();
   EXPECT_TRUE((*other)->rig_status()["calibration"].is_null());
-}
-
-// The thesis rig at half resolution (a calibration in seconds), as a file.
-std::string half_resolution_rig_file() {
-  const std::string path = temp_dir() + "/half-thesis.json";
-  std::ofstream(path) << hw::to_json(half_resolution_rig());
-  return path;
 }
 
 server::WorkstationOptions training_options() {
