@@ -3,8 +3,8 @@
 # builds bodyscan with clang, AddressSanitizer and UndefinedBehaviorSanitizer
 # into ./build-san, runs the storage, hardware and server tests on that build,
 # then runs each libFuzzer target (fuzz/) from its corpus for FUZZ_SECONDS
-# (default 60). Any sanitizer report or fuzzer finding fails it; a fuzzer's
-# crashing input is left in build-san/fuzz-findings/.
+# (default 60), one per core at a time. Any sanitizer report or fuzzer finding
+# fails it; a fuzzer's crashing input is left in build-san/fuzz-findings/.
 #
 #   deploy/sanitize.sh              tests, then fuzzing
 #   deploy/sanitize.sh --fuzz-only  fuzzing only (e.g. FUZZ_SECONDS=3600 for an hour each)
@@ -48,21 +48,35 @@ fi
 
 findings="$BUILD_DIR/fuzz-findings"
 mkdir -p "$findings"
-for f in "${fuzzers[@]}"; do
-  name=${f%_fuzzer}
+# One fuzzer per core at a time (each is a single process); the first that finds
+# a problem fails the pass once the running ones end.
+fuzz() {
+  local f=$1 name=${1%_fuzzer} work status=0
   work=$(mktemp -d)  # new inputs the run finds; the corpus in the repo stays as it is
-  echo "sanitize: $f for ${FUZZ_SECONDS} s from fuzz/corpus/$name"
-  log="$findings/$name.log"
-  status=0
+  local log="$findings/$name.log"
   (cd "$BUILD_DIR" && "./fuzz/$f" -max_total_time="$FUZZ_SECONDS" -max_len=65536 -timeout=30 -rss_limit_mb=4096 \
     -artifact_prefix="$PWD/fuzz-findings/$name-" -print_final_stats=1 "$work" "$OLDPWD/fuzz/corpus/$name") \
     >"$log" 2>&1 || status=$?
   rm -rf "$work"
-  grep -E "^(#[0-9]+ +DONE|stat::number_of_executed_units|stat::peak_rss_mb)" "$log" || true
+  # One write, so that the fuzzers running side by side do not interleave their lines.
+  printf 'sanitize: %s ran %s s from fuzz/corpus/%s\n%s\n' "$f" "$FUZZ_SECONDS" "$name" \
+    "$(grep -E "^(#[0-9]+ +DONE|stat::number_of_executed_units|stat::peak_rss_mb)" "$log" || true)"
   if ((status != 0)); then
     tail -n 60 "$log" >&2
     echo "sanitize: $f found a problem (exit $status); the input is in $findings, the log in $log" >&2
-    exit 1
+    return 1
   fi
+}
+failed=0
+pids=()
+for f in "${fuzzers[@]}"; do
+  if ((${#pids[@]} >= $(nproc))); then
+    wait "${pids[0]}" || failed=1
+    pids=("${pids[@]:1}")
+  fi
+  fuzz "$f" &
+  pids+=($!)
 done
+for pid in "${pids[@]}"; do wait "$pid" || failed=1; done
+((failed == 0)) || exit 1
 echo "sanitize: tests and fuzzers clean"
