@@ -57,9 +57,9 @@ std::vector<Vec2> resampled(const std::vector<Eigen::Vector3d>& loop, int n) {
 }
 
 // Squared distance from p to the closed polyline `poly`: to the nearest vertex's
-// two segments.
-// The search runs over plain doubles: it is the frame search's inner loop, and the
-// sanitizers' build does not inline Eigen's small expressions.
+// two segments. The vertex search runs over plain doubles: it is the frame
+// search's inner loop, and the sanitizers' build does not inline Eigen's small
+// expressions.
 double squared_distance(const Vec2& p, const std::vector<Vec2>& poly) {
   static_assert(sizeof(Vec2) == 2 * sizeof(double), "a polyline is x, z pairs back to back");
   const double* xz = poly.data()->data();
