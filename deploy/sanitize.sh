@@ -27,7 +27,8 @@ targets=("${fuzzers[@]}")
 ((fuzz_only)) || targets+=(bodyscan storage_tests hw_tests server_tests)
 
 export CCACHE_DIR=${CCACHE_DIR:-$PWD/.cache/ccache}
-flags="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+# The fuzzers' coverage guidance is added where they need it (fuzz/CMakeLists.txt).
+flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 CC=clang CXX=clang++ cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DBODYSCAN_WEB=OFF -DBODYSCAN_BUILD_BENCH=OFF -DBODYSCAN_FUZZ=ON -DCMAKE_CXX_FLAGS="$flags" >/dev/null
 cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${targets[@]}"

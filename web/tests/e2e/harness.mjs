@@ -3,7 +3,7 @@
 // (no browser download), screenshots kept as artefacts, and ground truth from the
 // demo body the simulated rig scans.
 import { execFileSync, spawn } from 'node:child_process';
-import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { createRequire } from 'node:module';
@@ -61,12 +61,37 @@ export function demoBodyBounds() {
   return { min, max };
 }
 
+// The simulated rig (the thesis layout, the demo body) on pixels twice the size:
+// half the width and height, as the C++ tests' half_resolution_rig, so that a
+// calibration and a scan render a quarter of the pixels. The UI's behaviour does
+// not depend on the resolution; the figures the suite judges keep to their
+// tolerances. Written once, into the run's temporary folder.
+let halfRig = null;
+function halfResolutionRig() {
+  if (halfRig) return halfRig;
+  const source = join(REPO, 'hw/rigs/thesis.json');
+  const rig = JSON.parse(readFileSync(source, 'utf8'));
+  for (const c of rig.cameras) {
+    c.width /= 2;
+    c.height /= 2;
+    c.pixel_size_um *= 2;
+    c.blur_px = (c.blur_px ?? 0.7) / 2; // 0.7 px: the description's default (hw/rig_description.hpp)
+  }
+  rig.simulation.subject = resolve(dirname(source), rig.simulation.subject);
+  const dir = mkdtempSync(join(tmpdir(), 'bodyscan-rig-'));
+  process.on('exit', () => rmSync(dir, { recursive: true, force: true }));
+  halfRig = join(dir, 'half-thesis.json');
+  writeFileSync(halfRig, JSON.stringify(rig));
+  return halfRig;
+}
+
 // `bodyscan serve` on a fresh data folder (or a copy of `seed`, an archive
 // made before); resolves once it prints its URL.
 export async function startServer({ every = 6, extraArgs = [], seed = null } = {}) {
   const data = mkdtempSync(join(tmpdir(), 'bodyscan-ui-'));
   if (seed) cpSync(seed, data, { recursive: true });
-  const proc = spawn(BIN(), ['serve', '--address', '127.0.0.1', '--port', '0', '--data', data, '--every', String(every), '--web', WEB_ROOT(), ...extraArgs], {
+  const args = ['serve', '--address', '127.0.0.1', '--port', '0', '--data', data, '--rig', halfResolutionRig(), '--every', String(every), '--web', WEB_ROOT(), ...extraArgs];
+  const proc = spawn(BIN(), args, {
     env: { ...process.env, BODYSCAN_ADMIN_PASSWORD: ADMIN_PASSWORD },
     stdio: ['ignore', 'pipe', 'pipe'],
   });
