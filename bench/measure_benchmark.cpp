@@ -43,8 +43,8 @@
 // --json OUT.json also writes, per rig and body, the automatic set of the truth and
 // the scan value by value with the allowance and the fill's marks, the fixed
 // planes' largest difference and the repeat pair's differences; it is rewritten
-// after each body. bench/measure_table.py renders docs/benchmarks.md §7's tables
-// from it.
+// after each body (bench/json_figures.hpp). bench/tables.py renders
+// docs/benchmarks.md's measure_accuracy and measure_fill tables from it.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -58,6 +58,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "hw/sim/scene.hpp"
 #include "pipeline/rig_backend.hpp"
@@ -140,6 +141,7 @@ ReconstructOptions g_surface = pipeline::body_surface_options();
 std::string g_save;
 std::string g_json_out;
 nlohmann::json g_json = nlohmann::json::array();
+nlohmann::json g_run;  // --json's provenance (bench/json_figures.hpp)
 bool g_resurface = false;
 uint64_t g_seed = 1;
 // --posture: applied over every scan's rig description.
@@ -225,11 +227,7 @@ std::string body_name(const std::string& path) {
 // run leaves what it has finished; passes `rc` through.
 int finish(nlohmann::json& record, int rc) {
   if (rc == 0) g_json.push_back(std::move(record));
-  if (!g_json_out.empty()) {
-    std::ofstream out(g_json_out);
-    out << g_json.dump(1) << "\n";
-    if (!out) std::fprintf(stderr, "--json: cannot write %s\n", g_json_out.c_str());
-  }
+  if (!g_json_out.empty() && !bench::write_figures(g_json_out, g_run, g_json) && rc == 0) return 1;
   return rc;
 }
 
@@ -566,6 +564,7 @@ int main(int argc, char** argv) {
     return "";
   });
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  g_run = bench::run_record(argc, argv);
   if (noise_fields > 0) {
     if (bodies.empty()) return std::fprintf(stderr, "measure_benchmark: --noise-study needs --body B.ply\n"), 2;
     int rc = 0;

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "hw/sim/pose_body.hpp"
 #include "recon/io/ply.hpp"
@@ -325,6 +326,6 @@ int main(int argc, char** argv) {
     }
     std::fflush(stdout);
   }
-  if (!json_out.empty()) std::ofstream(json_out) << all.dump(1) << "\n";
+  if (!json_out.empty() && !bench::write_figures(json_out, bench::run_record(argc, argv), all)) return 1;
   return 0;
 }

@@ -4,7 +4,7 @@
 // from the points.
 //
 //   sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S]
-//                [--cloud-dir DIR]
+//                [--cloud-dir DIR] [--json OUT.json]
 //
 // --defaults runs reconstruct_surface with no options (everything from the data).
 // --tuned searches sigma, normal sigma, sharpening, the PCA neighbourhood and the
@@ -13,7 +13,8 @@
 // sigma_z per cell, and prints the winners.
 // --cloud-dir writes each cell's cloud to DIR/sphere_N_s.ply for a peer to run on
 // (bench/sphere_vs_open3d.sh).
-// Prints a Markdown table with the thesis's value and our ratio per cell.
+// Prints a Markdown table with the thesis's value and our ratio per cell; --json
+// also writes the cells (bench/json_figures.hpp) for bench/tables.py.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "recon/geometry/sample_surface.hpp"
 #include "recon/io/ply.hpp"
@@ -46,7 +48,7 @@ struct Cell {
   ReconstructStats stats;
 };
 
-Cell run(const PointCloud& cloud, const ReconstructOptions& opt) {
+Cell reconstruct_cell(const PointCloud& cloud, const ReconstructOptions& opt) {
   Cell c;
   auto r = reconstruct_surface(cloud, opt);
   if (!r.ok() || r->mesh.vertices.empty()) return c;
@@ -70,7 +72,7 @@ PointCloud make_cloud(size_t n, double s, double nonuniform, uint64_t seed) {
 
 // Coordinate descent over the thesis's free parameters.
 Cell tune(const PointCloud& cloud, ReconstructOptions& best_opt) {
-  const Cell base = run(cloud, best_opt);
+  const Cell base = reconstruct_cell(cloud, best_opt);
   best_opt.sigma_scale = base.stats.sigma_scale;
   best_opt.normal_scale = base.stats.normal_scale;
   best_opt.voxel_size = base.stats.voxel_size;
@@ -91,7 +93,7 @@ Cell tune(const PointCloud& cloud, ReconstructOptions& best_opt) {
       for (float v : values) {
         ReconstructOptions o = best_opt;
         set(o, v);
-        const Cell c = run(cloud, o);
+        const Cell c = reconstruct_cell(cloud, o);
         if (std::isfinite(c.rms) && !(c.rms >= best.rms)) {
           best = c;
           best_opt = o;
@@ -113,16 +115,17 @@ int main(int argc, char** argv) {
   bool defaults = false, tuned = false;
   double nonuniform = 0.0;
   uint64_t seed = 1;
-  std::string cloud_dir;
+  std::string cloud_dir, json_out;
   std::vector<std::pair<size_t, double>> cells;
   CommandLine cl("sphere_table",
                  "usage: sphere_table [--defaults] [--tuned] [--nonuniform RATIO] [--cells N:s,...] [--seed S] "
-                 "[--cloud-dir DIR]\n");
+                 "[--cloud-dir DIR] [--json OUT]\n");
   cl.flag("--defaults", &defaults);
   cl.flag("--tuned", &tuned);
   cl.option("--nonuniform", &nonuniform);
   cl.option("--seed", &seed);
   cl.option("--cloud-dir", &cloud_dir);
+  cl.option("--json", &json_out);
   // N:s pairs: a cloud of N points with noise sigma s.
   cl.option("--cells", [&cells](const std::string& v) -> std::string {
     size_t pos = 0;
@@ -150,6 +153,8 @@ int main(int argc, char** argv) {
   std::printf("|---:|---:|---:|%s%s\n", defaults ? "---:|---:|" : "",
               tuned ? "---:|---:|---:|---:|---:|---:|---:|" : "");
   double worst_default = 0, worst_tuned = 0;
+  const nlohmann::json run = bench::run_record(argc, argv);
+  nlohmann::json records = nlohmann::json::array();
   for (auto [n, s] : cells) {
     double thesis = NAN;
     for (size_t r = 0; r < kSizes.size(); ++r)
@@ -166,10 +171,14 @@ int main(int argc, char** argv) {
       }
     }
     std::printf("| %zu | %.2f | %.6f |", n, s, thesis);
+    nlohmann::json record = {{"points", n}, {"noise", s}, {"nonuniform", nonuniform}, {"seed", seed}};
+    // The thesis measured the uniform sphere only.
+    if (std::isfinite(thesis) && nonuniform <= 1.0) record["thesis_rms"] = thesis;
     if (defaults) {
-      const Cell d = run(cloud, {});
+      const Cell d = reconstruct_cell(cloud, {});
       std::printf(" %.6f | %.2f |", d.rms, d.rms / thesis);
       worst_default = std::max(worst_default, d.rms / thesis);
+      record["defaults"] = {{"rms", d.rms}, {"vertices", d.vertices}};
     }
     if (tuned) {
       ReconstructOptions o;
@@ -177,9 +186,19 @@ int main(int argc, char** argv) {
       std::printf(" %.6f | %.2f | %.2f | %.2f | %.2f | %zu | %.2f |", t.rms, t.rms / thesis, o.sigma_scale,
                   o.normal_scale, o.sharpening, t.stats.normal_k, o.voxel_size / t.stats.median_density_sigma);
       worst_tuned = std::max(worst_tuned, t.rms / thesis);
+      record["tuned"] = {{"rms", t.rms},
+                         {"vertices", t.vertices},
+                         {"sigma_scale", o.sigma_scale},
+                         {"normal_scale", o.normal_scale},
+                         {"sharpening", o.sharpening},
+                         {"normal_k", t.stats.normal_k},
+                         {"voxel_per_density_sigma", o.voxel_size / t.stats.median_density_sigma}};
     }
     std::printf("\n");
     std::fflush(stdout);
+    records.push_back(std::move(record));
+    // Rewritten after every cell, so that a long run leaves what it has finished.
+    if (!json_out.empty() && !bench::write_figures(json_out, run, records)) return 1;
   }
   if (defaults) std::printf("\nworst defaults/thesis ratio: %.3f\n", worst_default);
   if (tuned) std::printf("worst tuned/thesis ratio: %.3f\n", worst_tuned);

@@ -6,7 +6,8 @@
 #   deploy/install-deps.sh --browser  also Chromium, for the browser UI's tests
 #   deploy/install-deps.sh --bench    also the peers the benchmarks compare with (Open3D)
 #   deploy/install-deps.sh --sanitize also clang and its sanitizer and libFuzzer runtimes
-#   deploy/install-deps.sh --lint     also clang-format and clang-tidy, for deploy/check-format.sh and check-tidy.sh
+#   deploy/install-deps.sh --lint     also clang-format, clang-tidy and Python, for deploy/check-format.sh,
+#                                     check-tidy.sh and the benchmark tables' check (bench/tables.py --check)
 #
 # It never removes a package: before installing it asks apt what the install
 # would do, says how many packages and how many megabytes that is, and stops
@@ -49,7 +50,7 @@ for arg in "$@"; do
     --browser) packages+=(chromium) ;;  # driven headless by playwright-core (web/tests/e2e)
     --bench) packages+=(python3-open3d python3-numpy time wrk curl chromium) ;;
     --sanitize) packages+=(clang libclang-rt-dev) ;;  # deploy/sanitize.sh
-    --lint) packages+=(clang-format clang-tidy) ;;     # deploy/check-format.sh, deploy/check-tidy.sh
+    --lint) packages+=(clang-format clang-tidy python3) ;;  # check-format.sh, check-tidy.sh, bench/tables.py --check
     *) echo "install-deps: unknown option '$arg'" >&2; exit 2 ;;
   esac
 done
