@@ -21,10 +21,12 @@ output, and a new run is one command away.
 Several files for one table (one body each, run side by side) are stored as one:
 their records in order, each run's provenance kept.
 """
+import datetime
 import json
 import math
 import os
 import re
+import subprocess
 import sys
 from collections import OrderedDict
 
@@ -44,6 +46,23 @@ def signed(x, digits=1):
 
 
 # ---- provenance ---------------------------------------------------------------
+
+
+def run_record():
+    """A Python benchmark's run, as bench/json_figures.hpp records a C++ one's."""
+    try:
+        commit = subprocess.run(["git", "-C", ROOT, "describe", "--always", "--dirty", "--abbrev=7"],
+                                capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        commit = "unknown"
+    cpu = "unknown processor"
+    try:
+        cpu = next(l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    command = " ".join([os.path.relpath(sys.argv[0], ROOT)] + sys.argv[1:])
+    return {"command": command, "commit": commit, "date": datetime.datetime.utcnow().strftime("%Y-%m-%d"),
+            "machine": {"cpu": cpu, "cores": os.cpu_count()}}
 
 
 def load(paths):
@@ -201,12 +220,38 @@ def measure_fill(records):
     return "\n".join(out)
 
 
+def gap_cylinder(records):
+    """Per case: the strip's radius off (first seed) and the tape's error per seed."""
+    cases = OrderedDict()
+    for r in records:
+        key = (r["strip_deg"], r["noise_mm"], r["stray"], r["quiet_strays"], r["true_normals"])
+        cases.setdefault(key, []).append(r)
+    seeds = sorted({r["seed"] for r in records})
+    out = [f"| strip | noise (mm RMS) | stray points in it | normals | strip's radius off, mean / largest (mm), "
+           f"seed {seeds[0]} | girth off (mm), seeds {seeds[0]}-{seeds[-1]} | spread |",
+           "|---|---:|---|---|---|---|---:|"]
+    for (strip, noise, stray, quiet, given), rs in cases.items():
+        rs = sorted(rs, key=lambda r: r["seed"])
+        errors = [r["girth_error_mm"] for r in rs]
+        same = max(errors) - min(errors) < 0.005
+        girth = signed(errors[0], 2) if same else ", ".join(signed(e, 2) for e in errors)
+        spread = "" if same else f"{max(errors) - min(errors):.2f}"
+        strays = "" if not strip else ("none" if not stray else "the same, themselves without noise" if quiet
+                                       else "one per 16 × 6 mm")
+        normals = "**true**" if given else "estimated"
+        out.append(f"| {f'{strip:g}°' if strip else 'none'} | {noise:g} | {strays} | {normals} "
+                   f"| {signed(rs[0]['strip_mean_mm'], 2)} / {signed(rs[0]['strip_largest_mm'], 2)} | {girth} "
+                   f"| {spread} |")
+    return "\n".join(out)
+
+
 # A table's name: (its renderer, the figures file it reads, by name in docs/figures).
 TABLES = {
     "sphere": (sphere, "sphere"),
     "posture": (posture, "posture"),
     "measure_accuracy": (measure_accuracy, "measure"),
     "measure_fill": (measure_fill, "measure"),
+    "gap_cylinder": (gap_cylinder, "gap_cylinder"),
 }
 
 
