@@ -32,8 +32,8 @@ inline std::string first_line_of(const std::string& command) {
 }
 
 // The run's provenance: the command as given, the commit of the source tree the
-// benchmark was built from (git describe: "-dirty" when it had uncommitted
-// changes; "unknown" outside a checkout), the UTC date, the processor and cores.
+// benchmark runs in ("-dirty" when files outside docs/ had uncommitted changes;
+// "unknown" outside a checkout), the UTC date, the processor and cores.
 inline nlohmann::json run_record(int argc, char** argv) {
   std::string command;
   for (int i = 0; i < argc; ++i) {
@@ -41,9 +41,13 @@ inline nlohmann::json run_record(int argc, char** argv) {
     if (i == 0 && arg.rfind(BODYSCAN_SOURCE_DIR "/", 0) == 0) arg.erase(0, std::strlen(BODYSCAN_SOURCE_DIR "/"));
     command += (i ? " " : "") + arg;
   }
-  std::string commit =
-      first_line_of("git -C '" BODYSCAN_SOURCE_DIR "' describe --always --dirty --abbrev=7 2>/dev/null");
+  std::string commit = first_line_of("git -C '" BODYSCAN_SOURCE_DIR "' describe --always --abbrev=7 2>/dev/null");
   if (commit.empty()) commit = "unknown";
+  // Changes to docs/ (where the figures go) do not make a run's tree dirty.
+  else if (!first_line_of("git -C '" BODYSCAN_SOURCE_DIR
+                          "' status --porcelain --untracked-files=no -- . ':(exclude)docs' 2>/dev/null")
+                .empty())
+    commit += "-dirty";
   std::array<char, 32> date{};
   const std::time_t now = std::time(nullptr);
   std::tm utc{};

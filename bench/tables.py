@@ -50,9 +50,13 @@ def signed(x, digits=1):
 
 def run_record():
     """A Python benchmark's run, as bench/json_figures.hpp records a C++ one's."""
+    def git(*args):
+        return subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True, check=True).stdout.strip()
     try:
-        commit = subprocess.run(["git", "-C", ROOT, "describe", "--always", "--dirty", "--abbrev=7"],
-                                capture_output=True, text=True, check=True).stdout.strip()
+        commit = git("describe", "--always", "--abbrev=7")
+        # Changes to docs/ (where the figures go) do not make a run's tree dirty.
+        if git("status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)docs"):
+            commit += "-dirty"
     except (OSError, subprocess.CalledProcessError):
         commit = "unknown"
     cpu = "unknown processor"
@@ -61,8 +65,8 @@ def run_record():
     except (OSError, StopIteration):
         pass
     command = " ".join([os.path.relpath(sys.argv[0], ROOT)] + sys.argv[1:])
-    return {"command": command, "commit": commit, "date": datetime.datetime.utcnow().strftime("%Y-%m-%d"),
-            "machine": {"cpu": cpu, "cores": os.cpu_count()}}
+    date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
+    return {"command": command, "commit": commit, "date": date, "machine": {"cpu": cpu, "cores": os.cpu_count()}}
 
 
 def load(paths):
