@@ -7,17 +7,20 @@
 // the smallest clearance, in mm around the light's centre, that every camera has.
 //
 //   rig_coverage [--rig thesis|square|tiered|FILE]... [--body BODY.ply] [--min-angle DEG]
-//                [--max-view DEG] [--cross]
+//                [--max-view DEG] [--cross] [--json OUT.json]
 //
 // --max-view counts a camera only within DEG of the surface's normal (default 90:
 // any camera in front of it; the scan drops views beyond the rig's max_view_deg).
+// --json also writes each rig's figures (bench/json_figures.hpp) for bench/tables.py.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <string>
 
 #include "bench/body_region.hpp"
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "pipeline/rig_backend.hpp"
 #include "recon/geometry/sample_surface.hpp"
@@ -26,18 +29,22 @@ using namespace bodyscan;
 
 int main(int argc, char** argv) {
   std::vector<std::string> rigs;
-  std::string body;
+  std::string body, json_out;
   double min_angle = 8, min_incidence = 0.1, max_view = 90;
   bool cross = false;
   CommandLine cl("rig_coverage",
-                 "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG] [--max-view DEG] [--cross]\n");
+                 "usage: rig_coverage [--rig R]... [--body BODY.ply] [--min-angle DEG] [--max-view DEG] [--cross] "
+                 "[--json OUT]\n");
   cl.option("--rig", &rigs);
   cl.option("--body", &body);
   cl.option("--min-angle", &min_angle);
   cl.option("--max-view", &max_view);
   cl.flag("--cross", &cross);
+  cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
   if (rigs.empty()) rigs = hw::shipped_rig_names();  // all of them
+  const nlohmann::json run = bench::run_record(argc, argv);
+  nlohmann::json records = nlohmann::json::array();
   for (const std::string& name : rigs) {
     pipeline::SimulatedSubject subject;
     subject.body = body;
@@ -144,5 +151,18 @@ int main(int argc, char** argv) {
                   zone_total[z] ? 100.0 * zone_covered[z] / zone_total[z] : 0.0,
                   zone_total[z] * surface_area(scene.subject()) / s.size() / 100.0, z < 2 ? "," : "");
     std::printf("\n");
+    const std::string body_name = std::filesystem::path(body.empty() ? desc.simulation.subject : body).stem().string();
+    nlohmann::json zones;
+    for (int z = 0; z < 3; ++z) zones[zone_names[z]] = zone_total[z] ? 100.0 * zone_covered[z] / zone_total[z] : 0.0;
+    records.push_back({{"rig", desc.name},
+                       {"body", body_name},
+                       {"max_view_deg", max_view},
+                       {"min_angle_deg", min_angle},
+                       {"covered_percent", 100.0 * covered / s.size()},
+                       {"seen_percent", 100.0 * seen / s.size()},
+                       {"light_clearance_mm", clearance},
+                       {"zones_covered_percent", zones}});
   }
+  if (!json_out.empty() && !bench::write_figures(json_out, run, records)) return 1;
+  return 0;
 }

@@ -249,6 +249,29 @@ def gap_cylinder(records):
     return "\n".join(out)
 
 
+def rig_coverage(records):
+    """Per body: the share each layout covers, overall and in the zones measurements hang from."""
+    rigs = list(OrderedDict.fromkeys(r["rig"] for r in records))
+    bodies = sorted({r["body"] for r in records})
+    by = {(r["body"], r["rig"]): r for r in records}
+    zones = ["crotch", "shoulder tops", "forearms"]
+
+    def cell(body, value):
+        values = [value(by[(body, rig)]) if (body, rig) in by else None for rig in rigs]
+        best = max(v for v in values if v is not None)
+        return " / ".join("—" if v is None else f"**{v:.1f} %**" if v == best else f"{v:.1f} %" for v in values)
+
+    out = [f"| body | covered: {' / '.join(rigs)} | " + " | ".join(zones) + " |", "|---|---|---|---|---|"]
+    for b in bodies:
+        out.append(f"| {b} | {cell(b, lambda r: r['covered_percent'])} | "
+                   + " | ".join(cell(b, lambda r, z=z: r["zones_covered_percent"][z]) for z in zones) + " |")
+    views = sorted({r["max_view_deg"] for r in records})
+    clear = min(r["light_clearance_mm"] for r in records)
+    out += ["", f"Views within {', '.join(f'{v:g}' for v in views)}° of the normal; every frame light at least "
+                f"{clear:.0f} mm clear of the body for every camera."]
+    return "\n".join(out)
+
+
 # A table's name: (its renderer, the figures file it reads, by name in docs/figures).
 TABLES = {
     "sphere": (sphere, "sphere"),
@@ -256,6 +279,7 @@ TABLES = {
     "measure_accuracy": (measure_accuracy, "measure"),
     "measure_fill": (measure_fill, "measure"),
     "gap_cylinder": (gap_cylinder, "gap_cylinder"),
+    "rig_coverage": (rig_coverage, "rig_coverage"),
 }
 
 
