@@ -6,8 +6,7 @@ A benchmark run with --json writes {"run": ..., "records": [...]}
 docs/figures/NAME.json; the table stands in docs/benchmarks.md between
 
     <!-- table NAME -->
-    ...
-    <!-- /table -->
+    ...the table, and where its figures come from. <!-- /table -->
 
 and this script writes it there, with a line naming the command, commit, date and
 machine of each run behind it. So a figure cannot drift from its benchmark's
@@ -33,7 +32,7 @@ from collections import OrderedDict
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOC = os.path.join(ROOT, "docs", "benchmarks.md")
 FIGURES = os.path.join(ROOT, "docs", "figures")
-BLOCK = re.compile(r"(<!-- table ([a-z0-9_]+) -->\n)(.*?)(<!-- /table -->)", re.S)
+BLOCK = re.compile(r"(<!-- table ([a-z0-9_]+) -->\n)(.*?) ?(<!-- /table -->)", re.S)
 
 
 def label(name):
@@ -290,7 +289,7 @@ def figures_path(name):
 def rendered(table):
     render, figures = TABLES[table]
     runs, records = load([figures_path(figures)])
-    return render(records) + "\n\n" + provenance(runs) + "\n"
+    return render(records) + "\n\n" + provenance(runs)
 
 
 def rewrite(doc_text):
@@ -299,7 +298,7 @@ def rewrite(doc_text):
         name = m.group(2)
         if name not in TABLES:
             sys.exit(f"tables: {DOC} names a table '{name}' this script does not know")
-        return m.group(1) + rendered(name) + m.group(4)
+        return m.group(1) + rendered(name) + " " + m.group(4)
     return BLOCK.sub(block, doc_text)
 
 
