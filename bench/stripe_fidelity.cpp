@@ -11,7 +11,10 @@
 // angle in one renderer and not the other is the renderer's.
 //
 //   stripe_fidelity [--rig NAME|FILE] [--body BODY.ply] [--every N] [--sub K] [--radius PX]
-//   [--noisy [--smooth N]]
+//   [--noisy [--smooth N]] [--json OUT.json]
+//
+// --json also writes all cameras' errors by view (bench/json_figures.hpp) for
+// bench/tables.py.
 //
 // --noisy compares the noise-free image with the frame a camera delivers (sensor
 // noise, speckle, its pixel format), extracted against a base frame and smoothed
@@ -30,9 +33,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "hw/rig_description.hpp"
 #include "hw/sim/renderer.hpp"
@@ -68,15 +73,38 @@ struct Bins {
     }
   }
   // Signed mean, median, |err| p50 / p90, count, and how many are over 2 and 4 mm.
-  static void print_row(std::vector<double> v) {
+  static nlohmann::json stats(std::vector<double> v) {
     std::vector<double> a;
     double s = 0;
     for (double e : v) a.push_back(std::abs(e)), s += e;
     std::sort(v.begin(), v.end());
     std::sort(a.begin(), a.end());
     const auto over = [&](double mm) { return a.end() - std::upper_bound(a.begin(), a.end(), mm); };
-    std::printf("%+.3f  %+.3f  %.3f / %.3f  %zu  %td / %td\n", s / static_cast<double>(v.size()), v[v.size() / 2],
-                a[a.size() / 2], a[a.size() * 9 / 10], v.size(), over(2), over(4));
+    return {{"signed_mean_mm", s / static_cast<double>(v.size())},
+            {"median_mm", v[v.size() / 2]},
+            {"abs_p50_mm", a[a.size() / 2]},
+            {"abs_p90_mm", a[a.size() * 9 / 10]},
+            {"samples", v.size()},
+            {"over_2mm", over(2)},
+            {"over_4mm", over(4)}};
+  }
+  static void print_row(const std::vector<double>& v) {
+    const nlohmann::json j = stats(v);
+    std::printf("%+.3f  %+.3f  %.3f / %.3f  %zu  %td / %td\n", j["signed_mean_mm"].get<double>(),
+                j["median_mm"].get<double>(), j["abs_p50_mm"].get<double>(), j["abs_p90_mm"].get<double>(),
+                j["samples"].get<size_t>(), j["over_2mm"].get<ptrdiff_t>(), j["over_4mm"].get<ptrdiff_t>());
+  }
+  // Per view bin with samples: its edges and stats.
+  nlohmann::json to_json() const {
+    nlohmann::json out = nlohmann::json::array();
+    for (size_t b = 0; b + 1 < edges.size(); ++b) {
+      if (all[b].empty()) continue;
+      nlohmann::json j = stats(all[b]);
+      j["view_from_deg"] = edges[b];
+      j["view_to_deg"] = std::min(90.0, edges[b + 1]);
+      out.push_back(std::move(j));
+    }
+    return out;
   }
 };
 
@@ -223,13 +251,15 @@ int main(int argc, char** argv) {
   int smooth = 3;
   CommandLine cl("stripe_fidelity",
                  "usage: stripe_fidelity [--rig NAME|FILE] [--body BODY.ply] [--every N] [--sub K] [--radius PX] "
-                 "[--noisy [--smooth N]]\n");
+                 "[--noisy [--smooth N]] [--json OUT]\n");
   cl.option("--rig", &rig_name);
   cl.option("--body", &body);
   cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
   cl.option("--sub", integer_between(1, 64, [&sub](long long n) { sub = static_cast<int>(n); }));
   cl.option("--radius", integer_between(1, 64, [&radius](long long n) { radius = static_cast<int>(n); }));
   cl.flag("--noisy", &noisy);
+  std::string json_out;
+  cl.option("--json", &json_out);
   cl.option("--smooth", integer_between(0, 1000, [&smooth](long long n) { smooth = static_cast<int>(n); }));
   if (const auto exit = cl.parse(argc, argv)) return *exit;
   std::string path = rig_name;
@@ -440,5 +470,16 @@ int main(int argc, char** argv) {
   shipped_runs.print("shipped");
   reference_runs.print(noisy ? "frames" : "reference");
   if (noisy) end_features.print();
+  if (!json_out.empty()) {
+    const nlohmann::json record = {
+        {"rig", desc->name},
+        {"body", std::filesystem::path(body.empty() ? desc->simulation.subject : body).stem().string()},
+        {"every", every},
+        {"sub", sub},
+        {"noisy", noisy},
+        {"renderer", shipped_all.to_json()},
+        {"reference", reference_all.to_json()}};
+    if (!bench::write_figures(json_out, bench::run_record(argc, argv), nlohmann::json::array({record}))) return 1;
+  }
   return 0;
 }

@@ -271,6 +271,23 @@ def rig_coverage(records):
     return "\n".join(out)
 
 
+def stripe_fidelity(records):
+    """The renderer's stripe against the reference's (or the delivered frame's), by view angle."""
+    out = []
+    for r in records:
+        other = "frame" if r["noisy"] else "reference"
+        out += [f"| view (°) | samples | renderer: signed mean / median (mm) | {other}: signed mean / median (mm) "
+                f"| renderer \\|err\\| p50 (mm) |", "|---|---:|---|---|---:|"]
+        ref = {(b["view_from_deg"], b["view_to_deg"]): b for b in r["reference"]}
+        for b in r["renderer"]:
+            o = ref.get((b["view_from_deg"], b["view_to_deg"]))
+            other_cell = f"{signed(o['signed_mean_mm'], 3)} / {signed(o['median_mm'], 3)}" if o else "—"
+            out.append(f"| {b['view_from_deg']:g}-{b['view_to_deg']:g} | {b['samples']:,} "
+                       f"| {signed(b['signed_mean_mm'], 3)} / {signed(b['median_mm'], 3)} | {other_cell} "
+                       f"| {b['abs_p50_mm']:.3f} |")
+    return "\n".join(out)
+
+
 # A table's name: (its renderer, the figures file it reads, by name in docs/figures).
 TABLES = {
     "sphere": (sphere, "sphere"),
@@ -279,6 +296,7 @@ TABLES = {
     "measure_fill": (measure_fill, "measure"),
     "gap_cylinder": (gap_cylinder, "gap_cylinder"),
     "rig_coverage": (rig_coverage, "rig_coverage"),
+    "stripe_fidelity": (stripe_fidelity, "stripe_fidelity"),
 }
 
 
