@@ -5,8 +5,6 @@
 // carries its provenance and cannot drift from what the benchmark printed.
 #pragma once
 
-#include <unistd.h>
-
 #include <array>
 #include <cstdio>
 #include <cstring>
