@@ -146,14 +146,15 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < std::min<size_t>(8, by.size()); ++k)
       std::printf("%s %s %.1f %%", k ? "," : "", by[k].second.c_str(), 100.0 * by[k].first / s.size());
     std::printf("\n  zones:");
-    for (int z = 0; z < 3; ++z)
-      std::printf(" %s %.1f %% of %.0f cm2%s", zone_names[z],
-                  zone_total[z] ? 100.0 * zone_covered[z] / zone_total[z] : 0.0,
+    nlohmann::json zones;  // name: % covered
+    for (int z = 0; z < 3; ++z) {
+      const double percent = zone_total[z] ? 100.0 * zone_covered[z] / zone_total[z] : 0.0;
+      zones[zone_names[z]] = percent;
+      std::printf(" %s %.1f %% of %.0f cm2%s", zone_names[z], percent,
                   zone_total[z] * surface_area(scene.subject()) / s.size() / 100.0, z < 2 ? "," : "");
+    }
     std::printf("\n");
     const std::string body_name = std::filesystem::path(body.empty() ? desc.simulation.subject : body).stem().string();
-    nlohmann::json zones;
-    for (int z = 0; z < 3; ++z) zones[zone_names[z]] = zone_total[z] ? 100.0 * zone_covered[z] / zone_total[z] : 0.0;
     records.push_back({{"rig", desc.name},
                        {"body", body_name},
                        {"max_view_deg", max_view},
