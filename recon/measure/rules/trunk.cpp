@@ -38,6 +38,9 @@ constexpr double kBustReachOfStature = 0.012;
 // breast's crease; the bust girth's reach grows between them (breast_reach).
 constexpr double kChestFoldMm = 6;
 constexpr double kBreastFoldMm = 14;
+// The waist's window stops under the under-bust only below a fold whose
+// breast_reach is at least this (10 mm deep).
+constexpr double kBreastBoundReach = 0.5;
 // The bust's level ignores a bump in the front's profile this many 2 mm samples
 // tall or less (despiked): a stray stripe's skin on a flat chest's midline.
 constexpr size_t kBustBumpSamples = 2;
@@ -308,13 +311,13 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
   for (Side side : kBothSides) sheet.landmark("bust_point_" + side_name(side), bust_point(cuts, out.bust_y, side));
 
   // Under-bust: below the bust points, the front's deepest point behind the chord.
+  // The front is the mean over kUnderBustColumns columns either side of each bust
+  // point's X (one column follows the skin's noise); a level where a column misses
+  // the front is left out.
+  std::vector<Eigen::Vector2d> front;  // (y, front z), top down
   {
     const double xb = 0.5 * (sheet.position("bust_point_left").x() + sheet.position("bust_point_right").x());
     const double xs = 0.5 * (sheet.position("bust_point_left").x() - sheet.position("bust_point_right").x());
-    // The front is the mean over kUnderBustColumns columns either side of each bust
-    // point's X (one column follows the skin's noise); a level where a column
-    // misses the front is left out.
-    std::vector<Eigen::Vector2d> curve;  // (y, front z), top down
     cuts.prefetch(out.bust_y, out.bust_y - 0.1 * stature, -2);
     for (double y = out.bust_y; y >= out.bust_y - 0.1 * stature; y -= 2) {
       const Ring* m = cuts.midline_loop(y);
@@ -325,25 +328,71 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
         if (!m->crossing_z(xb + xs + o, &f, &b) || !m->crossing_z(xb - xs - o, &f2, &b2)) break;
         sum += f + f2, n += 2;
       }
-      if (n == 2 * (2 * kUnderBustColumns + 1)) curve.emplace_back(y, sum / n);
+      if (n == 2 * (2 * kUnderBustColumns + 1)) front.emplace_back(y, sum / n);
     }
-    out.underbust_y = out.bust_y - 0.05 * stature;
-    if (curve.size() >= 3) {
-      const Notch notch = deepest_behind_chord(curve, 0.02 * stature);
-      out.underbust_y = curve[notch.k].x();
-      out.underbust_fold = notch.depth < 0;
-      // A shallow fold (a man's) is flat at the bottom, and its deepest sample is
-      // the skin noise's: there the vertex of a parabola over 2 % of the stature
-      // either side stands. A deep fold is a crease, steep above and gentle below,
-      // where that vertex would slide down the ribs: there the centroid of the
-      // crease's bottom kCreaseDepthMm deep.
-      if (notch.depth > -kShallowFoldMm && notch.vertex_y) out.underbust_y = *notch.vertex_y;
-      if (notch.depth <= -kShallowFoldMm)
-        out.underbust_y = minimum_centroid(notch.ys, notch.depths, notch.k, kCreaseDepthMm);
-      out.breast = breast_reach(-notch.depth);
-    }
-    sheet.landmark("underbust_front_point", {mid_x, out.underbust_y, cuts.front_z(out.underbust_y)});
   }
+  out.underbust_y = out.bust_y - 0.05 * stature;
+  // The fold's level on a stretch of that front. A shallow fold (a man's) is flat
+  // at the bottom, and its deepest sample is the skin noise's: there the vertex of
+  // a parabola over 2 % of the stature either side stands. A deep fold is a crease,
+  // steep above and gentle below, where that vertex would slide down the ribs:
+  // there the centroid of the crease's bottom kCreaseDepthMm deep.
+  const auto fold_level = [&](const std::vector<Eigen::Vector2d>& curve) {
+    const Notch notch = deepest_behind_chord(curve, 0.02 * stature);
+    double y = curve[notch.k].x();
+    if (notch.depth > -kShallowFoldMm && notch.vertex_y) y = *notch.vertex_y;
+    if (notch.depth <= -kShallowFoldMm) y = minimum_centroid(notch.ys, notch.depths, notch.k, kCreaseDepthMm);
+    return std::make_pair(y, notch.depth);
+  };
+  if (front.size() >= 3) {
+    const auto [y, depth] = fold_level(front);
+    out.underbust_y = y;
+    out.underbust_fold = depth < 0;
+    out.breast = breast_reach(-depth);
+  }
+  const bool breast_crease = out.underbust_fold && out.breast >= kBreastBoundReach;
+
+  // Hip: the buttocks' greatest backward projection. The back is flat over its
+  // backmost on a heavy body, so the level is the vertex of a parabola whose weights
+  // fall to zero kHipHalf of the stature either side of itself.
+  out.hip_y = extreme_level(
+      cuts, crotch_y + 0.01 * stature, crotch_y + 0.16 * stature, [](const Ring& m) { return m.z_min; }, false, 0.5,
+      crotch_y + 0.08 * stature, kHipHalf * stature, true);
+  // The hip's back point is on the tape at the centre back: the tape spans the
+  // cleft between the buttocks at their backmost, wherever on either side that is.
+  Eigen::Vector3d hip_point(mid_x, out.hip_y, mid_z);
+  if (const Ring* m = cuts.midline_loop(out.hip_y)) hip_point.z() = m->z_min;
+  sheet.landmark("hip_back_point", hip_point);
+
+  // Waist: the narrowest trunk between hip and under-bust. Only a breast's crease
+  // (a fold at least halfway from a man's to a breast's, kBreastBoundReach) bounds
+  // the window: a man's fold is a shelf a few mm deep, and a belly's dome has no
+  // fold. Otherwise the window runs to 70 % of the stature. The level is the
+  // centroid of the girth profile's dip kWaistDepthMm deep: a flat waist's
+  // narrowest cut moves with the skin's noise.
+  {
+    double lo = std::max(out.hip_y + 0.04 * stature, cuts.level(0.55)),
+           hi = breast_crease ? std::min(out.underbust_y - 0.02 * stature, cuts.level(0.70)) : cuts.level(0.70);
+    if (lo >= hi) lo = out.hip_y + 0.04 * stature, hi = out.underbust_y - 0.02 * stature;
+    const auto [ys, vs] = midline_profile(cuts, lo, hi, [](const Ring& m) { return m.girth; });
+    out.waist_y = ys.empty() ? 0.5 * (lo + hi) : minimum_centroid(ys, vs, arg_extreme(vs, false), kWaistDepthMm);
+  }
+  double f = mid_z, b = mid_z;
+  if (const Ring* m = cuts.midline_loop(out.waist_y)) m->crossing_z(mid_x, &f, &b);
+  sheet.landmark("waist_back_point", {mid_x, out.waist_y, b});
+  sheet.landmark("waist_front_point", {mid_x, out.waist_y, f});
+
+  // Below a man's shallow fold the belly's hollow over the waist can lie deeper
+  // behind the chord than the fold itself, and whether it falls inside a window of
+  // fixed length depends on where the bust's level is: his under-bust is sought
+  // between the bust and the waist.
+  if (!breast_crease) {
+    std::vector<Eigen::Vector2d> above_waist;
+    for (const Eigen::Vector2d& q : front)
+      if (q.x() >= out.waist_y) above_waist.push_back(q);
+    if (above_waist.size() >= 3 && above_waist.size() < front.size()) out.underbust_y = fold_level(above_waist).first;
+  }
+  sheet.landmark("underbust_front_point", {mid_x, out.underbust_y, cuts.front_z(out.underbust_y)});
 
   // The bust girth's level. A tape is read at its fullest across the prominence
   // (EN 13402-1: "maximum horizontal girth ... across the bust prominence"): over a
@@ -369,34 +418,6 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
     }
   }
 
-  // Hip: the buttocks' greatest backward projection. The back is flat over its
-  // backmost on a heavy body, so the level is the vertex of a parabola whose weights
-  // fall to zero kHipHalf of the stature either side of itself.
-  out.hip_y = extreme_level(
-      cuts, crotch_y + 0.01 * stature, crotch_y + 0.16 * stature, [](const Ring& m) { return m.z_min; }, false, 0.5,
-      crotch_y + 0.08 * stature, kHipHalf * stature, true);
-  // The hip's back point is on the tape at the centre back: the tape spans the
-  // cleft between the buttocks at their backmost, wherever on either side that is.
-  Eigen::Vector3d hip_point(mid_x, out.hip_y, mid_z);
-  if (const Ring* m = cuts.midline_loop(out.hip_y)) hip_point.z() = m->z_min;
-  sheet.landmark("hip_back_point", hip_point);
-
-  // Waist: the narrowest trunk between hip and under-bust. Where the front has no
-  // fold below the bust (a belly's dome, whose top is the most forward point), the
-  // under-bust is no landmark to bound it by, and the window runs to 70 % of the
-  // stature. The level is the centroid of the girth profile's dip kWaistDepthMm
-  // deep: a flat waist's narrowest cut moves with the skin's noise.
-  double lo = std::max(out.hip_y + 0.04 * stature, cuts.level(0.55)),
-         hi = out.underbust_fold ? std::min(out.underbust_y - 0.02 * stature, cuts.level(0.70)) : cuts.level(0.70);
-  if (lo >= hi) lo = out.hip_y + 0.04 * stature, hi = out.underbust_y - 0.02 * stature;
-  {
-    const auto [ys, vs] = midline_profile(cuts, lo, hi, [](const Ring& m) { return m.girth; });
-    out.waist_y = ys.empty() ? 0.5 * (lo + hi) : minimum_centroid(ys, vs, arg_extreme(vs, false), kWaistDepthMm);
-  }
-  double f = mid_z, b = mid_z;
-  if (const Ring* m = cuts.midline_loop(out.waist_y)) m->crossing_z(mid_x, &f, &b);
-  sheet.landmark("waist_back_point", {mid_x, out.waist_y, b});
-  sheet.landmark("waist_front_point", {mid_x, out.waist_y, f});
   return out;
 }
 
