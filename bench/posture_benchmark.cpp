@@ -234,6 +234,8 @@ int main(int argc, char** argv) {
       const auto& pts = m.kind == "height" ? std::vector<Eigen::Vector3d>{m.path.back()} : m.path;
       for (const Eigen::Vector3d& p : pts) vs.push_back(nearest_vertex(ref.mesh, p));
       for (const Eigen::Vector3d& p : m.loop) vs.push_back(nearest_vertex(ref.mesh, p));
+      // And the landmarks it is read from (a height's level can come from others).
+      for (const std::string& l : m.landmarks) vs.push_back(ref.landmark_vertex.at(l));
     }
     struct Variant {
       std::string name;

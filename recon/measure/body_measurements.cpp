@@ -88,8 +88,11 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
 
     sheet.landmark("top_of_head", cuts.crown());
     sheet.height("stature", "Stature", "5.1.1", {"top_of_head"}, cuts.crown(), "top of the head above the floor");
-    sheet.height("cervical_height", "Cervical height", "", {"back_neck_point"}, sheet.position("back_neck_point"),
-                 "back neck point above the floor");
+    // The back neck point lies at the side neck points' level: the value is read
+    // from all three.
+    sheet.height("cervical_height", "Cervical height", "",
+                 {"back_neck_point", "side_neck_point_left", "side_neck_point_right"},
+                 sheet.position("back_neck_point"), "back neck point (at the side neck points' level) above the floor");
     sheet.height("crotch_height", "Inside leg length (crotch height)", "5.1.15", {"crotch"}, sheet.position("crotch"),
                  "crotch above the floor");
     rules::measure_neck(cuts, sheet, neck);
