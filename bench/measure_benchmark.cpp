@@ -25,7 +25,8 @@
 // vertical, the ankle joints FEET mm apart (hw/sim/pose_body.hpp: a MakeHuman body
 // only), turned TURN degrees about the vertical (+ turns the face from +Z toward +X).
 // The truth is then the posed body exactly as the simulator rendered it (posture,
-// turn and place), and --save keeps that one.
+// turn and place), and --save keeps that one. With --saved it only names the
+// posture the saved scans were taken in, for the JSON records.
 // --noise-study N measures each body's own mesh N times under smooth skin noise
 // (tests/support/skin_noise.hpp: fields at 40 and 10 mm, each --noise-rms RMS, default
 // 0.25 mm) and ranks the measurements and landmarks by how far they move: no scan,
@@ -375,6 +376,15 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
   return 0;
 }
 
+// The posture --posture asked for (the scan's, or with --saved the one the saved
+// scan was taken in), as the JSON record's "posed".
+void add_posture(nlohmann::json& record) {
+  if (g_subject.turn_deg)
+    record["posed"] = {{"arms_deg", *g_subject.posture.arm_abduction_deg[0]},
+                       {"ankles_mm", *g_subject.posture.ankle_distance_mm},
+                       {"turn_deg", *g_subject.turn_deg}};
+}
+
 int run(const std::string& rig, const std::string& body, bool repeat, double sway, int every) {
   std::printf("\n== rig %s, body %s", rig.c_str(), body.empty() ? "(the rig's)" : body.c_str());
   if (g_subject.turn_deg)
@@ -420,10 +430,7 @@ int run(const std::string& rig, const std::string& body, bool repeat, double swa
     b = std::move(*s);
   }
   nlohmann::json record = {{"rig", rig}, {"body", body_name(body)}, {"scan_seconds", scan_seconds}};
-  if (g_subject.turn_deg)
-    record["posed"] = {{"arms_deg", *g_subject.posture.arm_abduction_deg[0]},
-                       {"ankles_mm", *g_subject.posture.ankle_distance_mm},
-                       {"turn_deg", *g_subject.turn_deg}};
+  add_posture(record);
   return finish(record, report(a->truth, a->mesh, *a->body, a->floor, b ? &*b->body : nullptr, sway, record));
 }
 
@@ -467,6 +474,7 @@ int remeasure(const std::string& dir, const std::string& rig, const std::string&
     b = std::move(*m);
   }
   nlohmann::json record = {{"rig", rig}, {"body", body_name(body)}, {"saved", dir}};
+  add_posture(record);
   return finish(record, report(*truth, *mesh, *a, floor, b ? &*b : nullptr, sway, record));
 }
 

@@ -196,6 +196,59 @@ Eigen::Vector3d bust_point(const BodyCuts& cuts, double bust_y, Side side) {
   return p;
 }
 
+// The front under the bust, top down from bust_y over 10 % of the stature, as (y,
+// front z): the mean over kUnderBustColumns columns either side of each bust
+// point's X (one column follows the skin's noise); a level where a column misses
+// the front is left out.
+std::vector<Eigen::Vector2d> front_under_bust(const BodyCuts& cuts, const MeasurementSheet& sheet, double bust_y) {
+  const double stature = cuts.stature();
+  const double xb = 0.5 * (sheet.position("bust_point_left").x() + sheet.position("bust_point_right").x());
+  const double xs = 0.5 * (sheet.position("bust_point_left").x() - sheet.position("bust_point_right").x());
+  std::vector<Eigen::Vector2d> front;
+  cuts.prefetch(bust_y, bust_y - 0.1 * stature, -2);
+  for (double y = bust_y; y >= bust_y - 0.1 * stature; y -= 2) {
+    const Ring* m = cuts.midline_loop(y);
+    double f = 0, b = 0, f2 = 0, b2 = 0, sum = 0;
+    int n = 0;
+    for (int j = -kUnderBustColumns; m && j <= kUnderBustColumns; ++j) {
+      const double o = j * kUnderBustStep * stature;
+      if (!m->crossing_z(xb + xs + o, &f, &b) || !m->crossing_z(xb - xs - o, &f2, &b2)) break;
+      sum += f + f2, n += 2;
+    }
+    if (n == 2 * (2 * kUnderBustColumns + 1)) front.emplace_back(y, sum / n);
+  }
+  return front;
+}
+
+// The fold's level on a stretch of the front under the bust (at least 3 samples),
+// and its depth behind the stretch's chord (<= 0). A shallow fold (a man's) is
+// flat at the bottom, and its deepest sample is the skin noise's: there the vertex
+// of a parabola over 2 % of the stature either side stands. A deep fold is a
+// crease, steep above and gentle below, where that vertex would slide down the
+// ribs: there the centroid of the crease's bottom kCreaseDepthMm deep.
+std::pair<double, double> fold_level(const std::vector<Eigen::Vector2d>& front, double stature) {
+  const Notch notch = deepest_behind_chord(front, 0.02 * stature);
+  double y = front[notch.k].x();
+  if (notch.depth > -kShallowFoldMm && notch.vertex_y) y = *notch.vertex_y;
+  if (notch.depth <= -kShallowFoldMm) y = minimum_centroid(notch.ys, notch.depths, notch.k, kCreaseDepthMm);
+  return {y, notch.depth};
+}
+
+// Waist: the narrowest trunk between hip and under-bust. Only a breast's crease
+// (`crease_y`: a fold at least halfway from a man's to a breast's,
+// kBreastBoundReach) bounds the window: a man's fold is a shelf a few mm deep, and
+// a belly's dome has no fold. Otherwise the window runs to 70 % of the stature.
+// The level is the centroid of the girth profile's dip kWaistDepthMm deep: a flat
+// waist's narrowest cut moves with the skin's noise.
+double waist_level(const BodyCuts& cuts, double hip_y, std::optional<double> crease_y) {
+  const double stature = cuts.stature();
+  double lo = std::max(hip_y + 0.04 * stature, cuts.level(0.55)),
+         hi = crease_y ? std::min(*crease_y - 0.02 * stature, cuts.level(0.70)) : cuts.level(0.70);
+  if (lo >= hi && crease_y) lo = hip_y + 0.04 * stature, hi = *crease_y - 0.02 * stature;
+  const auto [ys, vs] = midline_profile(cuts, lo, hi, [](const Ring& m) { return m.girth; });
+  return ys.empty() ? 0.5 * (lo + hi) : minimum_centroid(ys, vs, arg_extreme(vs, false), kWaistDepthMm);
+}
+
 }  // namespace
 
 StatusOr<double> find_crotch(const BodyCuts& cuts, MeasurementSheet& sheet) {
@@ -311,41 +364,10 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
   for (Side side : kBothSides) sheet.landmark("bust_point_" + side_name(side), bust_point(cuts, out.bust_y, side));
 
   // Under-bust: below the bust points, the front's deepest point behind the chord.
-  // The front is the mean over kUnderBustColumns columns either side of each bust
-  // point's X (one column follows the skin's noise); a level where a column misses
-  // the front is left out.
-  std::vector<Eigen::Vector2d> front;  // (y, front z), top down
-  {
-    const double xb = 0.5 * (sheet.position("bust_point_left").x() + sheet.position("bust_point_right").x());
-    const double xs = 0.5 * (sheet.position("bust_point_left").x() - sheet.position("bust_point_right").x());
-    cuts.prefetch(out.bust_y, out.bust_y - 0.1 * stature, -2);
-    for (double y = out.bust_y; y >= out.bust_y - 0.1 * stature; y -= 2) {
-      const Ring* m = cuts.midline_loop(y);
-      double f = 0, b = 0, f2 = 0, b2 = 0, sum = 0;
-      int n = 0;
-      for (int j = -kUnderBustColumns; m && j <= kUnderBustColumns; ++j) {
-        const double o = j * kUnderBustStep * stature;
-        if (!m->crossing_z(xb + xs + o, &f, &b) || !m->crossing_z(xb - xs - o, &f2, &b2)) break;
-        sum += f + f2, n += 2;
-      }
-      if (n == 2 * (2 * kUnderBustColumns + 1)) front.emplace_back(y, sum / n);
-    }
-  }
+  const std::vector<Eigen::Vector2d> front = front_under_bust(cuts, sheet, out.bust_y);
   out.underbust_y = out.bust_y - 0.05 * stature;
-  // The fold's level on a stretch of that front. A shallow fold (a man's) is flat
-  // at the bottom, and its deepest sample is the skin noise's: there the vertex of
-  // a parabola over 2 % of the stature either side stands. A deep fold is a crease,
-  // steep above and gentle below, where that vertex would slide down the ribs:
-  // there the centroid of the crease's bottom kCreaseDepthMm deep.
-  const auto fold_level = [&](const std::vector<Eigen::Vector2d>& curve) {
-    const Notch notch = deepest_behind_chord(curve, 0.02 * stature);
-    double y = curve[notch.k].x();
-    if (notch.depth > -kShallowFoldMm && notch.vertex_y) y = *notch.vertex_y;
-    if (notch.depth <= -kShallowFoldMm) y = minimum_centroid(notch.ys, notch.depths, notch.k, kCreaseDepthMm);
-    return std::make_pair(y, notch.depth);
-  };
   if (front.size() >= 3) {
-    const auto [y, depth] = fold_level(front);
+    const auto [y, depth] = fold_level(front, stature);
     out.underbust_y = y;
     out.underbust_fold = depth < 0;
     out.breast = breast_reach(-depth);
@@ -364,19 +386,7 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
   if (const Ring* m = cuts.midline_loop(out.hip_y)) hip_point.z() = m->z_min;
   sheet.landmark("hip_back_point", hip_point);
 
-  // Waist: the narrowest trunk between hip and under-bust. Only a breast's crease
-  // (a fold at least halfway from a man's to a breast's, kBreastBoundReach) bounds
-  // the window: a man's fold is a shelf a few mm deep, and a belly's dome has no
-  // fold. Otherwise the window runs to 70 % of the stature. The level is the
-  // centroid of the girth profile's dip kWaistDepthMm deep: a flat waist's
-  // narrowest cut moves with the skin's noise.
-  {
-    double lo = std::max(out.hip_y + 0.04 * stature, cuts.level(0.55)),
-           hi = breast_crease ? std::min(out.underbust_y - 0.02 * stature, cuts.level(0.70)) : cuts.level(0.70);
-    if (lo >= hi) lo = out.hip_y + 0.04 * stature, hi = out.underbust_y - 0.02 * stature;
-    const auto [ys, vs] = midline_profile(cuts, lo, hi, [](const Ring& m) { return m.girth; });
-    out.waist_y = ys.empty() ? 0.5 * (lo + hi) : minimum_centroid(ys, vs, arg_extreme(vs, false), kWaistDepthMm);
-  }
+  out.waist_y = waist_level(cuts, out.hip_y, breast_crease ? std::optional<double>(out.underbust_y) : std::nullopt);
   double f = mid_z, b = mid_z;
   if (const Ring* m = cuts.midline_loop(out.waist_y)) m->crossing_z(mid_x, &f, &b);
   sheet.landmark("waist_back_point", {mid_x, out.waist_y, b});
@@ -390,7 +400,8 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
     std::vector<Eigen::Vector2d> above_waist;
     for (const Eigen::Vector2d& q : front)
       if (q.x() >= out.waist_y) above_waist.push_back(q);
-    if (above_waist.size() >= 3 && above_waist.size() < front.size()) out.underbust_y = fold_level(above_waist).first;
+    if (above_waist.size() >= 3 && above_waist.size() < front.size())
+      out.underbust_y = fold_level(above_waist, stature).first;
   }
   sheet.landmark("underbust_front_point", {mid_x, out.underbust_y, cuts.front_z(out.underbust_y)});
 
