@@ -294,6 +294,7 @@ TABLES = {
     "posture": (posture, "posture"),
     "measure_accuracy": (measure_accuracy, "measure"),
     "measure_fill": (measure_fill, "measure"),
+    "measure_posed": (measure_accuracy, "measure_posed"),
     "gap_cylinder": (gap_cylinder, "gap_cylinder"),
     "rig_coverage": (rig_coverage, "rig_coverage"),
     "stripe_fidelity": (stripe_fidelity, "stripe_fidelity"),
