@@ -52,20 +52,42 @@ constexpr double kForearmStepMm = 4;
 
 // The arm's horizontal cuts from just below where its own loop ends, down to where
 // it ends, splits into fingers, thins under 40 % of its largest, or (past the
-// crotch) nears the leg: each cut's centroid and tape.
+// crotch) nears the leg: each cut's centroid and tape. The first cut's arm is the
+// outermost loop on its side; each next one the loop on that side nearest the last
+// centre (a fold of the surface beside the arm can be a small loop farther out).
+// Fingers part where another loop lies near the arm's and the arm's own tape has
+// shrunk by at least half of that loop's since the last cut (the fingers left it);
+// a fold beside the arm adds a loop and takes nothing from the arm's.
 struct ArmTrack {
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> girths;
 };
 ArmTrack follow_arm(const BodyCuts& cuts, double arm_apart_y, double crotch_y, Side side) {
-  const double mid_x = cuts.midline_x(), stature = cuts.stature();
+  constexpr double kMinGirthMm = 30;  // a loop shorter than this is no part (side_ring's)
+  const double mid_x = cuts.midline_x(), stature = cuts.stature(), reach = 0.06 * stature;
   ArmTrack track;
+  const auto continued = [&](const std::vector<Ring>& cut) -> const Ring* {
+    if (track.centres.empty()) return side_ring(cut, mid_x, side, true, kMinGirthMm);
+    const Ring* best = nullptr;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (const Ring& r : cut) {
+      if (r.spans_x(mid_x) || r.girth < kMinGirthMm || sign(side) * (r.centroid.x() - mid_x) <= 0) continue;
+      const Eigen::Vector3d& last = track.centres.back();
+      const double d = std::hypot(r.centroid.x() - last.x(), r.centroid.z() - last.z());
+      if (d < best_d) best = &r, best_d = d;
+    }
+    return best;
+  };
   cuts.prefetch(arm_apart_y - kArmStepMm, crotch_y - 0.05 * stature, -kArmStepMm);  // where a hanging arm ends
   for (double y = arm_apart_y - kArmStepMm; y > 0; y -= kArmStepMm) {
     const std::vector<Ring>& cut = cuts.at(y);
-    const Ring* a = side_ring(cut, mid_x, side, true);
+    const Ring* a = continued(cut);
     if (!a || (y < crotch_y && std::abs(a->centroid.x() - mid_x) < 0.1 * stature)) break;
-    if (parts_near(cut, *a, 0.06 * stature) > 0) break;
+    bool parted = false;
+    for (const Ring& r : cut)
+      if (&r != a && r.girth >= kMinGirthMm && (r.centroid - a->centroid).norm() < reach)
+        parted = parted || track.girths.empty() || track.girths.back() - a->girth >= 0.5 * r.girth;
+    if (parted) break;
     if (!track.girths.empty() && a->girth < 0.4 * *std::max_element(track.girths.begin(), track.girths.end())) break;
     track.centres.push_back(a->centroid);
     track.girths.push_back(a->girth);

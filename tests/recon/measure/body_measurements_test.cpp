@@ -251,6 +251,34 @@ TEST(BodyMeasurements, AStrayFoldBesideTheFlankDoesNotEndTheArm) {
     EXPECT_NEAR(b->find(name)->value_mm, clean->find(name)->value_mm, 0.5) << name;
 }
 
+TEST(BodyMeasurements, AFoldOutsideTheForearmIsNeitherTheArmNorItsFingers) {
+  // A scan can keep a fold of surface against the outside of the forearm, a small
+  // loop farther from the midline than the arm's in the cuts there. The track must
+  // keep to the arm and run past it to the hand: taking the fold for the arm, and
+  // the arm beside it for fingers parting, once put the wrist 60 mm up the forearm.
+  const ShippedBody* body = male_average();
+  ASSERT_TRUE(body);
+  const BodyMeasurements* clean = &body->measured;
+  const Eigen::Vector3d elbow = clean->landmark("elbow_point_left")->position;
+  const Eigen::Vector3d wrist = clean->landmark("wrist_point_left")->position;
+  const double y = 0.5 * (elbow.y() + wrist.y());
+  const BodySlicer slicer(body->mesh, 0, 1800);
+  const Ring* arm = nullptr;
+  const std::vector<Ring> cut = slicer.rings(y);
+  for (const Ring& r : cut)
+    if (!r.spans_x(0) && r.centroid.x() > 0 && (!arm || r.centroid.x() > arm->centroid.x())) arm = &r;
+  ASSERT_TRUE(arm);
+  // A loop 31 mm round (a tape over 30 mm counts as a part), 2 mm off the arm's
+  // outer side, 30 mm tall.
+  const Eigen::Vector2d at(arm->x_max + 7, arm->centroid.z());
+  const TriangleMesh with_fold =
+      testing::merged(body->mesh, testing::prism(testing::circle(5, at, 90), at, y - 15, y + 15));
+  auto b = measure_body(with_fold);
+  ASSERT_TRUE(b.ok()) << b.status().message();
+  for (const char* name : {"wrist_girth_left", "upper_arm_girth_left", "outer_arm_length_left"})
+    EXPECT_NEAR(b->find(name)->value_mm, clean->find(name)->value_mm, 0.5) << name;
+}
+
 TEST(BodyMeasurements, AScrapBesideTheHipIsNoArm) {
   // A coarse scan (every 6th laser step) can leave a scrap of surface beside the hip,
   // a small loop of its own in a few cuts above the crotch. The armpit search once
