@@ -62,32 +62,43 @@ struct ArmTrack {
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> girths;
 };
+
+constexpr double kMinPartGirthMm = 30;  // a loop shorter than this is no part (side_ring's)
+
+// The loop on `side` of the midline X = mid_x whose centre lies nearest `last` (in
+// the cut's plane), at least kMinPartGirthMm round.
+const Ring* nearest_side_ring(const std::vector<Ring>& cut, double mid_x, Side side, const Eigen::Vector3d& last) {
+  const Ring* best = nullptr;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (const Ring& r : cut) {
+    if (r.spans_x(mid_x) || r.girth < kMinPartGirthMm || sign(side) * (r.centroid.x() - mid_x) <= 0) continue;
+    const double d = std::hypot(r.centroid.x() - last.x(), r.centroid.z() - last.z());
+    if (d < best_d) best = &r, best_d = d;
+  }
+  return best;
+}
+
+// Whether fingers part from `arm` in `cut`: another loop within `reach` of it, and
+// the arm's tape shrunk by at least half of that loop's since the last cut (the
+// last of `girths`, the track's so far; none: any loop near counts).
+bool fingers_part(const std::vector<Ring>& cut, const Ring& arm, double reach, const std::vector<double>& girths) {
+  for (const Ring& r : cut)
+    if (&r != &arm && r.girth >= kMinPartGirthMm && (r.centroid - arm.centroid).norm() < reach &&
+        (girths.empty() || girths.back() - arm.girth >= 0.5 * r.girth))
+      return true;
+  return false;
+}
+
 ArmTrack follow_arm(const BodyCuts& cuts, double arm_apart_y, double crotch_y, Side side) {
-  constexpr double kMinGirthMm = 30;  // a loop shorter than this is no part (side_ring's)
-  const double mid_x = cuts.midline_x(), stature = cuts.stature(), reach = 0.06 * stature;
+  const double mid_x = cuts.midline_x(), stature = cuts.stature();
   ArmTrack track;
-  const auto continued = [&](const std::vector<Ring>& cut) -> const Ring* {
-    if (track.centres.empty()) return side_ring(cut, mid_x, side, true, kMinGirthMm);
-    const Ring* best = nullptr;
-    double best_d = std::numeric_limits<double>::infinity();
-    for (const Ring& r : cut) {
-      if (r.spans_x(mid_x) || r.girth < kMinGirthMm || sign(side) * (r.centroid.x() - mid_x) <= 0) continue;
-      const Eigen::Vector3d& last = track.centres.back();
-      const double d = std::hypot(r.centroid.x() - last.x(), r.centroid.z() - last.z());
-      if (d < best_d) best = &r, best_d = d;
-    }
-    return best;
-  };
   cuts.prefetch(arm_apart_y - kArmStepMm, crotch_y - 0.05 * stature, -kArmStepMm);  // where a hanging arm ends
   for (double y = arm_apart_y - kArmStepMm; y > 0; y -= kArmStepMm) {
     const std::vector<Ring>& cut = cuts.at(y);
-    const Ring* a = continued(cut);
+    const Ring* a = track.centres.empty() ? side_ring(cut, mid_x, side, true, kMinPartGirthMm)
+                                          : nearest_side_ring(cut, mid_x, side, track.centres.back());
     if (!a || (y < crotch_y && std::abs(a->centroid.x() - mid_x) < 0.1 * stature)) break;
-    bool parted = false;
-    for (const Ring& r : cut)
-      if (&r != a && r.girth >= kMinGirthMm && (r.centroid - a->centroid).norm() < reach)
-        parted = parted || track.girths.empty() || track.girths.back() - a->girth >= 0.5 * r.girth;
-    if (parted) break;
+    if (fingers_part(cut, *a, 0.06 * stature, track.girths)) break;
     if (!track.girths.empty() && a->girth < 0.4 * *std::max_element(track.girths.begin(), track.girths.end())) break;
     track.centres.push_back(a->centroid);
     track.girths.push_back(a->girth);
