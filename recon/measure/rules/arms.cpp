@@ -50,14 +50,7 @@ constexpr double kArmStepMm = 3;
 // The cuts across the forearm near the wrist, mm apart.
 constexpr double kForearmStepMm = 4;
 
-// The arm's horizontal cuts from just below where its own loop ends, down to where
-// it ends, splits into fingers, thins under 40 % of its largest, or (past the
-// crotch) nears the leg: each cut's centroid and tape. The first cut's arm is the
-// outermost loop on its side; each next one the loop on that side nearest the last
-// centre (a fold of the surface beside the arm can be a small loop farther out).
-// Fingers part where another loop lies near the arm's and the arm's own tape has
-// shrunk by at least half of that loop's since the last cut (the fingers left it);
-// a fold beside the arm adds a loop and takes nothing from the arm's.
+// The arm's cuts that follow_arm takes, from the armpit down: centroids and tapes.
 struct ArmTrack {
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> girths;
@@ -89,6 +82,14 @@ bool fingers_part(const std::vector<Ring>& cut, const Ring& arm, double reach, c
   return false;
 }
 
+// The arm's horizontal cuts from just below where its own loop ends, down to where
+// it ends, splits into fingers, thins under 40 % of its largest, or (past the
+// crotch) nears the leg: each cut's centroid and tape. The first cut's arm is the
+// outermost loop on its side; each next one the loop on that side nearest the last
+// centre (a fold of the surface beside the arm can be a small loop farther out).
+// Fingers part where another loop lies near the arm's and the arm's own tape has
+// shrunk by at least half of that loop's since the last cut (the fingers left it);
+// a fold beside the arm adds a loop and takes nothing from the arm's.
 ArmTrack follow_arm(const BodyCuts& cuts, double arm_apart_y, double crotch_y, Side side) {
   const double mid_x = cuts.midline_x(), stature = cuts.stature();
   ArmTrack track;
