@@ -56,21 +56,6 @@ struct ArmTrack {
   std::vector<double> girths;
 };
 
-constexpr double kMinPartGirthMm = 30;  // a loop shorter than this is no part (side_ring's)
-
-// The loop on `side` of the midline X = mid_x whose centre lies nearest `last` (in
-// the cut's plane), at least kMinPartGirthMm round.
-const Ring* nearest_side_ring(const std::vector<Ring>& cut, double mid_x, Side side, const Eigen::Vector3d& last) {
-  const Ring* best = nullptr;
-  double best_d = std::numeric_limits<double>::infinity();
-  for (const Ring& r : cut) {
-    if (r.spans_x(mid_x) || r.girth < kMinPartGirthMm || sign(side) * (r.centroid.x() - mid_x) <= 0) continue;
-    const double d = std::hypot(r.centroid.x() - last.x(), r.centroid.z() - last.z());
-    if (d < best_d) best = &r, best_d = d;
-  }
-  return best;
-}
-
 // Whether fingers part from `arm` in `cut`: another loop within `reach` of it, and
 // the arm's tape shrunk by at least half of that loop's since the last cut (the
 // last of `girths`, the track's so far; none: any loop near counts).
@@ -96,7 +81,7 @@ ArmTrack follow_arm(const BodyCuts& cuts, double arm_apart_y, double crotch_y, S
   cuts.prefetch(arm_apart_y - kArmStepMm, crotch_y - 0.05 * stature, -kArmStepMm);  // where a hanging arm ends
   for (double y = arm_apart_y - kArmStepMm; y > 0; y -= kArmStepMm) {
     const std::vector<Ring>& cut = cuts.at(y);
-    const Ring* a = track.centres.empty() ? side_ring(cut, mid_x, side, true, kMinPartGirthMm)
+    const Ring* a = track.centres.empty() ? side_ring(cut, mid_x, side, true)
                                           : nearest_side_ring(cut, mid_x, side, track.centres.back());
     if (!a || (y < crotch_y && std::abs(a->centroid.x() - mid_x) < 0.1 * stature)) break;
     if (fingers_part(cut, *a, 0.06 * stature, track.girths)) break;

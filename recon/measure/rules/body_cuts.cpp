@@ -98,14 +98,31 @@ const Ring* midline_ring(const std::vector<Ring>& rings, double x) {
   return best;
 }
 
+namespace {
+// Whether `r` lies wholly on `side` of the midline X = x, at least min_girth round.
+bool on_side(const Ring& r, double x, Side side, double min_girth) {
+  return !r.spans_x(x) && r.girth >= min_girth && sign(side) * (r.centroid.x() - x) > 0;
+}
+}  // namespace
+
 const Ring* side_ring(const std::vector<Ring>& rings, double x, Side side, bool farthest, double min_girth) {
   const Ring* best = nullptr;
   double best_d = 0;
   for (const Ring& r : rings) {
-    if (r.spans_x(x) || r.girth < min_girth) continue;
+    if (!on_side(r, x, side, min_girth)) continue;
     const double d = sign(side) * (r.centroid.x() - x);
-    if (d <= 0) continue;
     if (!best || (farthest ? d > best_d : d < best_d)) best = &r, best_d = d;
+  }
+  return best;
+}
+
+const Ring* nearest_side_ring(const std::vector<Ring>& rings, double x, Side side, const Eigen::Vector3d& last) {
+  const Ring* best = nullptr;
+  double best_d = kInf;
+  for (const Ring& r : rings) {
+    if (!on_side(r, x, side, kMinPartGirthMm)) continue;
+    const double d = std::hypot(r.centroid.x() - last.x(), r.centroid.z() - last.z());
+    if (d < best_d) best = &r, best_d = d;
   }
   return best;
 }

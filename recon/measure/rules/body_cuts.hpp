@@ -101,14 +101,21 @@ class BodyCuts {
 // The loop spanning the midline X = x (trunk, neck, head), the longest if several.
 const Ring* midline_ring(const std::vector<Ring>& rings, double x);
 
+// A loop of a cut whose tape is shorter than this (mm) is no part of the body.
+constexpr double kMinPartGirthMm = 30;
+
 // The loop wholly on `side` of the midline X = x, at least min_girth round:
 // `farthest` picks the outermost (an arm), otherwise the innermost (a leg).
-const Ring* side_ring(const std::vector<Ring>& rings, double x, Side side, bool farthest, double min_girth = 30);
+const Ring* side_ring(const std::vector<Ring>& rings, double x, Side side, bool farthest,
+                      double min_girth = kMinPartGirthMm);
+// The loop wholly on `side` of the midline X = x, at least kMinPartGirthMm round,
+// whose centre lies nearest `last` in the cut's plane (a part followed cut by cut).
+const Ring* nearest_side_ring(const std::vector<Ring>& rings, double x, Side side, const Eigen::Vector3d& last);
 
 // How many other loops of the cut (of a tape at least min_girth) lie within
 // `reach` of the part's centre: fingers parting from a hand. A stray fold of the
 // reconstruction against the flank, far from the arm, is not counted.
-size_t parts_near(const std::vector<Ring>& rings, const Ring& part, double reach, double min_girth = 30);
+size_t parts_near(const std::vector<Ring>& rings, const Ring& part, double reach, double min_girth = kMinPartGirthMm);
 
 // The middle of a flat extreme: of the points whose height along `dir` lies within
 // `band` of the highest, the one nearest (along `across`) to the vertex of the
