@@ -3,19 +3,24 @@
 // to the true body surface with both triangulation methods, coverage (and where the
 // holes are), and the processing time from frames to points.
 //
-//   scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N]
+//   scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--json OUT.json]
 //
-// Defaults: both shipped rigs, the rig's own demo body, every step.
+// Defaults: both shipped rigs, the rig's own demo body, every step. --json also
+// writes each run's figures (bench/json_figures.hpp) for bench/tables.py: per camera
+// its markers, centre and calibration bias, per method the cloud's distances to the
+// truth, and the default method's coverage.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
 
 #include "bench/body_region.hpp"
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "pipeline/rig_backend.hpp"
 #include "pipeline/scan.hpp"
@@ -68,6 +73,7 @@ float g_weak = -1;
 int g_radius = -1;
 double g_max_view = -1;
 bool g_keep_sway = false;
+nlohmann::json g_records = nlohmann::json::array();  // one per rig and body, for --json
 
 int run(const std::string& rig_name, const std::string& body, int every) {
   pipeline::SimulatedSubject subject;
@@ -77,8 +83,13 @@ int run(const std::string& rig_name, const std::string& body, int every) {
   hw::sim::SimulatedRig& rig = **sim;
   const hw::RigDescription& desc = rig.description();
   const pipeline::Rig handle = pipeline::rig_handle(rig);
-  std::printf("\n== rig %s, body %s, every %d step(s)\n", desc.name.c_str(),
-              body.empty() ? desc.simulation.subject.c_str() : body.c_str(), every);
+  const std::string body_path = body.empty() ? desc.simulation.subject : body;
+  std::printf("\n== rig %s, body %s, every %d step(s)\n", desc.name.c_str(), body_path.c_str(), every);
+  nlohmann::json record = {{"rig", desc.name},
+                           {"body", std::filesystem::path(body_path).stem().string()},
+                           {"every", every},
+                           {"cameras", nlohmann::json::array()},
+                           {"methods", nlohmann::json::array()}};
 
   // Calibration.
   auto t0 = Clock::now();
@@ -135,6 +146,10 @@ int run(const std::string& rig_name, const std::string& body, int every) {
     std::printf("%-12s %5s %6d %9.3f %9.3f %9.3f %9.3f %9.2f %9.2f\n", cc.camera_id.c_str(), to_string(cc.side),
                 cc.lens.dots_used(), cc.lens.held_out_rms_px(), std::sqrt(lens_ss / lens_err.size()),
                 quantiles(lens_err).max, marker_worst, (cc.centre - model.centre()).norm(), cc.ray_spread_mm);
+    record["cameras"].push_back({{"camera", cc.camera_id},
+                                 {"marker_worst_px", marker_worst},
+                                 {"centre_mm", (cc.centre - model.centre()).norm()},
+                                 {"rays_mm", cc.ray_spread_mm}});
   }
 
   // The scan, processed four times from the same frames: planes from the sweep fit
@@ -233,6 +248,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
     for (double x : dd) far += x > 5;
     std::printf("%-36s %8zu points: distance to the true surface mean %.3f mm, p95 %.3f, max %.1f (%zu beyond 5 mm)\n",
                 names[k].c_str(), cloud.size(), q.mean, q.p95, q.max, far);
+    record["methods"].push_back(
+        {{"method", names[k]}, {"points", cloud.size()}, {"mean_mm", q.mean}, {"p95_mm", q.p95}, {"max_mm", q.max}});
     for (size_t c = 0; c < cal->cameras.size(); ++c) {
       std::vector<double> dc;
       for (size_t i = 0; i < dd.size(); ++i)
@@ -336,9 +353,11 @@ int run(const std::string& rig_name, const std::string& body, int every) {
         }
       }
       std::printf("    signed mean within 5 mm by camera:");
-      for (size_t c = 0; c < camera_n.size(); ++c)
-        std::printf(" %s %+.3f", cal->cameras[c].camera_id.c_str(),
-                    camera_bias[c] / static_cast<double>(std::max<size_t>(camera_n[c], 1)));
+      for (size_t c = 0; c < camera_n.size(); ++c) {
+        const double bias = camera_bias[c] / static_cast<double>(std::max<size_t>(camera_n[c], 1));
+        std::printf(" %s %+.3f", cal->cameras[c].camera_id.c_str(), bias);
+        record["cameras"][c]["points_signed_mm"] = bias;
+      }
       std::printf("\n");
     }
     // The calibration alone: each camera's image-to-laser-plane transform for the
@@ -381,6 +400,8 @@ int run(const std::string& rig_name, const std::string& body, int every) {
           }
         }
         std::printf(" %s %+.3f (|.| %.3f, %zu)", cc.camera_id.c_str(), n ? sum / n : 0.0, n ? sum_abs / n : 0.0, n);
+        record["cameras"][c]["calibration_signed_mm"] = n ? sum / n : 0.0;
+        record["cameras"][c]["calibration_abs_mm"] = n ? sum_abs / n : 0.0;
       }
       std::printf("\n");
     }
@@ -401,6 +422,7 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       holes[bench::body_region(x.cast<double>(), n.cast<double>())]++;
     }
     std::printf("coverage within 5 mm: %.1f %% of the body's area; uncovered:", 100.0 * covered / samples.size());
+    record["coverage_percent"] = 100.0 * covered / samples.size();
     std::vector<std::pair<size_t, std::string>> by_size;
     for (const auto& [region, count] : holes) by_size.emplace_back(count, region);
     std::sort(by_size.rbegin(), by_size.rend());
@@ -408,6 +430,7 @@ int run(const std::string& rig_name, const std::string& body, int every) {
       std::printf("%s %s %.1f %%", i ? "," : "", by_size[i].second.c_str(), 100.0 * by_size[i].first / samples.size());
     std::printf("\n");
   }
+  g_records.push_back(std::move(record));
   return 0;
 }
 
@@ -415,11 +438,13 @@ int run(const std::string& rig_name, const std::string& body, int every) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> rigs, bodies;
+  std::string json_out;
   int every = 1;
   CommandLine cl(
       "scan_benchmark",
       "usage: scan_benchmark [--rig thesis|square|FILE]... [--body BODY.ply]... [--every N] [--min-angle DEG] "
-      "[--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C] [--keep-sway]\n");
+      "[--max-view DEG] [--smooth N] [--radius PX] [--threshold N] [--redundant MM] [--weak C] [--keep-sway] "
+      "[--json OUT]\n");
   cl.option("--rig", &rigs);
   cl.option("--body", &bodies);
   cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
@@ -431,11 +456,14 @@ int main(int argc, char** argv) {
   cl.option("--threshold", &g_threshold);
   cl.option("--redundant", &g_redundant);
   cl.option("--weak", &g_weak);
+  cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  const nlohmann::json run_info = bench::run_record(argc, argv);
   if (rigs.empty()) rigs = {"thesis", "square"};
   if (bodies.empty()) bodies = {""};
   for (const std::string& r : rigs)
     for (const std::string& b : bodies)
       if (const int rc = run(r, b, every); rc != 0) return rc;
+  if (!json_out.empty() && !bench::write_figures(json_out, run_info, g_records)) return 1;
   return 0;
 }
