@@ -5,9 +5,9 @@
 // camera grabbing at the thesis rig's frame size, and unpacking the packed pixel
 // formats a GigE camera sends.
 //
-//   ./build/bench/devices_benchmark
+//   ./build/bench/devices_benchmark [--json OUT.json] [Google Benchmark's flags]
 //
-// The figures are in docs/benchmarks.md §11.
+// The figures are in docs/benchmarks.md §11 (rendered by bench/tables.py from --json).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -15,6 +15,7 @@
 #include <random>
 #include <thread>
 
+#include "bench/benchmark_main.hpp"
 #include "hw/aravis/aravis_camera.hpp"
 #include "hw/aravis/pixel_unpack.hpp"
 #include "hw/rig_description.hpp"
@@ -183,4 +184,4 @@ BENCHMARK(BM_Unpack)
 }  // namespace
 }  // namespace bodyscan
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return bodyscan::bench::run_benchmarks(argc, argv); }

@@ -1,7 +1,7 @@
 // Hole filling on a real open surface (issue 5: the square rig's feet).
 //
 //   hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R]
-//                       [--save-open OPEN.ply] [--out FILLED.ply] [--min-weight W]
+//                       [--save-open OPEN.ply] [--out FILLED.ply] [--min-weight W] [--json OUT.json]
 //
 // IN.ply is either a scan's point cloud, e.g. from
 //   bodyscan scan --rig square --body male_average.ply --out S --no-surface
@@ -13,15 +13,18 @@
 // whole; several may be given, compared in one run) it fills a fresh copy of the
 // mesh R times and prints the best wall time, the loops, what was added, and a
 // checksum of the result (equal checksums: the same triangulation), so a faster
-// programme can be shown to fill exactly as before.
+// programme can be shown to fill exactly as before. --json also writes each limit's
+// figures (bench/json_figures.hpp) for bench/tables.py.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "pipeline/scan_job.hpp"
 #include "recon/geometry/fill_holes.hpp"
@@ -60,7 +63,7 @@ StatusOr<TriangleMesh> open_surface(const PointCloud& cloud, float min_relative_
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string in, out, save_open;
+  std::string in, out, save_open, json_out;
   std::vector<size_t> limits;
   int repeat = 1;
   float min_weight = -1.f;  // the body options' own
@@ -69,7 +72,7 @@ int main(int argc, char** argv) {
   bool membrane = false;
   CommandLine cl("hole_fill_benchmark",
                  "usage: hole_fill_benchmark IN.ply [--max-dp N ...] [--membrane] [--repeat R] [--save-open "
-                 "OPEN.ply] [--out FILLED.ply] [--min-weight W]\n");
+                 "OPEN.ply] [--out FILLED.ply] [--min-weight W] [--json OUT]\n");
   cl.positional("IN.ply", &in, /*required=*/false);
   cl.option("--max-dp",
             integer_between(1, 1LL << 40, [&limits](long long n) { limits.push_back(static_cast<size_t>(n)); }));
@@ -78,6 +81,7 @@ int main(int argc, char** argv) {
   cl.option("--out", &out);
   cl.option("--save-open", &save_open);
   cl.option("--min-weight", &min_weight);
+  cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
   if (membrane) options.fairing = HoleFairing::kMembrane;
   if (in.empty()) {
@@ -107,6 +111,8 @@ int main(int argc, char** argv) {
     open.triangles = std::move(loaded->triangles);
   }
   std::printf("%s: %zu vertices, %zu triangles\n", in.c_str(), open.num_vertices(), open.num_triangles());
+  const float weight = min_weight >= 0.f ? min_weight : pipeline::body_surface_options().min_relative_weight;
+  nlohmann::json records = nlohmann::json::array();
   for (size_t limit : limits) {
     options.max_dp_edges = limit;
     double best = 1e300;
@@ -123,6 +129,18 @@ int main(int argc, char** argv) {
         "area %.0f  checksum %016llx\n",
         limit, best, stats.holes, stats.holes_filled, stats.largest_hole_edges, stats.triangles_added,
         stats.vertices_added, stats.area_added, static_cast<unsigned long long>(checksum(filled)));
+    records.push_back({{"input", std::filesystem::path(in).filename().string()},
+                       {"surfaced", loaded->triangles.empty()},
+                       {"min_relative_weight", weight},
+                       {"open_triangles", open.num_triangles()},
+                       {"max_dp", limit},
+                       {"repeat", repeat},
+                       {"seconds", best},
+                       {"loops", stats.holes},
+                       {"filled", stats.holes_filled},
+                       {"longest_edges", stats.largest_hole_edges},
+                       {"triangles_added", stats.triangles_added},
+                       {"area_mm2", stats.area_added}});
     if (!out.empty() && limit == limits.back()) {
       const Status s = write_ply(out, filled);
       if (!s.ok()) {
@@ -131,5 +149,6 @@ int main(int argc, char** argv) {
       }
     }
   }
+  if (!json_out.empty() && !bench::write_figures(json_out, bench::run_record(argc, argv), records)) return 1;
   return 0;
 }

@@ -29,16 +29,10 @@ inline std::string first_line_of(const std::string& command) {
   return line;
 }
 
-// The run's provenance: the command as given, the commit of the source tree the
+// The run's provenance: the command, the commit of the source tree the
 // benchmark runs in ("-dirty" when files outside docs/ had uncommitted changes;
 // "unknown" outside a checkout), the UTC date, the processor and cores.
-inline nlohmann::json run_record(int argc, char** argv) {
-  std::string command;
-  for (int i = 0; i < argc; ++i) {
-    std::string arg = argv[i];
-    if (i == 0 && arg.rfind(BODYSCAN_SOURCE_DIR "/", 0) == 0) arg.erase(0, std::strlen(BODYSCAN_SOURCE_DIR "/"));
-    command += (i ? " " : "") + arg;
-  }
+inline nlohmann::json run_record(const std::string& command) {
   std::string commit = first_line_of("git -C '" BODYSCAN_SOURCE_DIR "' describe --always --abbrev=7 2>/dev/null");
   if (commit.empty()) commit = "unknown";
   // Changes to docs/ (where the figures go) do not make a run's tree dirty.
@@ -57,6 +51,18 @@ inline nlohmann::json run_record(int argc, char** argv) {
           {"commit", commit},
           {"date", date.data()},
           {"machine", {{"cpu", cpu}, {"cores", std::thread::hardware_concurrency()}}}};
+}
+
+// The same, the command being this process's arguments (the program's path relative
+// to the source tree where it lies in it).
+inline nlohmann::json run_record(int argc, char** argv) {
+  std::string command;
+  for (int i = 0; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (i == 0 && arg.rfind(BODYSCAN_SOURCE_DIR "/", 0) == 0) arg.erase(0, std::strlen(BODYSCAN_SOURCE_DIR "/"));
+    command += (i ? " " : "") + arg;
+  }
+  return run_record(command);
 }
 
 // Writes {"run": run, "records": records} to path (replacing it); false, with a

@@ -5,17 +5,19 @@
 // long the sweep takes.
 //
 //   posture_sweep_benchmark [--rig thesis|tiered|R.json] [--body X.ply] [--every N]
-//                           [ARMS,FEET,TURN ...]
+//                           [--json OUT.json] [ARMS,FEET,TURN ...]
 //
 // Default postures: the scanning posture, turned and not, and the ways customers
 // stand outside it (arms low, feet close, turned past 30 degrees). The time of a
 // real rig's sweep is the frames each camera takes at the description's frame rate
-// (the simulator renders slower than a camera records).
+// (the simulator renders slower than a camera records). --json also writes each
+// posture's figures (bench/json_figures.hpp) for bench/tables.py.
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <vector>
 
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "hw/sim/sim_rig.hpp"
 #include "pipeline/posture_sweep.hpp"
@@ -36,12 +38,22 @@ std::string angle(const std::optional<double>& a) {
   return b;
 }
 
+nlohmann::json value(const std::optional<double>& a) { return a ? nlohmann::json(*a) : nlohmann::json(); }
+
+nlohmann::json posture_json(const BodyPosture& p) {
+  return {{"arm_left_deg", value(p.arm_abduction_deg[0])},
+          {"arm_right_deg", value(p.arm_abduction_deg[1])},
+          {"ankles_mm", value(p.ankle_distance_mm)},
+          {"turn_deg", value(p.turn_deg)}};
+}
+
 // "read / truth" per part: arms left and right (deg), ankles (mm), turn (deg).
 std::string pair(const std::optional<double>& sweep, const std::optional<double>& truth) {
   return angle(sweep) + " / " + angle(truth);
 }
 
-int run(const std::string& rig_name, const std::string& body, int every, const std::vector<Case>& cases) {
+int run(const std::string& rig_name, const std::string& body, int every, const std::vector<Case>& cases,
+        nlohmann::json& records) {
   std::printf("rig %s, body %s, every %d laser steps\n\n", rig_name.c_str(),
               body.empty() ? "(the rig's)" : body.c_str(), every);
   std::printf(
@@ -72,8 +84,15 @@ int run(const std::string& rig_name, const std::string& body, int every, const s
     mo.floor_y = -0.5 * desc.frame.tube;
     StatusOr<BodyMeasurements> truth = measure_body((*sim)->scene().subject(), mo);
     std::printf("| %g, %g, %+g | ", c.arms, c.feet, c.turn);
+    nlohmann::json record = {{"rig", desc.name},
+                             {"body", body.empty() ? desc.simulation.subject : body},
+                             {"every", every},
+                             {"posed", {{"arms_deg", c.arms}, {"ankles_mm", c.feet}, {"turn_deg", c.turn}}}};
     if (!sweep.ok() || !truth.ok()) {
-      std::printf("%s |\n", (!sweep.ok() ? sweep.status() : truth.status()).message().c_str());
+      const std::string error = (!sweep.ok() ? sweep.status() : truth.status()).message();
+      std::printf("%s |\n", error.c_str());
+      record["error"] = error;
+      records.push_back(std::move(record));
       ++disagreements;
       continue;
     }
@@ -98,6 +117,14 @@ int run(const std::string& rig_name, const std::string& body, int every, const s
                 agree ? "yes" : ("no: " + differ).c_str(), per_camera, per_camera / desc.simulation.frame_rate_hz,
                 sweep->processing_seconds);
     std::fflush(stdout);
+    record["sweep"] = posture_json(p);
+    record["truth"] = posture_json(t);
+    record["agree"] = agree;
+    record["differ"] = differ;
+    record["frames_per_camera"] = per_camera;
+    record["camera_seconds"] = per_camera / desc.simulation.frame_rate_hz;
+    record["processing_seconds"] = sweep->processing_seconds;
+    records.push_back(std::move(record));
   }
   std::printf("\n%d of %zu postures where the sweep's checks and the truth's disagree\n", disagreements, cases.size());
   return 0;
@@ -106,15 +133,17 @@ int run(const std::string& rig_name, const std::string& body, int every, const s
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string rig = "thesis", body;
+  std::string rig = "thesis", body, json_out;
   int every = bodyscan::pipeline::kPostureSweepEvery;
   std::vector<Case> cases;
   std::vector<std::string> case_args;
-  CommandLine cl("posture_sweep_benchmark",
-                 "usage: posture_sweep_benchmark [--rig R] [--body X.ply] [--every N] [ARMS,FEET,TURN ...]\n");
+  CommandLine cl(
+      "posture_sweep_benchmark",
+      "usage: posture_sweep_benchmark [--rig R] [--body X.ply] [--every N] [--json OUT] [ARMS,FEET,TURN ...]\n");
   cl.option("--rig", &rig);
   cl.option("--body", &body);
   cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
+  cl.option("--json", &json_out);
   cl.rest("ARMS,FEET,TURN ...", &case_args);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
   for (const std::string& a : case_args) {
@@ -124,5 +153,10 @@ int main(int argc, char** argv) {
   }
   if (cases.empty())
     cases = {{42, 380, 0}, {40, 350, 20}, {45, 420, -25}, {20, 300, 0}, {30, 250, 10}, {42, 150, 0}, {42, 380, 40}};
-  return run(rig, body, every, cases);
+  nlohmann::json records = nlohmann::json::array();
+  const int rc = run(rig, body, every, cases, records);
+  if (rc == 0 && !json_out.empty() &&
+      !bodyscan::bench::write_figures(json_out, bodyscan::bench::run_record(argc, argv), records))
+    return 1;
+  return rc;
 }

@@ -4,17 +4,19 @@
 // separately the calibration sequence (the dot grid before each camera, the frame
 // lights, each laser alone).
 //
-//   render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM]
+//   render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM] [--json OUT.json]
 //
 // --sway makes the subject sway (docs/simulated-rig.md), so every frame is posed
 // and cast anew.
 //
-// Prints frames, wall time, frames per second and the time for the whole scan.
+// Prints frames, wall time, frames per second and the time for the whole scan;
+// --json also writes them (bench/json_figures.hpp) for bench/tables.py.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "hw/sim/sim_rig.hpp"
 #include "pipeline/acquire.hpp"
@@ -26,10 +28,13 @@ int main(int argc, char** argv) {
   std::string rig_name = "thesis";
   int every = 1;
   double sway = 0;
-  CommandLine cl("render_benchmark", "usage: render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM]\n");
+  std::string json_out;
+  CommandLine cl("render_benchmark",
+                 "usage: render_benchmark [--rig thesis|square|FILE] [--every N] [--sway MM] [--json OUT]\n");
   cl.option("--rig", &rig_name);
   cl.option("--every", integer_between(1, 1000000, [&every](long long n) { every = static_cast<int>(n); }));
   cl.option("--sway", &sway);
+  cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
@@ -79,5 +84,17 @@ int main(int argc, char** argv) {
               scan_frames * cam.width * cam.height / secs(t2, t3) / 1e6,
               scan_frames / static_cast<double>(desc.cameras.size()) / desc.simulation.frame_rate_hz,
               static_cast<unsigned long long>(checksum));
+  const nlohmann::json record = {
+      {"rig", desc.name},
+      {"every", every},
+      {"sway_mm", sway},
+      {"calibration_frames", calibration_frames},
+      {"calibration_seconds", secs(t1, t2)},
+      {"scan_frames", scan_frames},
+      {"scan_seconds", secs(t2, t3)},
+      {"cameras_seconds", scan_frames / static_cast<double>(desc.cameras.size()) / desc.simulation.frame_rate_hz}};
+  if (!json_out.empty() &&
+      !bench::write_figures(json_out, bench::run_record(argc, argv), nlohmann::json::array({record})))
+    return 1;
   return 0;
 }

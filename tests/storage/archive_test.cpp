@@ -17,6 +17,7 @@
 #include <sstream>
 #include <thread>
 
+#include "bench/json_figures.hpp"
 #include "tests/test_data.hpp"
 
 namespace bodyscan::storage {
@@ -487,7 +488,8 @@ TEST(Archive, AFullDiskGivesAClearErrorAndLosesNothing) {
 // The crash drill: a child stores scans as fast as it can (customers, raw data,
 // results, reprocessing, deletions) and is killed with SIGKILL at a random moment;
 // the archive is reopened and every scan the child saw complete must be there,
-// whole. BODYSCAN_CRASH_POINTS sets how many kills (docs/benchmarks.md).
+// whole. BODYSCAN_CRASH_POINTS sets how many kills; BODYSCAN_CRASH_JSON=F.json
+// writes the drill's counts there for docs/benchmarks.md (bench/tables.py).
 TEST(ArchiveCrash, SigkillAtRandomPointsLosesNoCompletedScan) {
   const char* env = std::getenv("BODYSCAN_CRASH_POINTS");
   const int points = env ? std::atoi(env) : 12;
@@ -584,6 +586,16 @@ TEST(ArchiveCrash, SigkillAtRandomPointsLosesNoCompletedScan) {
       "crash drill: %d kills, %zu scans completed before them, %zu interrupted scans marked failed, "
       "%zu kills left half-written files; 0 completed scans lost\n",
       points, completed.size(), recovered_running, kills_mid_write);
+  if (const char* json = std::getenv("BODYSCAN_CRASH_JSON")) {
+    const nlohmann::json record = {{"kills", points},
+                                   {"completed", completed.size()},
+                                   {"interrupted_marked_failed", recovered_running},
+                                   {"kills_mid_write", kills_mid_write},
+                                   {"completed_lost", 0}};
+    const std::string command = "BODYSCAN_CRASH_POINTS=" + std::to_string(points) +
+                                " storage_tests --gtest_filter=ArchiveCrash.SigkillAtRandomPointsLosesNoCompletedScan";
+    EXPECT_TRUE(bench::write_figures(json, bench::run_record(command), nlohmann::json::array({record})));
+  }
 }
 
 }  // namespace
