@@ -3,6 +3,7 @@
 //   body_benchmark --body MESH.ply [--points N] [--noise MM] [--seed S]
 //                  [--cloud-out PTS.ply] [--mesh-out OUT.ply] [--voxel V]
 //   body_benchmark --body MESH.ply --evaluate OTHER.ply   (accuracy of any mesh)
+//   ... [--json OUT.json]   the figures also as JSON (bench/json_figures.hpp)
 //
 // Samples N points uniformly by area from the true mesh, adds isotropic Gaussian
 // noise, reconstructs with the defaults (no input normals), and reports wall time
@@ -13,8 +14,10 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
+#include "bench/json_figures.hpp"
 #include "core/command_line.hpp"
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/geometry/sample_surface.hpp"
@@ -25,33 +28,41 @@ using namespace bodyscan;
 
 namespace {
 
-void print_accuracy(const TriangleMesh& mesh, const TriangleMesh& truth) {
+// Prints the mesh's distances to the truth both ways and its topology, and adds them
+// to record.
+void print_accuracy(const TriangleMesh& mesh, const TriangleMesh& truth, nlohmann::json& record) {
   const MeshComparison c = compare_meshes(mesh, truth, 1'000'000, 12345);
-  auto row = [](const char* name, const DistanceStats& d) {
+  auto row = [&record](const char* name, const char* key, const DistanceStats& d) {
     std::printf("%-16s mean %.3f  rms %.3f  p95 %.3f  p99 %.3f  max %.3f mm\n", name, d.mean, d.rms, d.p95, d.p99,
                 d.max);
+    record[key] = {{"mean", d.mean}, {"rms", d.rms}, {"p95", d.p95}, {"p99", d.p99}, {"max", d.max}};
   };
-  row("output->truth", c.output_to_truth);
-  row("truth->output", c.truth_to_output);
+  row("output->truth", "output_to_truth_mm", c.output_to_truth);
+  row("truth->output", "truth_to_output_mm", c.truth_to_output);
   const MeshTopology t = analyze_topology(mesh);
   std::printf(
       "topology        %zu vertices, %zu triangles, %zu components, %zu boundary edges, "
       "%zu non-manifold edges, Euler %ld\n",
       mesh.num_vertices(), mesh.num_triangles(), t.components, t.boundary_edges, t.non_manifold_edges,
       t.euler_characteristic);
+  record["triangles"] = mesh.num_triangles();
+  record["components"] = t.components;
+  record["boundary_edges"] = t.boundary_edges;
+  record["non_manifold_edges"] = t.non_manifold_edges;
+  record["euler"] = t.euler_characteristic;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string body, cloud_out, mesh_out, evaluate;
+  std::string body, cloud_out, mesh_out, evaluate, json_out;
   size_t points = 1'000'000;
   double noise = 0.5;
   uint64_t seed = 1;
   ReconstructOptions opt;
   CommandLine cl("body_benchmark",
                  "usage: body_benchmark --body MESH.ply [--points N] [--noise MM] [--seed S] [--cloud-out F] "
-                 "[--mesh-out F] [--evaluate MESH.ply] [--voxel V] [--sigma S] [--normal-sigma S]\n");
+                 "[--mesh-out F] [--evaluate MESH.ply] [--voxel V] [--sigma S] [--normal-sigma S] [--json OUT]\n");
   cl.option("--body", &body);
   cl.option("--points", integer_between(1, 1LL << 40, [&points](long long n) { points = static_cast<size_t>(n); }));
   cl.option("--noise", &noise);
@@ -62,7 +73,15 @@ int main(int argc, char** argv) {
   cl.option("--voxel", &opt.voxel_size);
   cl.option("--sigma", &opt.sigma_scale);
   cl.option("--normal-sigma", &opt.normal_scale);
+  cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  nlohmann::json record;
+  const auto write = [&] {
+    return json_out.empty() ||
+                   bench::write_figures(json_out, bench::run_record(argc, argv), nlohmann::json::array({record}))
+               ? 0
+               : 1;
+  };
   if (body.empty()) {
     std::fprintf(stderr, "body_benchmark: --body is required\n");
     return 2;
@@ -79,8 +98,9 @@ int main(int argc, char** argv) {
       return 1;
     }
     std::printf("mesh            %s\n", evaluate.c_str());
-    print_accuracy(*other, *truth);
-    return 0;
+    record["mesh"] = std::filesystem::path(evaluate).filename().string();
+    print_accuracy(*other, *truth, record);
+    return write();
   }
 
   PointCloud cloud = sample_mesh_uniform(*truth, points, seed, false);
@@ -115,7 +135,24 @@ int main(int argc, char** argv) {
       "voxel %.3f mm, normal-k %zu, %zu bricks (%.0f MB)\n",
       s.median_density_sigma, s.noise_sigma, s.sigma_scale, s.normal_scale, s.voxel_size, s.normal_k, s.bricks,
       static_cast<double>(s.field_bytes) / 1e6);
-  print_accuracy(r->mesh, *truth);
+  record = {{"mesh", "bodyscan"},
+            {"points", cloud.size()},
+            {"noise_mm", noise},
+            {"seconds", wall},
+            {"stages_seconds",
+             {{"neighbours", s.t_neighbours},
+              {"normals", s.t_normals},
+              {"orientation", s.t_orientation},
+              {"kernels", s.t_kernels},
+              {"field", s.t_field},
+              {"mesh", s.t_mesh}}},
+            {"peak_mb", static_cast<double>(ru.ru_maxrss) / 1024.0},
+            {"spacing_mm", s.median_density_sigma},
+            {"noise_estimate_mm", s.noise_sigma},
+            {"voxel_mm", s.voxel_size},
+            {"bricks", s.bricks},
+            {"field_mb", static_cast<double>(s.field_bytes) / 1e6}};
+  print_accuracy(r->mesh, *truth, record);
   if (!mesh_out.empty()) {
     const Status st = write_ply(mesh_out, r->mesh);
     if (!st.ok()) {
@@ -123,5 +160,5 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  return 0;
+  return write();
 }

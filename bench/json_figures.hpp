@@ -31,7 +31,8 @@ inline std::string first_line_of(const std::string& command) {
 
 // The run's provenance: the command, the commit of the source tree the
 // benchmark runs in ("-dirty" when files outside docs/ had uncommitted changes;
-// "unknown" outside a checkout), the UTC date, the processor and cores.
+// "unknown" outside a checkout), the UTC date, the processor and cores, and the
+// build type where the benchmark's build says it.
 inline nlohmann::json run_record(const std::string& command) {
   std::string commit = first_line_of("git -C '" BODYSCAN_SOURCE_DIR "' describe --always --abbrev=7 2>/dev/null");
   if (commit.empty()) commit = "unknown";
@@ -47,10 +48,14 @@ inline nlohmann::json run_record(const std::string& command) {
   std::strftime(date.data(), date.size(), "%Y-%m-%d", &utc);
   std::string cpu = first_line_of("sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo 2>/dev/null");
   if (cpu.empty()) cpu = "unknown processor";
-  return {{"command", command},
-          {"commit", commit},
-          {"date", date.data()},
-          {"machine", {{"cpu", cpu}, {"cores", std::thread::hardware_concurrency()}}}};
+  nlohmann::json run = {{"command", command},
+                        {"commit", commit},
+                        {"date", date.data()},
+                        {"machine", {{"cpu", cpu}, {"cores", std::thread::hardware_concurrency()}}}};
+#ifdef BODYSCAN_BUILD_TYPE
+  run["build"] = BODYSCAN_BUILD_TYPE;  // CMake's build type: the optimisation and whether asserts are on
+#endif
+  return run;
 }
 
 // The same, the command being this process's arguments (the program's path relative

@@ -364,6 +364,7 @@ int report(const TriangleMesh& truth_mesh, const TriangleMesh& mesh, const BodyM
     std::sort(diffs.begin(), diffs.end());
     record["repeat"] = {{"sway_mm", sway},
                         {"count", diffs.size()},
+                        {"over_2mm", std::count_if(diffs.begin(), diffs.end(), [](double x) { return x > 2.0; })},
                         {"median_mm", diffs.empty() ? 0.0 : diffs[diffs.size() / 2]},
                         {"largest_mm", worst},
                         {"largest", worst_name}};

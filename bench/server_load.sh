@@ -1,18 +1,21 @@
 #!/usr/bin/env bash
 # The workstation server under HTTP load: wrk against a scan's measurements (JSON)
 # and its mesh (GLB), first with the rig idle, then while a long scan runs.
-#   [BODYSCAN_BIN=PATH] [DURATION=15] [THREADS=2] [CONNECTIONS=50] [FIRST_EVERY=6] bench/server_load.sh
+#   [BODYSCAN_BIN=PATH] [DURATION=15] [THREADS=2] [CONNECTIONS=50] [FIRST_EVERY=6] bench/server_load.sh [--json OUT]
 # Builds nothing. Starts its own server on a free port with a throw-away archive and
 # an empty web root, makes one scan (every=6, ~45 s with calibration on 2 cores:
 # the sparsest that closes the surface and gives the automatic measurements) to
 # have a mesh and measurements, measures, then starts a scan with every=1
 # (~2-3 min) and measures again while it runs, cancels it and stops the server.
 # (every=12 leaves the surface in pieces and the measurements list empty.)
-# Prints a markdown table. Needs curl, wrk (Debian package wrk) and python3.
+# Prints a markdown table; with --json OUT.json also writes its rows with the run's
+# provenance (bench/tables.py --wrap). Needs curl, wrk (Debian package wrk) and python3.
 # KEEP_LOGS=1 keeps the temp dir (server log, wrk outputs) and says where.
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")/.." && pwd)"
+json_out=""
+if [[ "${1:-}" == --json && -n "${2:-}" ]]; then json_out="$(realpath "$2")"; fi
 duration="${DURATION:-15}"
 threads="${THREADS:-2}"
 connections="${CONNECTIONS:-50}"
@@ -160,7 +163,7 @@ run_wrk() {  # NAME URL [HEADER]
   wrk -t"$threads" -c"$connections" -d"${duration}s" --latency -H "$cookie" "${extra[@]}" "$2" >"$out" 2>&1 ||
     { cat "$out" >&2; log "wrk failed"; exit 1; }
   if [[ "${VERBOSE:-0}" == 1 ]]; then cat "$out" >&2; fi
-  rows+=("$(python3 "$tmp/parse_wrk.py" "$1" "$out")")
+  rows+=("$(python3 "$tmp/parse_wrk.py" "$1" "$out" "$tmp/records.jsonl")")
   settle "$1"
 }
 
@@ -179,8 +182,8 @@ settle() {
 }
 
 cat >"$tmp/parse_wrk.py" <<'EOF'
-import re, sys
-name, path = sys.argv[1], sys.argv[2]
+import json, re, sys
+name, path, records = sys.argv[1], sys.argv[2], sys.argv[3]
 text = open(path).read()
 def ms(v):
     m = re.fullmatch(r"([\d.]+)(us|ms|s|m|h)", v)
@@ -208,6 +211,9 @@ if sock:
 errors = non2xx + (sum(map(int, sock.groups())) if sock else 0)
 detail = f" ({', '.join(parts)})" if parts else ""
 print(f"| {name} | {rps:.0f} | {p50:.1f} | {p99:.1f} | {xfer:.1f} | {errors} of {total}{detail} |")
+with open(records, "a") as f:
+    f.write(json.dumps({"case": name, "requests_per_s": rps, "p50_ms": p50, "p99_ms": p99, "transfer_mb_s": xfer,
+                        "errors": errors, "error_detail": ", ".join(parts), "requests": int(total)}) + "\n")
 EOF
 
 run_wrk "measurements JSON, idle" "$json_url"
@@ -283,3 +289,15 @@ printf '%s\n' "${rows[@]}"
 echo
 printf '%s\n' "${notes[@]}"
 echo "- server exit status: $server_rc"
+if [[ -n "$json_out" ]]; then
+  python3 - "$tmp/records.jsonl" "$json_bytes" "$glb_bytes" "$n_measurements" "$duration" "$threads" "$connections" \
+    <<'EOF' | "$here/bench/tables.py" --wrap "$json_out" "bench/server_load.sh --json OUT.json"
+import json, sys
+path, json_bytes, glb_bytes, measurements, duration, threads, connections = sys.argv[1:]
+rows = [json.loads(line) for line in open(path)]
+for r in rows:
+    r.update(json_bytes=int(json_bytes), glb_bytes=int(glb_bytes), measurements=int(measurements),
+             seconds=int(duration), threads=int(threads), connections=int(connections))
+print(json.dumps(rows))
+EOF
+fi

@@ -16,6 +16,9 @@ output, and a new run is one command away.
     bench/tables.py --check                 fail if a table differs from its figures (CI)
     bench/tables.py --print NAME F.json...  print table NAME from fresh runs' files
     bench/tables.py --store NAME F.json...  keep runs' files as docs/figures/NAME.json
+    bench/tables.py --wrap OUT.json COMMAND <RECORDS.json
+                                            a script benchmark's records (a JSON array)
+                                            with this tree's provenance, as OUT.json
 
 Several files for one table (one body each, run side by side) are stored as one:
 their records in order, each run's provenance kept.
@@ -47,8 +50,9 @@ def signed(x, digits=1):
 # ---- provenance ---------------------------------------------------------------
 
 
-def run_record():
-    """A Python benchmark's run, as bench/json_figures.hpp records a C++ one's."""
+def run_record(command=None):
+    """A Python or script benchmark's run, as bench/json_figures.hpp records a C++ one's:
+    the command (this process's own unless given), commit, date and machine."""
     def git(*args):
         return subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True, check=True).stdout.strip()
     try:
@@ -63,9 +67,16 @@ def run_record():
         cpu = next(l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name"))
     except (OSError, StopIteration):
         pass
-    command = " ".join([os.path.relpath(sys.argv[0], ROOT)] + sys.argv[1:])
+    if command is None:
+        command = " ".join([os.path.relpath(sys.argv[0], ROOT)] + sys.argv[1:])
     date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
-    return {"command": command, "commit": commit, "date": date, "machine": {"cpu": cpu, "cores": os.cpu_count()}}
+    run = {"command": command, "commit": commit, "date": date, "machine": {"cpu": cpu, "cores": os.cpu_count()}}
+    try:  # the build the script drove (bodyscan and the C++ benchmarks in build/)
+        cache = open(os.path.join(ROOT, "build", "CMakeCache.txt")).read()
+        run["build"] = re.search(r"^CMAKE_BUILD_TYPE:STRING=(.*)$", cache, re.M)[1]
+    except (OSError, TypeError):
+        pass
+    return run
 
 
 def load(paths):
@@ -87,7 +98,8 @@ def provenance(runs):
     groups = OrderedDict()
     for r in runs:
         m = r["machine"]
-        key = (r["commit"], r["date"], f"{m['cores']} cores, {m['cpu']}")
+        build = f", {r['build']} build" if r.get("build") else ""
+        key = (r["commit"], r["date"], f"{m['cores']} cores, {m['cpu']}{build}")
         groups.setdefault(key, []).append(r["command"])
     lines = []
     for (commit, date, machine), commands in groups.items():
@@ -288,6 +300,305 @@ def stripe_fidelity(records):
     return "\n".join(out)
 
 
+def ordinal_steps(every):
+    """'every step', 'every 2nd step', 'every 8th step'."""
+    if every == 1:
+        return "every step"
+    suffix = {1: "st", 2: "nd", 3: "rd"}.get(every % 10 if every % 100 not in (11, 12, 13) else 0, "th")
+    return f"every {every}{suffix} step"
+
+
+def mb(nbytes, digits=2):
+    return f"{nbytes / 1e6:.{digits}f}"
+
+
+def seconds(x):
+    return f"{x:.2f}" if x < 10 else f"{x:.1f}"
+
+
+SCAN_DEFAULT = "sweep fit, laser-plane homography"
+SCAN_THESIS = "per frame, laser-plane homography"  # the thesis's §3.1.3: poles per frame, eq. 3.6
+
+
+def scan_cloud(records):
+    """Per rig and body: the default cloud's distance to the truth and coverage, beside the thesis's method."""
+    out = ["| rig | body | steps | points | mean (mm) | p95 (mm) | coverage ≤ 5 mm "
+           "| thesis's method: mean / p95 (mm) | ours / thesis's: mean, p95 |",
+           "|---|---|---|---:|---:|---:|---:|---|---|"]
+    for r in records:
+        m = {x["method"]: x for x in r["methods"]}
+        d, t = m[SCAN_DEFAULT], m[SCAN_THESIS]
+        out.append(f"| {r['rig']} | {r['body']} | {ordinal_steps(r['every'])} | {d['points']:,} | {d['mean_mm']:.3f} "
+                   f"| {d['p95_mm']:.3f} | {r['coverage_percent']:.1f} % | {t['mean_mm']:.3f} / {t['p95_mm']:.3f} "
+                   f"| {d['mean_mm'] / t['mean_mm']:.2f}, {d['p95_mm'] / t['p95_mm']:.2f} |")
+    return "\n".join(out)
+
+
+def scan_markers(records):
+    """Per camera: its markers against the lights' true images, its centre, and the biases it adds."""
+    out = ["| rig | camera | marker worst (px) | centre vs truth (mm) | rays meet within (mm) "
+           "| calibration alone, signed (\\|.\\|) mm | points by camera, signed mm |",
+           "|---|---|---:|---:|---:|---|---:|"]
+    for r in records:
+        for c in r["cameras"]:
+            out.append(f"| {r['rig']} | {c['camera']} | {c['marker_worst_px']:.3f} | {c['centre_mm']:.2f} "
+                       f"| {c['rays_mm']:.2f} | {signed(c['calibration_signed_mm'], 3)} ({c['calibration_abs_mm']:.3f}) "
+                       f"| {signed(c['points_signed_mm'], 3)} |")
+    return "\n".join(out)
+
+
+def render(records):
+    """Per rig and subject: the frames of a scan, the renderer's wall time, the cameras' own."""
+    out = ["| rig, subject | steps | frames | wall time | the cameras take | wall / cameras |",
+           "|---|---|---:|---:|---:|---:|"]
+    for r in records:
+        subject = f"swaying {r['sway_mm']:g} mm" if r["sway_mm"] > 0 else "still"
+        out.append(f"| {r['rig']}, {subject} | {ordinal_steps(r['every'])} | {r['scan_frames']:,} "
+                   f"| {r['scan_seconds']:.1f} s | {r['cameras_seconds']:.1f} s "
+                   f"| {r['scan_seconds'] / r['cameras_seconds']:.2f} |")
+    return "\n".join(out)
+
+
+def hole_fill(records):
+    """Per minimum weight and programme limit: the loops, what the fill adds and its time."""
+    out = ["| minimum relative weight | open surface (triangles) | limit (edges) | loops | longest loop (edges) "
+           "| fill added (m²) | `fill_holes` (s, best of) |",
+           "|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in records:
+        out.append(f"| {100 * r['min_relative_weight']:.0f} % | {r['open_triangles']:,} | {r['max_dp']} | {r['loops']} "
+                   f"| {r['longest_edges']} | {r['area_mm2'] / 1e6:.2f} | {r['seconds']:.2f} ({r['repeat']}) |")
+    return "\n".join(out)
+
+
+def formats(records):
+    """Per mesh: its size in each format, and the Draco encodings' error and times."""
+    out = ["| mesh | triangles | PLY MB | OBJ MB | STL MB | GLB MB | bits | largest vertex error mm | encode s "
+           "| decode s | archive `mesh.drc` MB | error mm | encode s | decode s |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in records:
+        out.append(f"| {r['mesh']} | {r['triangles']:,} | {mb(r['ply_bytes'])} | {mb(r['obj_bytes'])} "
+                   f"| {mb(r['stl_bytes'])} | {mb(r['glb_bytes'], 3)} | {r['glb_bits']} | {r['glb_error_mm']:.3f} "
+                   f"| {r['glb_encode_seconds']:.2f} | {r['glb_decode_seconds']:.2f} | {mb(r['drc_bytes'], 3)} "
+                   f"| {r['drc_error_mm']:.4f} | {r['drc_encode_seconds']:.2f} | {r['drc_decode_seconds']:.2f} |")
+    return "\n".join(out)
+
+
+def archived_scan(records):
+    """One archived scan's folder, file by file."""
+    out = ["| file | bytes |", "|---|---:|"]
+    out += [f"| {r['file']} | {r['bytes']:,} |" for r in records]
+    out.append(f"| in all | **{sum(r['bytes'] for r in records):,}** |")
+    return "\n".join(out)
+
+
+def crash_drill(records):
+    """The archive's crash drill: kills, and what each left."""
+    out = ["| kills | scans completed before a kill | interrupted scans marked failed "
+           "| kills that left half-written files | completed scans lost |", "|---:|---:|---:|---:|---:|"]
+    out += [f"| {r['kills']} | {r['completed']} | {r['interrupted_marked_failed']} | {r['kills_mid_write']} "
+            f"| **{r['completed_lost']}** |" for r in records]
+    return "\n".join(out)
+
+
+def avatars(records):
+    """Per surface and budget: the product's decimation beside meshoptimizer's collapses alone."""
+    out = ["| surface | triangles | budget → kept | time s | non-manifold edges | median / p95 mm | largest mm "
+           "| OBJ MB | GLB MB | meshoptimizer alone: s, non-manifold edges |",
+           "|---|---:|---|---:|---:|---|---:|---:|---:|---|"]
+    for r in records:
+        out.append(f"| {r['mesh']} | {r['triangles']:,} | {r['budget'] // 1000} k → {r['kept']:,} | {r['seconds']:.2f} "
+                   f"| {r['non_manifold_edges']} | {r['median_mm']:.3f} / {r['p95_mm']:.3f} | {r['largest_mm']:.2f} "
+                   f"| {mb(r['obj_bytes'])} | {mb(r['glb_bytes'])} | {r['meshoptimizer_seconds']:.2f}, "
+                   f"{r['meshoptimizer_non_manifold_edges']} |")
+    return "\n".join(out)
+
+
+def server_load(records):
+    """Per case: wrk's throughput and latency against the server, idle and during a scan."""
+    out = ["| case | requests/s | p50 ms | p99 ms | transfer MB/s | errors |", "|---|---:|---:|---:|---:|---|"]
+    for r in records:
+        detail = f" ({r['error_detail']})" if r["error_detail"] else ""
+        out.append(f"| {r['case']} | {r['requests_per_s']:.0f} | {r['p50_ms']:.1f} | {r['p99_ms']:.1f} "
+                   f"| {r['transfer_mb_s']:.0f} | {r['errors']} of {r['requests']:,}{detail} |")
+    r = records[0]
+    out += ["", f"wrk: {r['threads']} threads, {r['connections']} connections, {r['seconds']} s a case; the scan read "
+                f"has {r['measurements']} automatic measurements (JSON {r['json_bytes'] / 1e3:.0f} KB) and a "
+                f"{r['glb_bytes'] / 1e3:.0f} KB GLB."]
+    return "\n".join(out)
+
+
+def ui_first_frame(records):
+    """Per model: medians of the page's User Timing marks in headless Chromium."""
+    def ms(x):
+        return "—" if x is None else f"{x:.0f} ms"
+    out = ["| model | triangles | GLB | page load → first frame | scan opened → first frame "
+           "| of which fetch + Draco decode | normals | first draw | scan opened → picking ready | BVH build "
+           "| opened again in the app | pick (median / max) |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in records:
+        out.append(f"| {r['label']} | {r['triangles']:,} | {r['glbKB']:.0f} KB | {ms(r['loadToFrame'])} "
+                   f"| **{ms(r['openToFrame'])}** | {ms(r['decoded'])} | {ms(r['normals'])} | {ms(r['draw'])} "
+                   f"| **{ms(r['picking'])}** | {ms(r['bvh'])} | {ms(r['warm'])} "
+                   f"| {r['pick']:.2f} / {r['pickMax']:.2f} ms |")
+    r = records[0]
+    out += ["", f"Medians of {r['runs']} runs; headless Chromium {r['chromium']} (WebGL on SwiftShader, no GPU)."]
+    return "\n".join(out)
+
+
+# devices_benchmark's benchmarks: what each row is.
+DEVICE_PATHS = [
+    ("BM_TmclRequestInProcess", "TMCL request, board in process",
+     "frame encode, checksum, the simulated board's interpreter, decode"),
+    ("BM_TmclRequestPty", "TMCL request over a pseudo-terminal",
+     "`SerialLink` byte for byte to `PtyBoard` (termios, `poll`, the pty's wake-ups); a USB CDC-ACM board adds its "
+     "1 ms USB frames"),
+    ("BM_ControllerLaserOnOffPty", "A laser on and off through `TmclController` (pty)", "two confirmed `SIO` requests"),
+    ("BM_ControllerLaserStepPty", "One laser step there and back, waiting until reached (pty)",
+     "`MVP` and `GAP 8` polls, and the simulated motor's 16 microsteps at 20,000/s"),
+    ("BM_WatchdogTrip", "Board-side watchdog trip after the cable is pulled, laser on, 500 ms period",
+     "the stored TMCL program alone, no host; it samples the heartbeat once a period, so a trip takes one to two "
+     "periods after the last feed"),
+    ("BM_AravisFakeGrab/8", "Aravis fake camera, software trigger, 1280 × 1024 Mono8",
+     "the fake paces itself; our cost per frame is the CPU time (trigger, buffer pool, copy into a `Frame`)"),
+    ("BM_AravisFakeGrab/16", "the same, Mono16", ""),
+    ("BM_Unpack", "Unpack 1280 × 1024", "to 16-bit pixels"),
+]
+
+
+def duration(value, unit):
+    ns = value * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[unit]
+    return f"{ns:.0f} ns" if ns < 1e3 else f"{ns / 1e3:.1f} µs" if ns < 1e5 else f"{ns / 1e6:.2f} ms"
+
+
+def devices(records):
+    """Per device path: Google Benchmark's median (or only) run, wall and CPU time, the rate."""
+    medians = [r for r in records if r.get("aggregate_name") == "median"]
+    runs = medians or [r for r in records if r.get("run_type") == "iteration"]
+    out = ["| Path | Time (wall) | CPU | Rate | What it is |", "|---|---:|---:|---:|---|"]
+    for prefix, name, what in DEVICE_PATHS:
+        for r in runs:
+            run_name = r["run_name"]
+            if not (run_name == prefix or (prefix == "BM_Unpack" and run_name.startswith("BM_Unpack/"))):
+                continue
+            wall, cpu = r["real_time"], r["cpu_time"]
+            if "items_per_second" in r and prefix == "BM_Unpack":
+                rate = f"{r['items_per_second'] / 1e9:.2f} Gpx/s"
+            else:
+                per_s = 1e9 / (wall * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[r["time_unit"]])
+                rate = f"{per_s / 1e6:.1f} M/s" if per_s >= 1e6 else f"{per_s:,.0f}/s" if per_s >= 1.5 else ""
+            label = f"{name} {r.get('label', '')}".strip() if prefix == "BM_Unpack" else name
+            out.append(f"| {label} | {duration(wall, r['time_unit'])} | {duration(cpu, r['time_unit'])} | {rate} "
+                       f"| {what if prefix != 'BM_Unpack' or 'Mono8' in label else ''} |")
+    repetitions = max(r.get("repetitions", 1) for r in records)
+    out += ["", f"{'Medians of ' + str(repetitions) + ' repetitions' if medians else 'One run each'}."]
+    return "\n".join(out)
+
+
+def posture_sweep(records):
+    """Per rig and body: how often the sweep checks as the truth does, its largest misses, its cost."""
+    groups = OrderedDict()
+    for r in records:
+        groups.setdefault((r["rig"], os.path.splitext(os.path.basename(r["body"]))[0]), []).append(r)
+    out = ["| rig, body | checks as the truth's | arms, ankles, turn: largest \\|sweep − truth\\| "
+           "| frames a camera; at the frame rate | processing |", "|---|---:|---|---:|---:|"]
+
+    def largest(rs, keys):
+        diffs = [abs(r["sweep"][k] - r["truth"][k]) for r in rs if "sweep" in r for k in keys
+                 if r["sweep"].get(k) is not None and r["truth"].get(k) is not None]
+        return max(diffs) if diffs else float("nan")
+
+    for (rig, body), rs in groups.items():
+        agree = sum(r.get("agree", False) for r in rs)
+        ok = [r for r in rs if "sweep" in r]
+        proc = [r["processing_seconds"] for r in ok]
+        misses = "; ".join(f"{r['posed']['arms_deg']:g}°, {r['posed']['ankles_mm']:g} mm, "
+                           f"{r['posed']['turn_deg']:+g}°: {r.get('differ') or r.get('error')}"
+                           for r in rs if not r.get("agree", False))
+        out.append(f"| {rig}, {body} | {agree} of {len(rs)} | {largest(rs, ['arm_left_deg', 'arm_right_deg']):.1f}°, "
+                   f"{largest(rs, ['ankles_mm']):.1f} mm, {largest(rs, ['turn_deg']):.1f}° "
+                   f"| {ok[0]['frames_per_camera']:.0f}; {ok[0]['camera_seconds']:.1f} s "
+                   f"| {min(proc):.1f}-{max(proc):.1f} s |")
+        if misses:
+            out.append(f"| | misses: {misses} | | | |")
+    return "\n".join(out)
+
+
+def measure_repeat(records):
+    """Per body: two scans (other noise; the second swaying), the automatic set's differences."""
+    out = ["| rig | body | second scan sways | values | over 2 mm | median (mm) | largest (mm) |",
+           "|---|---|---:|---:|---:|---:|---|"]
+    for r in records:
+        p = r["repeat"]
+        out.append(f"| {r['rig']} | {r['body']} | {p['sway_mm']:g} mm | {p['count']} | {p['over_2mm']} "
+                   f"| {p['median_mm']:.2f} | {p['largest'].replace('_', ' ')} {p['largest_mm']:.2f} |")
+    return "\n".join(out)
+
+
+def open3d_body(records):
+    """bodyscan's defaults against Open3D's pipeline on one cloud: time, memory, distances, topology."""
+    ours = next(r for r in records if r["mesh"] == "bodyscan")
+    theirs = next(r for r in records if r["mesh"] == "open3d")
+
+    def dist(r, key):
+        d = r[key]
+        return f"{d['mean']:.3f} / {d['rms']:.3f} / {d['p95']:.3f} / {d['p99']:.3f} / {d['max']:.2f}"
+
+    def stages(r):
+        return ", ".join(f"{k} {v:.1f}" for k, v in r["stages_seconds"].items()) + " s"
+
+    def topology(r):
+        closed = "closed, " if r["boundary_edges"] == 0 and r["non_manifold_edges"] == 0 else ""
+        return (f"{closed}{r['components']} component{'s' if r['components'] != 1 else ''}, {r['boundary_edges']} "
+                f"boundary, {r['non_manifold_edges']} non-manifold edges (Euler {r['euler']})")
+
+    speed = theirs["process_seconds"] / ours["process_seconds"]
+    out = [f"| | bodyscan (defaults) | Open3D {theirs['version']} | ratio |", "|---|---:|---:|---:|",
+           f"| wall time, whole process (PLY in → mesh out) | **{ours['process_seconds']:.1f} s** "
+           f"| {theirs['process_seconds']:.1f} s | **{speed:.1f}× faster** |",
+           f"| stages (in process) | {stages(ours)} | {stages(theirs)} | |",
+           f"| peak RSS, whole process | **{ours['process_peak_mb'] / 1024:.2f} GB** "
+           f"| {theirs['process_peak_mb'] / 1024:.2f} GB | {ours['process_peak_mb'] / theirs['process_peak_mb']:.2f}× |",
+           f"| output → truth: mean / RMS / p95 / p99 / max (mm) | {dist(ours, 'output_to_truth_mm')} "
+           f"| {dist(theirs, 'output_to_truth_mm')} "
+           f"| RMS {theirs['output_to_truth_mm']['rms'] / ours['output_to_truth_mm']['rms']:.1f}× lower |",
+           f"| truth → output: mean / RMS / p95 / p99 / max (mm) | {dist(ours, 'truth_to_output_mm')} "
+           f"| {dist(theirs, 'truth_to_output_mm')} "
+           f"| RMS {theirs['truth_to_output_mm']['rms'] / ours['truth_to_output_mm']['rms']:.1f}× lower |",
+           f"| triangles | {ours['triangles'] / 1e6:.2f} M | {theirs['triangles'] / 1e6:.2f} M | |",
+           f"| topology | {topology(ours)} | {topology(theirs)} | |",
+           "",
+           f"{ours['points']:,} points, {ours['noise_mm']:g} mm noise per axis. Chosen automatically: spacing "
+           f"{ours['spacing_mm']:.2f} mm, estimated noise {ours['noise_estimate_mm']:.3f} mm, voxel "
+           f"{ours['voxel_mm']:.2f} mm, {ours['bricks']:,} bricks ({ours['field_mb']:.0f} MB of field)."]
+    return "\n".join(out)
+
+
+def open3d_sphere(records):
+    """The nonuniform sphere: bodyscan's defaults against Open3D at its best depth, per N and noise."""
+    cells = {(r["points"], r["noise"]): r for r in records if "defaults" in r and "open3d" in r}
+    sizes = sorted({n for n, _ in cells}, reverse=True)
+    noises = sorted({x for _, x in cells})
+    out = ["| N | " + " | ".join(f"s = {x:.2f}" for x in noises) + " |", "|---:|" + "---:|" * len(noises)]
+    ratios = []
+    for n in sizes:
+        row = []
+        for x in noises:
+            r = cells.get((n, x))
+            if not r:
+                row.append("—")
+                continue
+            ratio = r["defaults"]["rms"] / r["open3d"]["rms"]
+            ratios.append(ratio)
+            row.append(f"{r['defaults']['rms']:.6f} / {r['open3d']['rms']:.6f} ({r['open3d']['depth']}; {ratio:.2f})")
+        out.append(f"| {n} | " + " | ".join(row) + " |")
+    gmean = math.exp(sum(math.log(x) for x in ratios) / len(ratios))
+    ratio = records[0]["nonuniform"]
+    out += ["", f"Density varying {ratio:g}× across the sphere. bodyscan is more accurate in "
+                f"**{sum(x < 1 for x in ratios)} of {len(ratios)} cells** (geometric mean ratio {gmean:.2f}, "
+                f"largest {max(ratios):.2f})."]
+    return "\n".join(out)
+
+
 # A table's name: (its renderer, the figures file it reads, by name in docs/figures).
 TABLES = {
     "sphere": (sphere, "sphere"),
@@ -298,6 +609,21 @@ TABLES = {
     "gap_cylinder": (gap_cylinder, "gap_cylinder"),
     "rig_coverage": (rig_coverage, "rig_coverage"),
     "stripe_fidelity": (stripe_fidelity, "stripe_fidelity"),
+    "scan_cloud": (scan_cloud, "scan"),
+    "scan_markers": (scan_markers, "scan"),
+    "render": (render, "render"),
+    "hole_fill": (hole_fill, "hole_fill"),
+    "formats": (formats, "formats"),
+    "archived_scan": (archived_scan, "archived_scan"),
+    "crash_drill": (crash_drill, "crash_drill"),
+    "avatars": (avatars, "avatars"),
+    "server_load": (server_load, "server_load"),
+    "ui_first_frame": (ui_first_frame, "ui_first_frame"),
+    "devices": (devices, "devices"),
+    "posture_sweep": (posture_sweep, "posture_sweep"),
+    "measure_repeat": (measure_repeat, "measure_repeat"),
+    "open3d_body": (open3d_body, "open3d_body"),
+    "open3d_sphere": (open3d_sphere, "open3d_sphere"),
 }
 
 
@@ -333,6 +659,12 @@ def main(argv):
             json.dump({"runs": runs, "records": records}, f, indent=1, ensure_ascii=False)
             f.write("\n")
         print(f"tables: stored {len(records)} records of {len(runs)} runs as {figures_path(argv[1])}")
+        return 0
+    if argv[:1] == ["--wrap"] and len(argv) == 3:
+        records = json.load(sys.stdin)
+        with open(argv[1], "w") as f:
+            json.dump({"run": run_record(argv[2]), "records": records}, f, indent=1, ensure_ascii=False)
+            f.write("\n")
         return 0
     if argv not in ([], ["--check"]):
         print(__doc__, file=sys.stderr)

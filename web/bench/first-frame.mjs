@@ -4,23 +4,25 @@
 // (the whole surface beside the display mesh the archive serves). Every row's
 // model is served the same way, from the browser's network layer, so that the rows
 // differ in the model alone.
-//   node bench/first-frame.mjs [--runs N] label=DIR[=MODEL.glb] [...]
+//   node bench/first-frame.mjs [--runs N] [--json OUT.json] label=DIR[=MODEL.glb] [...]
 // Per run, in a fresh browser context (empty cache): log in, open /scans/ID as a
 // page load, and read the page's User Timing: first frame after navigation start
 // and after the viewer mounted, the model fetched and decoded (Draco, in a
 // worker), normals computed, then the BVH build and 12 picks (taps on the body).
 // Then the same scan again from the archive page inside the app (warm: the
 // bundles and the immutable model come from the cache). Prints a markdown table
-// of medians. The renderer is SwiftShader (no GPU here): drawing costs more than
+// of medians (--json: its rows as a JSON array, for bench/tables.py). The renderer is SwiftShader (no GPU here): drawing costs more than
 // on a tablet's GPU.
-import { readFileSync } from 'node:fs';
+import { readFileSync, writeFileSync } from 'node:fs';
 import { ADMIN_PASSWORD, launchBrowser, login, startServer } from '../tests/e2e/harness.mjs';
 
 const args = process.argv.slice(2);
 let runs = 5;
+let jsonOut = '';
 const archives = [];
 for (let i = 0; i < args.length; i++) {
   if (args[i] === '--runs') runs = Number(args[++i]);
+  else if (args[i] === '--json') jsonOut = args[++i];
   else if (args[i].includes('=')) {
     const [label, dir, model] = args[i].split('=');
     archives.push({ label, dir, model });
@@ -124,6 +126,8 @@ for (const { label, dir, model } of archives) {
 }
 await browser.close();
 
+if (jsonOut)
+  writeFileSync(jsonOut, `${JSON.stringify(rows.map((r) => ({ ...r, runs, chromium: browser.version() })), null, 1)}\n`);
 const f = (x, d = 0) => (Number.isFinite(x) ? x.toFixed(d) : '—');
 console.log(`\nmedians of ${runs} runs; headless Chromium ${browser.version()} (SwiftShader), localhost\n`);
 console.log('| body | triangles | GLB | page load → first frame | scan opened → first frame | of which fetch + Draco decode | normals | first draw | scan opened → picking ready | BVH build | opened again in the app | pick (median / max) |');
