@@ -13,7 +13,8 @@ machine of each run behind it. So a figure cannot drift from its benchmark's
 output, and a new run is one command away.
 
     bench/tables.py                         rewrite every table from docs/figures/
-    bench/tables.py --check                 fail if a table differs from its figures (CI)
+    bench/tables.py --check                 fail if a table differs from its figures, or stands
+                                            outside a table block (CI)
     bench/tables.py --print NAME F.json...  print table NAME from fresh runs' files
     bench/tables.py --store NAME F.json...  keep runs' files as docs/figures/NAME.json
     bench/tables.py --wrap OUT.json COMMAND <RECORDS.json
@@ -647,6 +648,21 @@ def rewrite(doc_text):
     return BLOCK.sub(block, doc_text)
 
 
+def hand_tables(doc_text):
+    """The first lines of Markdown tables standing outside every table block."""
+    starts, inside, previous = [], False, False
+    for number, line in enumerate(doc_text.split("\n"), 1):
+        if re.match(r"<!-- table [a-z0-9_]+ -->", line):
+            inside = True
+        is_row = line.startswith("|")
+        if is_row and not previous and not inside:
+            starts.append(number)
+        if "<!-- /table -->" in line:
+            inside = False
+        previous = is_row
+    return starts
+
+
 def main(argv):
     if argv[:1] == ["--print"] and len(argv) >= 3 and argv[1] in TABLES:
         runs, records = load(argv[2:])
@@ -673,6 +689,11 @@ def main(argv):
     new = rewrite(text)
     count = len(BLOCK.findall(text))
     if argv == ["--check"]:
+        loose = hand_tables(text)
+        if loose:
+            print(f"tables: {DOC} has tables no benchmark's figures render, at lines {', '.join(map(str, loose))}; "
+                  "give each a <!-- table NAME --> block", file=sys.stderr)
+            return 1
         if new != text:
             print(f"tables: {DOC} differs from its figures (docs/figures); run bench/tables.py", file=sys.stderr)
             return 1
