@@ -384,11 +384,28 @@ def formats(records):
     return "\n".join(out)
 
 
+# What each file of an archived scan is (docs/archive.md).
+SCAN_FILES = {
+    "manifest.json": "the folder's checksummed manifest",
+    "raw/record.json": "the calibration record",
+    "raw/stripes.bin": "every frame's stripes and planes: the raw record a scan is reprocessed from",
+    "calibration.json": "the calibration's summary",
+    "measurements.json": "the measurements with their loops and paths",
+    "mesh.drc": "the surface, within 0.01 mm, with its confidence",
+    "mesh.glb": "the display mesh, served",
+    "points.drc": "the point cloud, served",
+    "points.ply": "the point cloud with camera, laser, frame and confidence",
+    "scan.json": "the scan's record",
+}
+
+
 def archived_scan(records):
     """One archived scan's folder, file by file."""
-    out = ["| file | bytes |", "|---|---:|"]
-    out += [f"| {r['file']} | {r['bytes']:,} |" for r in records]
-    out.append(f"| in all | **{sum(r['bytes'] for r in records):,}** |")
+    out = ["| file | bytes | what it is |", "|---|---:|---|"]
+    for r in records:
+        role = SCAN_FILES.get(r["file"]) or SCAN_FILES.get(r["file"].split("/", 1)[-1], "")
+        out.append(f"| {r['file']} | {r['bytes']:,} | {role} |")
+    out.append(f"| in all | **{sum(r['bytes'] for r in records):,}** | |")
     return "\n".join(out)
 
 
