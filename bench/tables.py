@@ -485,7 +485,11 @@ DEVICE_PATHS = [
 
 def duration(value, unit):
     ns = value * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[unit]
-    return f"{ns:.0f} ns" if ns < 1e3 else f"{ns / 1e3:.1f} µs" if ns < 1e5 else f"{ns / 1e6:.2f} ms"
+    if ns < 1e3:
+        return f"{ns:.0f} ns"
+    if ns < 1e5:
+        return f"{ns / 1e3:.1f} µs"
+    return f"{ns / 1e6:.2f} ms" if ns < 1e8 else f"{ns / 1e6:.0f} ms"
 
 
 def devices(records):
@@ -495,7 +499,8 @@ def devices(records):
     out = ["| Path | Time (wall) | CPU | Rate | What it is |", "|---|---:|---:|---:|---|"]
     for prefix, name, what in DEVICE_PATHS:
         for r in runs:
-            run_name = r["run_name"]
+            # Without the library's suffixes: /real_time, /manual_time, /iterations:N.
+            run_name = re.sub(r"/(real_time|manual_time|iterations:\d+)", "", r["run_name"])
             if not (run_name == prefix or (prefix == "BM_Unpack" and run_name.startswith("BM_Unpack/"))):
                 continue
             wall, cpu = r["real_time"], r["cpu_time"]
