@@ -626,7 +626,12 @@ HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
   stats.vertices_added = mesh.vertices.size() - original_vertices;
   mesh.triangles.insert(mesh.triangles.end(), added_triangles.begin(), added_triangles.end());
   mesh.confidence.resize(mesh.vertices.size(), 0.f);
-  if (!mesh.normals.empty()) mesh.normals = compute_vertex_normals(mesh);
+  if (!mesh.normals.empty()) {
+    // The patches' new vertices have none yet: the mesh is whole again only once
+    // its normals are recomputed over every vertex.
+    mesh.normals.clear();
+    mesh.normals = compute_vertex_normals(mesh);
+  }
   return stats;
 }
 

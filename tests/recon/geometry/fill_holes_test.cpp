@@ -123,6 +123,20 @@ TEST(FillHoles, CurvedHoleFollowsTheSphere) {
   EXPECT_GT(lowest_top[2], 0.92);
 }
 
+TEST(FillHoles, AMeshWithNormalsGetsThemForThePatchesVerticesToo) {
+  // A reconstructed surface carries its normals; the refined patch adds vertices,
+  // and every vertex, old or new, must have the sphere's outward normal after.
+  TriangleMesh m = without(icosphere(5, 1.0), [](const Vec3f& p) { return p.z() > std::cos(0.25 * M_PI); });
+  m.normals = compute_vertex_normals(m);
+  const size_t before = m.vertices.size();
+  const HoleFillStats s = fill_holes(m, HoleFillOptions{});
+  ASSERT_EQ(s.holes_filled, 1u);
+  ASSERT_GT(m.vertices.size(), before);
+  ASSERT_EQ(m.normals.size(), m.vertices.size());
+  for (size_t v = 0; v < m.vertices.size(); ++v)
+    EXPECT_GT(m.normals[v].dot(m.vertices[v].normalized()), 0.9f) << "vertex " << v;
+}
+
 TEST(FillHoles, LongLoopsAreSplitAndStillClose) {
   // A hole of about 300 boundary edges, filled with the dynamic programme limited to
   // 40 edges: the loop is cut by diagonals first.
