@@ -522,7 +522,7 @@ def posture_sweep(records):
     groups = OrderedDict()
     for r in records:
         groups.setdefault((r["rig"], os.path.splitext(os.path.basename(r["body"]))[0]), []).append(r)
-    out = ["| rig, body | checks as the truth's | arms, ankles, turn: largest \\|sweep − truth\\| "
+    out = ["| rig, body | checks as the truth's | where they agree, arms, ankles, turn: largest \\|sweep − truth\\| "
            "| frames a camera; at the frame rate | processing |", "|---|---:|---|---:|---:|"]
 
     def largest(rs, keys):
@@ -533,12 +533,14 @@ def posture_sweep(records):
     for (rig, body), rs in groups.items():
         agree = sum(r.get("agree", False) for r in rs)
         ok = [r for r in rs if "sweep" in r]
+        agreeing = [r for r in ok if r["agree"]]
         proc = [r["processing_seconds"] for r in ok]
         misses = "; ".join(f"{r['posed']['arms_deg']:g}°, {r['posed']['ankles_mm']:g} mm, "
                            f"{r['posed']['turn_deg']:+g}°: {r.get('differ') or r.get('error')}"
                            for r in rs if not r.get("agree", False))
-        out.append(f"| {rig}, {body} | {agree} of {len(rs)} | {largest(rs, ['arm_left_deg', 'arm_right_deg']):.1f}°, "
-                   f"{largest(rs, ['ankles_mm']):.1f} mm, {largest(rs, ['turn_deg']):.1f}° "
+        out.append(f"| {rig}, {body} | {agree} of {len(rs)} "
+                   f"| {largest(agreeing, ['arm_left_deg', 'arm_right_deg']):.1f}°, "
+                   f"{largest(agreeing, ['ankles_mm']):.1f} mm, {largest(agreeing, ['turn_deg']):.1f}° "
                    f"| {ok[0]['frames_per_camera']:.0f}; {ok[0]['camera_seconds']:.1f} s "
                    f"| {min(proc):.1f}-{max(proc):.1f} s |")
         if misses:
