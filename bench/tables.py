@@ -568,13 +568,16 @@ def open3d_body(records):
         d = r[key]
         return f"{d['mean']:.3f} / {d['rms']:.3f} / {d['p95']:.3f} / {d['p99']:.3f} / {d['max']:.2f}"
 
-    def stages(r):
-        return ", ".join(f"{k} {v:.1f}" for k, v in r["stages_seconds"].items()) + " s"
+    order = ["neighbours", "normals", "orientation", "kernels", "field", "mesh", "poisson"]
+
+    def stages(r):  # in the order each pipeline runs them
+        times = sorted(r["stages_seconds"].items(), key=lambda kv: order.index(kv[0]) if kv[0] in order else 99)
+        return ", ".join(f"{k} {v:.1f}" for k, v in times) + " s"
 
     def topology(r):
         closed = "closed, " if r["boundary_edges"] == 0 and r["non_manifold_edges"] == 0 else ""
         return (f"{closed}{r['components']} component{'s' if r['components'] != 1 else ''}, {r['boundary_edges']} "
-                f"boundary, {r['non_manifold_edges']} non-manifold edges (Euler {r['euler']})")
+                f"boundary, {r['non_manifold_edges']} non-manifold edges (Euler {signed(r['euler'], 0)})")
 
     speed = theirs["process_seconds"] / ours["process_seconds"]
     out = [f"| | bodyscan (defaults) | Open3D {theirs['version']} | ratio |", "|---|---:|---:|---:|",
