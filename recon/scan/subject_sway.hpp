@@ -53,7 +53,7 @@ struct SwayRegularization {
   // skin they were not fitted to. A still body's sweeps disagree a little
   // (grazing views, calibration), and a moving hold, however firm, turns that into
   // a path that thins the neck and waist slightly; held still, a still scan
-  // stays nearer the truth (docs/benchmarks.md §7, "A still body held still").
+  // stays nearer the truth (docs/benchmarks.md §7, "Repeat pairs").
   bool still = false;
 };
 
