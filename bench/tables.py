@@ -493,25 +493,29 @@ def duration(value, unit):
 
 
 def devices(records):
-    """Per device path: Google Benchmark's median (or only) run, wall and CPU time, the rate."""
+    """Per device path: Google Benchmark's median (or only) run, wall and CPU time, the rate;
+    the pixel formats' unpacking in one row."""
     medians = [r for r in records if r.get("aggregate_name") == "median"]
     runs = medians or [r for r in records if r.get("run_type") == "iteration"]
+    # Without the library's suffixes: /real_time, /manual_time, /iterations:N.
+    for r in runs:
+        r["path"] = re.sub(r"/(real_time|manual_time|iterations:\d+)", "", r["run_name"])
     out = ["| Path | Time (wall) | CPU | Rate | What it is |", "|---|---:|---:|---:|---|"]
     for prefix, name, what in DEVICE_PATHS:
-        for r in runs:
-            # Without the library's suffixes: /real_time, /manual_time, /iterations:N.
-            run_name = re.sub(r"/(real_time|manual_time|iterations:\d+)", "", r["run_name"])
-            if not (run_name == prefix or (prefix == "BM_Unpack" and run_name.startswith("BM_Unpack/"))):
-                continue
-            wall, cpu = r["real_time"], r["cpu_time"]
-            if "items_per_second" in r and prefix == "BM_Unpack":
-                rate = f"{r['items_per_second'] / 1e9:.2f} Gpx/s"
-            else:
-                per_s = 1e9 / (wall * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[r["time_unit"]])
-                rate = f"{per_s / 1e6:.1f} M/s" if per_s >= 1e6 else f"{per_s:,.0f}/s" if per_s >= 1.5 else ""
-            label = f"{name} {r.get('label', '')}".strip() if prefix == "BM_Unpack" else name
-            out.append(f"| {label} | {duration(wall, r['time_unit'])} | {duration(cpu, r['time_unit'])} | {rate} "
-                       f"| {what if prefix != 'BM_Unpack' or 'Mono8' in label else ''} |")
+        if prefix == "BM_Unpack":
+            unpack = [r for r in runs if r["path"].startswith("BM_Unpack/")]
+            if unpack:
+                out.append(f"| {name} {' / '.join(r.get('label', '') for r in unpack)} "
+                           f"| {' / '.join(duration(r['real_time'], r['time_unit']) for r in unpack)} | "
+                           f"| {' / '.join(format(r['items_per_second'] / 1e9, '.2f') for r in unpack)} Gpx/s "
+                           f"| {what} |")
+            continue
+        for r in (r for r in runs if r["path"] == prefix):
+            wall = r["real_time"] * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[r["time_unit"]]
+            per_s = 1e9 / wall
+            rate = f"{per_s / 1e6:.1f} M/s" if per_s >= 1e6 else f"{per_s:,.0f}/s" if per_s >= 1.5 else ""
+            out.append(f"| {name} | {duration(r['real_time'], r['time_unit'])} "
+                       f"| {duration(r['cpu_time'], r['time_unit'])} | {rate} | {what} |")
     repetitions = max(r.get("repetitions", 1) for r in records)
     out += ["", f"{'Medians of ' + str(repetitions) + ' repetitions' if medians else 'One run each'}."]
     return "\n".join(out)
@@ -659,10 +663,15 @@ def figures_path(name):
     return os.path.join(FIGURES, name + ".json")
 
 
+def with_provenance(text, runs):
+    """The rendered table and its provenance; a closing note and the provenance share a paragraph."""
+    return text + ("\n\n" if text.rstrip().endswith("|") else "\n") + provenance(runs)
+
+
 def rendered(table):
     render, figures = TABLES[table]
     runs, records = load([figures_path(figures)])
-    return render(records) + "\n\n" + provenance(runs)
+    return with_provenance(render(records), runs)
 
 
 def rewrite(doc_text):
@@ -693,7 +702,7 @@ def hand_tables(doc_text):
 def main(argv):
     if argv[:1] == ["--print"] and len(argv) >= 3 and argv[1] in TABLES:
         runs, records = load(argv[2:])
-        print(TABLES[argv[1]][0](records) + "\n\n" + provenance(runs))
+        print(with_provenance(TABLES[argv[1]][0](records), runs))
         return 0
     if argv[:1] == ["--store"] and len(argv) >= 3:
         runs, records = load(argv[2:])
