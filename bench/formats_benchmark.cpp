@@ -102,12 +102,13 @@ int avatars(const std::vector<std::string>& files, const std::vector<size_t>& bu
       TriangleMesh raw_mesh;
       raw_mesh.vertices = mesh->vertices;
       for (size_t i = 0; i + 2 < kept; i += 3) raw_mesh.triangles.push_back({out[i], out[i + 1], out[i + 2]});
+      const size_t obj_bytes = storage::encode_obj(s->mesh).size();
+      const size_t raw_non_manifold = analyze_topology(raw_mesh).non_manifold_edges;
       std::string name = f.size() > 40 ? "..." + f.substr(f.size() - 37) : f;
       std::printf("%-40s %10zu %8zu | %7.2f %11zu %8.3f %8.3f %8.2f %8s %7.2f %7.2f | %7.2f %11zu\n", name.c_str(),
                   mesh->num_triangles(), s->mesh.num_triangles(), t, topo.non_manifold_edges, d[d.size() / 2],
                   d[d.size() * 95 / 100], s->max_deviation_mm, topo.closed() ? "yes" : "no",
-                  static_cast<double>(storage::encode_obj(s->mesh).size()) / 1e6,
-                  static_cast<double>(glb->size()) / 1e6, raw, analyze_topology(raw_mesh).non_manifold_edges);
+                  static_cast<double>(obj_bytes) / 1e6, static_cast<double>(glb->size()) / 1e6, raw, raw_non_manifold);
       records.push_back({{"mesh", file_name(f)},
                          {"triangles", mesh->num_triangles()},
                          {"budget", budget},
@@ -118,10 +119,10 @@ int avatars(const std::vector<std::string>& files, const std::vector<size_t>& bu
                          {"median_mm", d[d.size() / 2]},
                          {"p95_mm", d[d.size() * 95 / 100]},
                          {"largest_mm", s->max_deviation_mm},
-                         {"obj_bytes", storage::encode_obj(s->mesh).size()},
+                         {"obj_bytes", obj_bytes},
                          {"glb_bytes", glb->size()},
                          {"meshoptimizer_seconds", raw},
-                         {"meshoptimizer_non_manifold_edges", analyze_topology(raw_mesh).non_manifold_edges}});
+                         {"meshoptimizer_non_manifold_edges", raw_non_manifold}});
     }
   }
   std::printf(
