@@ -75,12 +75,10 @@ int main(int argc, char** argv) {
   cl.option("--normal-sigma", &opt.normal_scale);
   cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  const nlohmann::json run_info = bench::run_record(argc, argv);  // the tree as the run starts
   nlohmann::json record;
   const auto write = [&] {
-    return json_out.empty() ||
-                   bench::write_figures(json_out, bench::run_record(argc, argv), nlohmann::json::array({record}))
-               ? 0
-               : 1;
+    return json_out.empty() || bench::write_figures(json_out, run_info, nlohmann::json::array({record})) ? 0 : 1;
   };
   if (body.empty()) {
     std::fprintf(stderr, "body_benchmark: --body is required\n");

@@ -152,10 +152,10 @@ int main(int argc, char** argv) {
   cl.option("--scan-folder", &folder);
   cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  const nlohmann::json run_info = bench::run_record(argc, argv);  // the tree as the run starts
   nlohmann::json records = nlohmann::json::array();
   const auto write = [&](int rc) {
-    const bool failed =
-        rc == 0 && !json_out.empty() && !bench::write_figures(json_out, bench::run_record(argc, argv), records);
+    const bool failed = rc == 0 && !json_out.empty() && !bench::write_figures(json_out, run_info, records);
     return failed ? 1 : rc;
   };
   if (!folder.empty()) return write(scan_folder(folder, records));

@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
   cl.option("--min-weight", &min_weight);
   cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  const nlohmann::json run_info = bench::run_record(argc, argv);  // the tree as the run starts
   if (membrane) options.fairing = HoleFairing::kMembrane;
   if (in.empty()) {
     std::fprintf(stderr, "hole_fill_benchmark: no input mesh\n");
@@ -149,6 +150,6 @@ int main(int argc, char** argv) {
       }
     }
   }
-  if (!json_out.empty() && !bench::write_figures(json_out, bench::run_record(argc, argv), records)) return 1;
+  if (!json_out.empty() && !bench::write_figures(json_out, run_info, records)) return 1;
   return 0;
 }

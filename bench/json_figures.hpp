@@ -32,7 +32,9 @@ inline std::string first_line_of(const std::string& command) {
 // The run's provenance: the command, the commit of the source tree the
 // benchmark runs in ("-dirty" when files outside docs/ had uncommitted changes;
 // "unknown" outside a checkout), the UTC date, the processor and cores, and the
-// build type where the benchmark's build says it.
+// build type where the benchmark's build says it. Take it as the run starts: the
+// tree is then nearest to the one the benchmark was built from, and edits made
+// while a long run goes on do not mark its figures.
 inline nlohmann::json run_record(const std::string& command) {
   std::string commit = first_line_of("git -C '" BODYSCAN_SOURCE_DIR "' describe --always --abbrev=7 2>/dev/null");
   if (commit.empty()) commit = "unknown";

@@ -187,6 +187,7 @@ int main(int argc, char** argv) {
   cl.option("--json", &json_out);
   cl.flag("--detail", &detail);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  const nlohmann::json run_info = bench::run_record(argc, argv);  // the tree as the run starts
   const std::string shared = BODYSCAN_SOURCE_DIR "/../shared/data/bodies";
   if (bodies.empty()) {
     if (std::filesystem::exists(shared + "/male_average.ply")) {
@@ -328,6 +329,6 @@ int main(int argc, char** argv) {
     }
     std::fflush(stdout);
   }
-  if (!json_out.empty() && !bench::write_figures(json_out, bench::run_record(argc, argv), all)) return 1;
+  if (!json_out.empty() && !bench::write_figures(json_out, run_info, all)) return 1;
   return 0;
 }

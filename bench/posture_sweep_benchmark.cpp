@@ -146,6 +146,7 @@ int main(int argc, char** argv) {
   cl.option("--json", &json_out);
   cl.rest("ARMS,FEET,TURN ...", &case_args);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  const nlohmann::json run_info = bodyscan::bench::run_record(argc, argv);  // the tree as the run starts
   for (const std::string& a : case_args) {
     const auto v = parse_number_list(a, 3);
     if (!v) return cl.fail("a case is ARMS,FEET,TURN, not '" + a + "'");
@@ -155,8 +156,6 @@ int main(int argc, char** argv) {
     cases = {{42, 380, 0}, {40, 350, 20}, {45, 420, -25}, {20, 300, 0}, {30, 250, 10}, {42, 150, 0}, {42, 380, 40}};
   nlohmann::json records = nlohmann::json::array();
   const int rc = run(rig, body, every, cases, records);
-  if (rc == 0 && !json_out.empty() &&
-      !bodyscan::bench::write_figures(json_out, bodyscan::bench::run_record(argc, argv), records))
-    return 1;
+  if (rc == 0 && !json_out.empty() && !bodyscan::bench::write_figures(json_out, run_info, records)) return 1;
   return rc;
 }

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   cl.option("--sway", &sway);
   cl.option("--json", &json_out);
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  const nlohmann::json run_info = bench::run_record(argc, argv);  // the tree as the run starts
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   auto sim = pipeline::open_simulated_rig(rig_name);
@@ -93,8 +94,6 @@ int main(int argc, char** argv) {
       {"scan_frames", scan_frames},
       {"scan_seconds", secs(t2, t3)},
       {"cameras_seconds", scan_frames / static_cast<double>(desc.cameras.size()) / desc.simulation.frame_rate_hz}};
-  if (!json_out.empty() &&
-      !bench::write_figures(json_out, bench::run_record(argc, argv), nlohmann::json::array({record})))
-    return 1;
+  if (!json_out.empty() && !bench::write_figures(json_out, run_info, nlohmann::json::array({record}))) return 1;
   return 0;
 }

@@ -262,6 +262,7 @@ int main(int argc, char** argv) {
   cl.option("--json", &json_out);
   cl.option("--smooth", integer_between(0, 1000, [&smooth](long long n) { smooth = static_cast<int>(n); }));
   if (const auto exit = cl.parse(argc, argv)) return *exit;
+  const nlohmann::json run_info = bench::run_record(argc, argv);  // the tree as the run starts
   std::string path = rig_name;
   if (rig_name.find('/') == std::string::npos && rig_name.find(".json") == std::string::npos) {
     auto p = shipped_rig_path(rig_name);
@@ -479,7 +480,7 @@ int main(int argc, char** argv) {
         {"noisy", noisy},
         {"renderer", shipped_all.to_json()},
         {"reference", reference_all.to_json()}};
-    if (!bench::write_figures(json_out, bench::run_record(argc, argv), nlohmann::json::array({record}))) return 1;
+    if (!bench::write_figures(json_out, run_info, nlohmann::json::array({record}))) return 1;
   }
   return 0;
 }
