@@ -51,6 +51,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -585,6 +586,11 @@ int main(int argc, char** argv) {
   int rc = 0;
   if (!saved.empty() && bodies == std::vector<std::string>{""})
     return std::fprintf(stderr, "measure_benchmark: --saved needs the bodies' names (--body B.ply)\n"), 2;
+  if (!g_save.empty()) {  // before the scans, not after them
+    std::error_code ec;
+    std::filesystem::create_directories(g_save, ec);
+    if (ec) return std::fprintf(stderr, "measure_benchmark: --save %s: %s\n", g_save.c_str(), ec.message().c_str()), 2;
+  }
   for (const std::string& r : rigs)
     for (const std::string& b : bodies)
       rc |= saved.empty() ? run(r, b, repeat, sway, every) : remeasure(saved, r, b, sway);

@@ -65,7 +65,8 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
     ASSIGN_OR_RETURN(const rules::NeckLevel neck, rules::find_neck(cuts, sheet, higher_armpit_y));
     for (Side side : kBothSides) RETURN_IF_ERROR(rules::find_side_neck_point(cuts, sheet, neck, higher_armpit_y, side));
     rules::PerSide<std::optional<rules::ArmAxes>> arm_axes;
-    for (Side side : kBothSides) arm_axes[side] = rules::find_arm_axes(cuts, sheet, arms[side].apart_y, crotch_y, side);
+    for (Side side : kBothSides)
+      arm_axes[side] = rules::find_arm_axes(cuts, sheet, arms[side].followed_from_y, crotch_y, side);
     for (Side side : kBothSides) {
       // An arm lost against the flank is read from its outer side, whose slope a
       // heavy arm's bulges tilt outward. It touches the flank, and so hangs no
@@ -75,7 +76,7 @@ StatusOr<BodyMeasurements> measure_body(const TriangleMesh& mesh, const BodyMeas
       if (arm_axes[side]) {
         upper_arm = arm_axes[side]->upper_dir;
       } else {
-        upper_arm = rules::outer_side_axis(cuts, arms[side].apart_y, side);
+        upper_arm = rules::outer_side_axis(cuts, arms[side].followed_from_y, side);
         if (const auto& other = arm_axes[rules::opposite(side)]) {
           const Eigen::Vector3d mirrored(-other->upper_dir.x(), other->upper_dir.y(), other->upper_dir.z());
           if (!upper_arm || std::abs(mirrored.y()) > std::abs(upper_arm->y())) upper_arm = mirrored;

@@ -29,6 +29,9 @@ struct Ring {
   // The mesh's confidence where the loop crosses X = x at its front and at its back,
   // the higher of the two (1 where the mesh has none, or the loop does not cross).
   float crossing_confidence(double x) const;
+  // Whether the two loops' outlines cross in the horizontal plane: one part's
+  // surface passes through the other's (a posed arm through the flank).
+  bool crosses(const Ring& other) const;
 };
 
 class BodySlicer {

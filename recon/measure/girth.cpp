@@ -58,7 +58,7 @@ void measure_around(const std::vector<Eigen::Vector3d>& points, const Plane& pla
 }
 
 // Whether two closed polygons' edges cross.
-bool loops_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
+bool polygons_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
   Eigen::AlignedBox2d ba, bb;
   for (const Eigen::Vector2d& p : a) ba.extend(p);
   for (const Eigen::Vector2d& p : b) bb.extend(p);
@@ -141,6 +141,10 @@ void drop_nested_loops(std::vector<SectionLoop>* loops, const Plane& plane) {
   loops->resize(k);
 }
 
+bool loops_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
+  return polygons_cross(a, b);
+}
+
 double closed_length(const std::vector<Eigen::Vector2d>& polygon) { return closed_length_of(polygon); }
 double closed_length(const std::vector<Eigen::Vector3d>& polygon) { return closed_length_of(polygon); }
 
@@ -211,7 +215,7 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
       grew = false;
       for (size_t i = 0; i < closed.size(); ++i)
         for (size_t j = 0; j < closed.size() && !taken[i]; ++j)
-          if (taken[j] && loops_cross(flat[j], flat[i])) taken[i] = grew = true;
+          if (taken[j] && polygons_cross(flat[j], flat[i])) taken[i] = grew = true;
     }
     for (size_t i = 0; i < closed.size(); ++i) {
       if (!taken[i] || meant[i]) continue;

@@ -18,6 +18,9 @@ namespace bodyscan {
 // The convex hull of points in a plane, counter-clockwise, without collinear points
 // (Andrew's monotone chain, O(n log n)). Fewer than 3 distinct points: those points.
 std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> points);
+// Whether two closed polygons' edges cross (a surface that passes through itself
+// cuts as crossing loops).
+bool loops_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b);
 // Length of the closed polygon through `polygon` (mm).
 double closed_length(const std::vector<Eigen::Vector2d>& polygon);
 double closed_length(const std::vector<Eigen::Vector3d>& polygon);

@@ -72,6 +72,13 @@ const Ring* BodyCuts::arm_loop(const std::vector<Ring>& cut, Side side) const {
   return side_ring(cut, midline_x_, side, true, 0.05 * stature_);
 }
 
+bool BodyCuts::arm_clear(double y, Side side) const {
+  const std::vector<Ring>& cut = at(y);
+  const Ring* arm = arm_loop(cut, side);
+  const Ring* trunk = midline_ring(cut, midline_x_);
+  return arm && !(trunk && arm->crosses(*trunk));
+}
+
 StatusOr<Girth> BodyCuts::level_girth(double y, const Eigen::Vector3d& near) const { return slicer_->girth(y, near); }
 
 std::vector<uint32_t> BodyCuts::triangles_near(const Eigen::Vector3d& c, double r,

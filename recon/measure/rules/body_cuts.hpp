@@ -79,6 +79,9 @@ class BodyCuts {
   // least 5 % of the stature round (a scrap a coarse scan leaves beside the hip is
   // no arm).
   const Ring* arm_loop(const std::vector<Ring>& cut, Side side) const;
+  // Whether at height y the arm on `side` is a loop of its own that does not cross
+  // the trunk's: a horizontal tape round the trunk leaves it out.
+  bool arm_clear(double y, Side side) const;
   // The horizontal tape at height y round the loop nearest `near`.
   StatusOr<Girth> level_girth(double y, const Eigen::Vector3d& near) const;
   // Triangles with a corner within r of c, for the tilted cuts (among `among`

@@ -20,6 +20,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // surface rounds the corner where two parts meet, and closes their gap a few mm
 // early in a narrow saddle; a true crotch's floor is long where the legs first meet.
 constexpr double kJoinDepth = 0.015;
+// An arm against the flank touches it over at most this fraction of the stature
+// below the armpit (find_arm_join).
+constexpr double kContactOfStature = 0.04;
 // Above a filled bridge, measured skin begins where the midline's crossing is
 // measured over at least half of this height (mm) around the level (above_bridge).
 constexpr double kBridgeWindowMm = 3;
@@ -312,7 +315,7 @@ StatusOr<ArmJoin> find_arm_join(const BodyCuts& cuts, MeasurementSheet& sheet, d
   auto arm = [&](double y) { return cuts.arm_loop(cuts.at(y), side) != nullptr; };
   // Upwards from just above the crotch, the first run of cuts with the arm apart
   // from the body that is at least 4 % of the stature long (a scrap that comes and
-  // goes is not); the armpit is where that run ends.
+  // goes is not).
   const double step = 5;
   double y = crotch_y + 0.03 * stature, first = y, last = y;
   cuts.prefetch(y, cuts.level(0.8), step);
@@ -326,7 +329,19 @@ StatusOr<ArmJoin> find_arm_join(const BodyCuts& cuts, MeasurementSheet& sheet, d
     if (last - first >= 0.04 * stature) break;
   }
   ArmJoin join;
-  join.apart_y = bisect(y, last, arm);
+  join.followed_from_y = bisect(y, last, arm);
+  // An arm that lies against the flank joins it where they touch, below the
+  // armpit, and parts from it again above the contact: the gap under the armpit
+  // is the last run of cuts, however short, that begins within kContactOfStature
+  // above the one before.
+  bool parted_again = false;
+  for (double u = y + step; u <= y + kContactOfStature * stature && u < cuts.level(0.95); u += step) {
+    if (!arm(u)) continue;
+    parted_again = true;
+    for (last = u; last + step < cuts.level(0.95) && arm(last + step);) last += step;
+    y = u = last + step;
+  }
+  join.apart_y = parted_again ? bisect(y, last, arm) : join.followed_from_y;
   // The armpit: halfway across the last gap between arm and trunk.
   const std::vector<Ring>& cut = cuts.at(join.apart_y - 0.5);
   const Ring* a = cuts.arm_loop(cut, side);
@@ -415,16 +430,23 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
   // two the reach grows with the crease's depth (breast_reach).
   out.bust_girth_y = out.bust_y;
   if (out.breast > 0) {
+    // Only where both arms are clear of the trunk: an arm that lies against the
+    // flank joins it (or, posed by skinning, passes through it) below the armpit,
+    // and the tape there would go round the arm.
+    const auto arms_apart = [&](double y) { return cuts.arm_clear(y, Side::kLeft) && cuts.arm_clear(y, Side::kRight); };
+    const auto girth = [](const Ring& m) { return m.girth; };
     const double reach = out.breast * kBustReachOfStature * stature;
     const double lo = out.bust_y - reach,
                  hi = std::max(out.bust_y, std::min(out.bust_y + reach, lower_armpit_y - 0.01 * stature));
-    const auto [ys, vs] = midline_profile(cuts, lo, hi, [](const Ring& m) { return m.girth; });
+    auto [ys, vs] = midline_profile(cuts, lo, hi, girth);
+    for (size_t i = ys.size(); i-- > 0;)
+      if (!arms_apart(ys[i])) ys.erase(ys.begin() + i), vs.erase(vs.begin() + i);
     if (!ys.empty()) {
       const size_t k = arg_extreme(vs, true);
       double best = vs[k];
       out.bust_girth_y = ys[k];
       for (double y = ys[k] - 1.5; y <= ys[k] + 1.5; y += 0.5)
-        if (const Ring* m = y >= lo && y <= hi ? cuts.midline_loop(y) : nullptr; m && m->girth > best)
+        if (const Ring* m = y >= lo && y <= hi && arms_apart(y) ? cuts.midline_loop(y) : nullptr; m && m->girth > best)
           best = m->girth, out.bust_girth_y = y;
     }
   }

@@ -11,7 +11,11 @@ namespace bodyscan::rules {
 
 // Where an arm meets the trunk.
 struct ArmJoin {
-  // The top of the first long run of cuts in which the arm is its own loop.
+  // The top of the first long run of cuts in which the arm is its own loop, up
+  // from the hand: the arm is followed down from there.
+  double followed_from_y = 0;
+  // The top of the gap between arm and flank under the armpit: followed_from_y,
+  // or where an arm lies against the flank, of the run above the contact.
   double apart_y = 0;
   // The armpit's level: apart_y, or above a filled bridge between arm and flank,
   // the first level where the gap's crossing is measured skin.

@@ -239,6 +239,27 @@ TEST(HeavyBodyPosture, ElbowsAndShouldersKeepToTheirSkin) {
   EXPECT_GE(against, 2);  // the rule for an arm against the flank is exercised
 }
 
+// female_heavy's arms lowered to 15 degrees press into the flank over the top of
+// the bust (skinning passes one through the other) and part from it again under
+// the armpit. The armpit is the top of that upper gap, not the contact's foot 68 mm
+// lower, so the bust's window still reaches the breasts' apex: the bust points keep
+// to the skin they marked at rest, and the bust girth, read only where both arms
+// are clear of the trunk, stays within half its allowance.
+TEST(HeavyBodyPosture, AnArmPressedToTheFlankUnderTheArmpitLeavesTheBustAlone) {
+  const Posed& rest = posed("female_heavy.ply", 0, 0);
+  const BodyMeasurement* rest_bust = rest.measured.find("bust_girth");
+  ASSERT_NE(rest_bust, nullptr);
+  for (const double arms : {15.0, 20.0, 25.0, 30.0, 35.0, 45.0}) {
+    const Posed& p = posed("female_heavy.ply", arms, 0);
+    for (const char* sd : {"left", "right"})
+      EXPECT_LT(drift(rest, p, std::string("bust_point_") + sd), 10) << sd << " arms " << arms;
+    const BodyMeasurement* bust = p.measured.find("bust_girth");
+    ASSERT_NE(bust, nullptr) << "arms " << arms;
+    EXPECT_LE(std::abs(bust->value_mm - rest_bust->value_mm), 0.5 * iso20685_allowance_mm(*rest_bust))
+        << "arms " << arms;
+  }
+}
+
 // One arm lowered against the flank, the other held out: the lowered arm's
 // shoulder point keeps to its skin whatever the other does. The arm against the
 // body cannot be followed; its slope is read from its outer side, which a heavy
