@@ -252,6 +252,45 @@ double waist_level(const BodyCuts& cuts, double hip_y, std::optional<double> cre
   return ys.empty() ? 0.5 * (lo + hi) : minimum_centroid(ys, vs, arg_extreme(vs, false), kWaistDepthMm);
 }
 
+// An arm that lies against the flank joins it where they touch, below the
+// armpit, and parts from it again above the contact: the gap under the armpit is
+// the last run of cuts, however short, that begins within kContactOfStature above
+// the one before. `joined` is the first cut (every `step` mm) above a run whose
+// last cut is `last`; `apart` says whether the arm is its own loop at a level. The
+// last run's top (bisected), if the arm parts again; else none.
+std::optional<double> gap_top_above_contact(const BodyCuts& cuts, const std::function<bool(double)>& apart,
+                                            double joined, double last, double step) {
+  const double reach = kContactOfStature * cuts.stature(), top = cuts.level(0.95);
+  bool parted_again = false;
+  for (double u = joined + step; u <= joined + reach && u < top; u += step) {
+    if (!apart(u)) continue;
+    parted_again = true;
+    for (last = u; last + step < top && apart(last + step);) last += step;
+    joined = u = last + step;
+  }
+  if (!parted_again) return std::nullopt;
+  return bisect(joined, last, apart);
+}
+
+// The level between lo and hi where the midline loop's tape is longest, every 2 mm
+// and then every 0.5 mm round the longest; only where both arms are clear of the
+// trunk: an arm that lies against the flank joins it (or, posed by skinning,
+// passes through it) below the armpit, and the tape there would go round the arm.
+std::optional<double> fullest_level(const BodyCuts& cuts, double lo, double hi) {
+  const auto arms_clear = [&](double y) { return cuts.arm_clear(y, Side::kLeft) && cuts.arm_clear(y, Side::kRight); };
+  std::optional<double> level;
+  double best = -kInf;
+  cuts.prefetch(lo, hi, 2);
+  for (double y = lo; y <= hi; y += 2)
+    if (const Ring* m = cuts.midline_loop(y); m && m->girth > best && arms_clear(y)) best = m->girth, level = y;
+  if (!level) return std::nullopt;
+  const double coarse = *level;
+  for (double y = coarse - 1.5; y <= coarse + 1.5; y += 0.5)
+    if (const Ring* m = y >= lo && y <= hi ? cuts.midline_loop(y) : nullptr; m && m->girth > best && arms_clear(y))
+      best = m->girth, level = y;
+  return level;
+}
+
 }  // namespace
 
 StatusOr<double> find_crotch(const BodyCuts& cuts, MeasurementSheet& sheet) {
@@ -330,18 +369,7 @@ StatusOr<ArmJoin> find_arm_join(const BodyCuts& cuts, MeasurementSheet& sheet, d
   }
   ArmJoin join;
   join.followed_from_y = bisect(y, last, arm);
-  // An arm that lies against the flank joins it where they touch, below the
-  // armpit, and parts from it again above the contact: the gap under the armpit
-  // is the last run of cuts, however short, that begins within kContactOfStature
-  // above the one before.
-  bool parted_again = false;
-  for (double u = y + step; u <= y + kContactOfStature * stature && u < cuts.level(0.95); u += step) {
-    if (!arm(u)) continue;
-    parted_again = true;
-    for (last = u; last + step < cuts.level(0.95) && arm(last + step);) last += step;
-    y = u = last + step;
-  }
-  join.apart_y = parted_again ? bisect(y, last, arm) : join.followed_from_y;
+  join.apart_y = gap_top_above_contact(cuts, arm, y, last, step).value_or(join.followed_from_y);
   // The armpit: halfway across the last gap between arm and trunk.
   const std::vector<Ring>& cut = cuts.at(join.apart_y - 0.5);
   const Ring* a = cuts.arm_loop(cut, side);
@@ -430,25 +458,11 @@ TrunkLevels find_trunk_levels(const BodyCuts& cuts, MeasurementSheet& sheet, dou
   // two the reach grows with the crease's depth (breast_reach).
   out.bust_girth_y = out.bust_y;
   if (out.breast > 0) {
-    // Only where both arms are clear of the trunk: an arm that lies against the
-    // flank joins it (or, posed by skinning, passes through it) below the armpit,
-    // and the tape there would go round the arm.
-    const auto arms_apart = [&](double y) { return cuts.arm_clear(y, Side::kLeft) && cuts.arm_clear(y, Side::kRight); };
-    const auto girth = [](const Ring& m) { return m.girth; };
     const double reach = out.breast * kBustReachOfStature * stature;
-    const double lo = out.bust_y - reach,
-                 hi = std::max(out.bust_y, std::min(out.bust_y + reach, lower_armpit_y - 0.01 * stature));
-    auto [ys, vs] = midline_profile(cuts, lo, hi, girth);
-    for (size_t i = ys.size(); i-- > 0;)
-      if (!arms_apart(ys[i])) ys.erase(ys.begin() + i), vs.erase(vs.begin() + i);
-    if (!ys.empty()) {
-      const size_t k = arg_extreme(vs, true);
-      double best = vs[k];
-      out.bust_girth_y = ys[k];
-      for (double y = ys[k] - 1.5; y <= ys[k] + 1.5; y += 0.5)
-        if (const Ring* m = y >= lo && y <= hi && arms_apart(y) ? cuts.midline_loop(y) : nullptr; m && m->girth > best)
-          best = m->girth, out.bust_girth_y = y;
-    }
+    out.bust_girth_y =
+        fullest_level(cuts, out.bust_y - reach,
+                      std::max(out.bust_y, std::min(out.bust_y + reach, lower_armpit_y - 0.01 * stature)))
+            .value_or(out.bust_y);
   }
 
   return out;
