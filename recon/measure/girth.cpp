@@ -57,8 +57,9 @@ void measure_around(const std::vector<Eigen::Vector3d>& points, const Plane& pla
   for (const Eigen::Vector2d& h : hull) g->tape.push_back(plane.point + h.x() * u + h.y() * v);
 }
 
-// Whether two closed polygons' edges cross.
-bool polygons_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
+}  // namespace
+
+bool loops_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
   Eigen::AlignedBox2d ba, bb;
   for (const Eigen::Vector2d& p : a) ba.extend(p);
   for (const Eigen::Vector2d& p : b) bb.extend(p);
@@ -82,8 +83,6 @@ bool polygons_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eig
     }
   return false;
 }
-
-}  // namespace
 
 void plane_basis(const Eigen::Vector3d& normal, Eigen::Vector3d* u, Eigen::Vector3d* v) {
   const Eigen::Vector3d n = normal.normalized();
@@ -139,10 +138,6 @@ void drop_nested_loops(std::vector<SectionLoop>* loops, const Plane& plane) {
       ++k;
     }
   loops->resize(k);
-}
-
-bool loops_cross(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b) {
-  return polygons_cross(a, b);
 }
 
 double closed_length(const std::vector<Eigen::Vector2d>& polygon) { return closed_length_of(polygon); }
@@ -215,7 +210,7 @@ StatusOr<Girth> mesh_girth(const TriangleMesh& mesh, const Plane& plane_in, cons
       grew = false;
       for (size_t i = 0; i < closed.size(); ++i)
         for (size_t j = 0; j < closed.size() && !taken[i]; ++j)
-          if (taken[j] && polygons_cross(flat[j], flat[i])) taken[i] = grew = true;
+          if (taken[j] && loops_cross(flat[j], flat[i])) taken[i] = grew = true;
     }
     for (size_t i = 0; i < closed.size(); ++i) {
       if (!taken[i] || meant[i]) continue;
