@@ -241,10 +241,10 @@ TEST(HeavyBodyPosture, ElbowsAndShouldersKeepToTheirSkin) {
 
 // female_heavy's arms lowered to 15 degrees press into the flank over the top of
 // the bust (skinning passes one through the other) and part from it again under
-// the armpit. The armpit is the top of that upper gap, not the contact's foot 68 mm
-// lower, so the bust's window still reaches the breasts' apex: the bust points keep
-// to the skin they marked at rest, and the bust girth, read only where both arms
-// are clear of the trunk, stays within half its allowance.
+// the armpit. The armpit is the top of that upper gap, not the contact's foot well
+// below it, so the bust's window still reaches the breasts' apex: the bust points
+// keep to the skin they marked at rest, and the bust girth, read only where both
+// arms are clear of the trunk, stays within half its allowance.
 TEST(HeavyBodyPosture, AnArmPressedToTheFlankUnderTheArmpitLeavesTheBustAlone) {
   const Posed& rest = posed("female_heavy.ply", 0, 0);
   const BodyMeasurement* rest_bust = rest.measured.find("bust_girth");
