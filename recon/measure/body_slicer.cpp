@@ -25,10 +25,10 @@ bool Ring::crossing_z(double x, double* front, double* back) const {
 
 bool Ring::crosses(const Ring& other) const {
   if (x_max < other.x_min || other.x_max < x_min || z_max < other.z_min || other.z_max < z_min) return false;
-  const auto flat = [](const std::vector<Eigen::Vector3d>& points) {
+  const auto flat = [](const std::vector<Eigen::Vector3d>& loop) {
     std::vector<Eigen::Vector2d> out;
-    out.reserve(points.size());
-    for (const Eigen::Vector3d& p : points) out.emplace_back(p.x(), p.z());
+    out.reserve(loop.size());
+    for (const Eigen::Vector3d& p : loop) out.emplace_back(p.x(), p.z());
     return out;
   };
   return loops_cross(flat(points), flat(other.points));
