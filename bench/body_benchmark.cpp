@@ -3,12 +3,20 @@
 //   body_benchmark --body MESH.ply [--points N] [--noise MM] [--seed S]
 //                  [--cloud-out PTS.ply] [--mesh-out OUT.ply] [--voxel V]
 //   body_benchmark --body MESH.ply --evaluate OTHER.ply   (accuracy of any mesh)
+//   body_benchmark --body MESH.ply [--points N ...] --oriented-out PTS.ply
+//   body_benchmark --cloud SCAN.ply --oriented-out PTS.ply
 //   ... [--json OUT.json]   the figures also as JSON (bench/json_figures.hpp)
 //
 // Samples N points uniformly by area from the true mesh, adds isotropic Gaussian
 // noise, reconstructs with the defaults (no input normals), and reports wall time
 // per stage, peak memory, and the distances output -> truth and truth -> output
 // (mean, RMS, 95th percentile, max), plus the mesh's topology.
+//
+// --oriented-out writes the cloud (the sampled one, or --cloud's) with PCA normals
+// of its 20 nearest neighbours, oriented as a scanner orients them: toward the
+// camera that saw each point, or for a sampled cloud to the true surface's side;
+// then stops. It is what a reconstruction that needs oriented normals (Screened
+// Poisson) starts from; the time it takes is reported for that side's total.
 #include <sys/resource.h>
 
 #include <chrono>
@@ -22,6 +30,9 @@
 #include "recon/geometry/mesh_distance.hpp"
 #include "recon/geometry/sample_surface.hpp"
 #include "recon/io/ply.hpp"
+#include "recon/spatial/knn_index.hpp"
+#include "recon/surface/estimate_normals.hpp"
+#include "recon/surface/orient_normals.hpp"
 #include "recon/surface/reconstruct.hpp"
 
 using namespace bodyscan;
@@ -52,22 +63,49 @@ void print_accuracy(const TriangleMesh& mesh, const TriangleMesh& truth, nlohman
   record["euler"] = t.euler_characteristic;
 }
 
+// Replaces cloud.normals by PCA normals of k = 20 neighbours, each turned toward
+// the camera that saw its point, else to the side of `sides` (the true normals of
+// a sampled cloud), and returns the seconds it took.
+double orient_like_a_scanner(PointCloud& cloud, const std::vector<Vec3f>& sides) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const KnnIndex index(cloud.positions);
+  LocalFrames frames = estimate_normals(cloud.positions, index, NeighborGraph{}, EstimateNormalsOptions{.k = 20});
+  if (cloud.has_cameras()) {
+    orient_normals_toward_cameras(cloud, frames);
+  } else {
+    for (size_t i = 0; i < frames.normals.size() && i < sides.size(); ++i)
+      if (frames.normals[i].dot(sides[i]) < 0) flip_frame(frames, i);
+  }
+  cloud.normals = std::move(frames.normals);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Writes the cloud; false (and says why) where it could not.
+bool write_cloud(const std::string& path, const PointCloud& cloud) {
+  const Status st = write_ply(path, cloud);
+  if (!st.ok()) std::fprintf(stderr, "body_benchmark: %s\n", st.message().c_str());
+  return st.ok();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string body, cloud_out, mesh_out, evaluate, json_out;
+  std::string body, cloud_in, cloud_out, oriented_out, mesh_out, evaluate, json_out;
   size_t points = 1'000'000;
   double noise = 0.5;
   uint64_t seed = 1;
   ReconstructOptions opt;
   CommandLine cl("body_benchmark",
                  "usage: body_benchmark --body MESH.ply [--points N] [--noise MM] [--seed S] [--cloud-out F] "
-                 "[--mesh-out F] [--evaluate MESH.ply] [--voxel V] [--sigma S] [--normal-sigma S] [--json OUT]\n");
+                 "[--mesh-out F] [--evaluate MESH.ply] [--voxel V] [--sigma S] [--normal-sigma S] [--json OUT]\n"
+                 "       body_benchmark (--body MESH.ply [--points N ...] | --cloud SCAN.ply) --oriented-out F\n");
   cl.option("--body", &body);
   cl.option("--points", integer_between(1, 1LL << 40, [&points](long long n) { points = static_cast<size_t>(n); }));
   cl.option("--noise", &noise);
   cl.option("--seed", &seed);
+  cl.option("--cloud", &cloud_in);
   cl.option("--cloud-out", &cloud_out);
+  cl.option("--oriented-out", &oriented_out);
   cl.option("--mesh-out", &mesh_out);
   cl.option("--evaluate", &evaluate);
   cl.option("--voxel", &opt.voxel_size);
@@ -80,6 +118,26 @@ int main(int argc, char** argv) {
   const auto write = [&] {
     return json_out.empty() || bench::write_figures(json_out, run_info, nlohmann::json::array({record})) ? 0 : 1;
   };
+  if (!cloud_in.empty()) {
+    if (oriented_out.empty()) {
+      std::fprintf(stderr, "body_benchmark: --cloud goes with --oriented-out\n");
+      return 2;
+    }
+    auto scan = read_ply(cloud_in);
+    if (!scan.ok() || !scan->cloud.has_cameras()) {
+      std::fprintf(
+          stderr, "body_benchmark: %s\n",
+          scan.ok() ? "--cloud needs a scan's points (each with its camera)" : scan.status().message().c_str());
+      return 1;
+    }
+    PointCloud& cloud = scan->cloud;
+    record = {{"cloud", std::filesystem::path(cloud_in).filename().string()},
+              {"points", cloud.size()},
+              {"normals_seconds", orient_like_a_scanner(cloud, {})}};
+    std::printf("normals         %zu points, PCA of 20 neighbours toward their cameras: %.2f s\n", cloud.size(),
+                record["normals_seconds"].get<double>());
+    return write_cloud(oriented_out, cloud) ? write() : 1;
+  }
   if (body.empty()) {
     std::fprintf(stderr, "body_benchmark: --body is required\n");
     return 2;
@@ -101,14 +159,20 @@ int main(int argc, char** argv) {
     return write();
   }
 
-  PointCloud cloud = sample_mesh_uniform(*truth, points, seed, false);
+  PointCloud cloud = sample_mesh_uniform(*truth, points, seed, true);
+  const std::vector<Vec3f> true_normals = std::move(cloud.normals);
+  cloud.normals.clear();  // the reconstruction estimates its own
   add_gaussian_noise(cloud, noise, seed + 1);
-  if (!cloud_out.empty()) {
-    const Status s = write_ply(cloud_out, cloud);
-    if (!s.ok()) {
-      std::fprintf(stderr, "body_benchmark: %s\n", s.message().c_str());
-      return 1;
-    }
+  if (!cloud_out.empty() && !write_cloud(cloud_out, cloud)) return 1;
+  if (!oriented_out.empty()) {
+    PointCloud oriented = cloud;
+    record = {{"cloud", "sampled"},
+              {"points", cloud.size()},
+              {"noise_mm", noise},
+              {"normals_seconds", orient_like_a_scanner(oriented, true_normals)}};
+    std::printf("normals         %zu points, PCA of 20 neighbours to the true side: %.2f s\n", oriented.size(),
+                record["normals_seconds"].get<double>());
+    return write_cloud(oriented_out, oriented) ? write() : 1;
   }
   std::printf("input           %zu points from %s, noise %.2f mm (per axis), no normals\n", cloud.size(), body.c_str(),
               noise);

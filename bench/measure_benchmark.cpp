@@ -7,8 +7,8 @@
 //
 //   measure_benchmark [--rig thesis|square|tiered|FILE]... [--body BODY.ply]... [--repeat]
 //                     [--sway MM] [--every N] [--fairing membrane|thin] [--save DIR | --saved DIR]
-//                     [--resurface] [--seed N] [--min-weight W] [--posture ARMS,FEET,TURN]
-//                     [--json OUT.json]
+//                     [--resurface] [--seed N] [--min-weight W] [--voxel MM]
+//                     [--posture ARMS,FEET,TURN] [--json OUT.json]
 //   measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body BODY.ply...
 //
 // --save writes each scan's surface, its point cloud and the posed true body as PLY
@@ -18,7 +18,8 @@
 // of an hour. With --resurface it first builds each surface again from the saved
 // cloud with today's reconstruction (as the scan job does, half a minute a scan),
 // so a change to the surface is judged on the same scans.
-// --min-weight sets the surface's ReconstructOptions::min_relative_weight.
+// --min-weight sets the surface's ReconstructOptions::min_relative_weight, --voxel
+// its voxel_size (mm; default: chosen from the cloud).
 // --posture ARMS,FEET,TURN has the simulated subject of every scan stand otherwise
 // than the rig description says, as `bodyscan scan --arms --feet --turn` does
 // (pipeline::SimulatedSubject): both upper arms ARMS degrees from the downward
@@ -550,7 +551,7 @@ int main(int argc, char** argv) {
   CommandLine cl("measure_benchmark",
                  "usage: measure_benchmark [--rig R]... [--body B]... [--repeat] [--sway MM] [--every N] "
                  "[--fairing membrane|thin] [--save DIR | --saved DIR [--resurface]] [--seed N] [--min-weight W] "
-                 "[--posture ARMS,FEET,TURN] [--json OUT]\n"
+                 "[--voxel MM] [--posture ARMS,FEET,TURN] [--json OUT]\n"
                  "       measure_benchmark --noise-study N [--noise-rms MM] [--noisy-out DIR] --body B...\n");
   cl.option("--rig", &rigs);
   cl.option("--body", &bodies);
@@ -567,6 +568,7 @@ int main(int argc, char** argv) {
   cl.option("--seed", &g_seed);
   cl.option("--json", &g_json_out);
   cl.option("--min-weight", &g_surface.min_relative_weight);
+  cl.option("--voxel", &g_surface.voxel_size);
   cl.option("--posture", parse_posture);
   cl.option("--fairing", [](const std::string& f) -> std::string {
     if (f != "membrane" && f != "thin") return "is membrane or thin, not '" + f + "'";

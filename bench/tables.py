@@ -631,6 +631,52 @@ def open3d_sphere(records):
     return "\n".join(out)
 
 
+def poissonrecon(records):
+    """bodyscan against PoissonRecon on a uniform cloud and a scan's: time, memory, distances, size."""
+    cases = [c for c in ("uniform", "scan") if any(r["case"] == c for r in records)]
+    cell = {(r["case"], r["method"]): r for r in records}
+    columns = []
+    for c in cases:
+        n = cell[(c, "bodyscan")]["points"]
+        what = f"{n / 1e6:g} M uniform" if c == "uniform" else f"tiered scan, {n / 1e3:.0f} k"
+        columns.append((c, "bodyscan", f"{what}: bodyscan{' --body' if c == 'scan' else ''}"))
+        if (c, "poisson") in cell:
+            columns.append((c, "poisson", f"PoissonRecon depth {cell[(c, 'poisson')]['depth']}"))
+
+    def seconds(r):
+        if r["method"] == "poisson":
+            return f"{r['process_seconds'] + r['normals_seconds']:.1f} (normals {r['normals_seconds']:.1f})"
+        return f"{r['process_seconds']:.1f}"
+
+    def dist(key):
+        return lambda r: f"{r[key]['rms']:.3f} / {r[key]['p95']:.3f} / {r[key]['max']:.1f}"
+
+    def closed(r):
+        return "closed" if r["boundary_edges"] == 0 and r["non_manifold_edges"] == 0 else (
+            f"{r['boundary_edges']} boundary, {r['non_manifold_edges']} non-manifold edges")
+
+    rows = [("wall time, whole process (s)", seconds),
+            ("peak RSS (GB)", lambda r: f"{r['process_peak_mb'] / 1024:.2f}"),
+            ("output → truth: RMS / p95 / max (mm)", dist("output_to_truth_mm")),
+            ("truth → output: RMS / p95 / max (mm)", dist("truth_to_output_mm")),
+            ("triangles", lambda r: f"{r['triangles'] / 1e6:.2f} M"),
+            ("surface", lambda r: f"{closed(r)}, {r['components']} component{'s' if r['components'] != 1 else ''}")]
+    out = ["| | " + " | ".join(title for _, _, title in columns) + " |", "|---|" + "---:|" * len(columns)]
+    for name, fmt in rows:
+        out.append(f"| {name} | " + " | ".join(fmt(cell[(c, m)]) for c, m, _ in columns) + " |")
+    notes = []
+    for c in cases:
+        if (c, "poisson") not in cell:
+            continue
+        ours, theirs = cell[(c, "bodyscan")], cell[(c, "poisson")]
+        time = (theirs["process_seconds"] + theirs["normals_seconds"]) / ours["process_seconds"]
+        p95 = ours["output_to_truth_mm"]["p95"] / theirs["output_to_truth_mm"]["p95"]
+        notes.append(f"{c}: bodyscan takes {1 / time:.2f}× PoissonRecon's time, its p95 is {p95:.2f}× PoissonRecon's")
+    if notes:
+        out += ["", "Ratios: " + "; ".join(notes) + "."]
+    return "\n".join(out)
+
+
 # A table's name: (its renderer, the figures file it reads, by name in docs/figures).
 TABLES = {
     "sphere": (sphere, "sphere"),
@@ -656,6 +702,7 @@ TABLES = {
     "measure_repeat": (measure_repeat, "measure_repeat"),
     "open3d_body": (open3d_body, "open3d_body"),
     "open3d_sphere": (open3d_sphere, "open3d_sphere"),
+    "poissonrecon": (poissonrecon, "poissonrecon"),
 }
 
 
