@@ -31,7 +31,9 @@ Status surface_and_measure(const ScanJobOptions& options, ScanJobResult* out) {
   if (options.reconstruct) {
     ReconstructOptions ro = with_scan_normals(options.surface, out->cloud);
     if (!ro.progress) ro.progress = options.progress;
+    const auto t0 = std::chrono::steady_clock::now();
     StatusOr<ReconstructResult> r = reconstruct_surface(out->cloud, ro);
+    out->surface_seconds = seconds_since(t0);
     if (r.ok()) {
       out->mesh = std::move(r->mesh);
       out->surface = r->stats;
@@ -46,7 +48,9 @@ Status surface_and_measure(const ScanJobOptions& options, ScanJobResult* out) {
     // The floor the subject stands on: the bottom frame's tubing lies on it, its
     // light centres (world Y = 0) half a tube up.
     mo.floor_y = -0.5 * out->calibration.frame.tube;
+    const auto t0 = std::chrono::steady_clock::now();
     StatusOr<BodyMeasurements> body = measure_body(out->mesh, mo);
+    out->measure_seconds = seconds_since(t0);
     if (body.ok())
       out->body = std::move(*body);
     else
@@ -85,7 +89,9 @@ StatusOr<ScanJobResult> run_scan_job(const Rig& rig, RigCalibration calibration,
     out.raw_record["scan_options"] = {{"max_view_deg", scan_options.view.max_view_deg}, {"every", options.every}};
     out.raw_stripes = processor.recording();
   }
+  const auto t_finish = std::chrono::steady_clock::now();
   ASSIGN_OR_RETURN(out.cloud, processor.finish());
+  out.finish_seconds = seconds_since(t_finish);
   out.scan = processor.stats();
   out.scan_seconds = seconds_since(t0);
   RETURN_IF_ERROR(surface_and_measure(options, &out));
@@ -104,7 +110,9 @@ StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string
   RETURN_IF_ERROR(processor.load_recording(stripes));
   out.raw_record = record;
   out.raw_stripes = std::string(stripes);
+  const auto t_finish = std::chrono::steady_clock::now();
   ASSIGN_OR_RETURN(out.cloud, processor.finish());
+  out.finish_seconds = seconds_since(t_finish);
   out.scan = processor.stats();
   out.scan_seconds = seconds_since(t0);
   RETURN_IF_ERROR(surface_and_measure(options, &out));
@@ -202,6 +210,8 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
   if (!r.measure_error.empty()) j["measure_error"] = r.measure_error;
   j["calibration_seconds"] = r.calibration_seconds;
   j["scan_seconds"] = r.scan_seconds;
+  j["after_last_frame_seconds"] = {
+      {"cloud", r.finish_seconds}, {"surface", r.surface_seconds}, {"measurements", r.measure_seconds}};
   if (!r.mesh.triangles.empty()) {
     j["mesh"] = {{"vertices", r.mesh.vertices.size()},
                  {"triangles", r.mesh.triangles.size()},

@@ -80,7 +80,10 @@ struct ScanJobResult {
   nlohmann::json raw_record;
   std::string raw_stripes;
   double calibration_seconds = 0;  // acquisition and processing
-  double scan_seconds = 0;         // acquisition and processing
+  double scan_seconds = 0;         // acquisition and processing, up to the finished cloud
+  // What runs after the last frame, seconds: the cloud finished (sweeps merged,
+  // the sway undone; the last part of scan_seconds), the surface, the automatic set.
+  double finish_seconds = 0, surface_seconds = 0, measure_seconds = 0;
 };
 
 // Errors when calibration or the scan fails, or the scan gives no usable cloud; a
