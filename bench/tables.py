@@ -677,6 +677,19 @@ def poissonrecon(records):
     return "\n".join(out)
 
 
+def latency(records):
+    """Per scan: each stage after the last frame, the totals to the measurements and to mesh.glb, the peak."""
+    out = ["| scan | points | triangles | replay (during the scan) | cloud | surface | measurements | files "
+           "| → measurements | → mesh.glb | peak RSS |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in records:
+        a = r["after_last_frame_seconds"]
+        out.append(f"| {r['scan']} | {r['points']:,} | {r['triangles'] / 1e6:.2f} M | {r['replay_seconds']:.2f} s "
+                   f"| {a['cloud']:.1f} s | {a['surface']:.1f} s | {a['measurements']:.1f} s | {a['files']:.1f} s "
+                   f"| **{r['to_measurements_seconds']:.1f} s** | **{r['to_glb_seconds']:.1f} s** "
+                   f"| {r['peak_mb'] / 1024:.2f} GB |")
+    return "\n".join(out)
+
+
 # A table's name: (its renderer, the figures file it reads, by name in docs/figures).
 TABLES = {
     "sphere": (sphere, "sphere"),
@@ -703,6 +716,7 @@ TABLES = {
     "open3d_body": (open3d_body, "open3d_body"),
     "open3d_sphere": (open3d_sphere, "open3d_sphere"),
     "poissonrecon": (poissonrecon, "poissonrecon"),
+    "latency": (latency, "latency"),
 }
 
 
