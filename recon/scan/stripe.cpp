@@ -25,9 +25,10 @@ __attribute__((always_inline)) inline uint16_t chunk_peak(const uint16_t* __rest
 // The row's maximum chunk by chunk (each a vectorised pass over 64 pixels), and the
 // first chunk holding it, so that the brightest pixel is then looked for there only.
 constexpr int kChunk = 64;
-__attribute__((target_clones("arch=haswell", "default"))) uint16_t row_peak(const uint16_t* __restrict f,
-                                                                            const uint16_t* __restrict b, int n,
-                                                                            int* chunk) {
+// Cloned for x86-64-v3 (AVX2), chosen by the CPU's features (implicit_field.cpp).
+__attribute__((target_clones("arch=x86-64-v3", "default"))) uint16_t row_peak(const uint16_t* __restrict f,
+                                                                              const uint16_t* __restrict b, int n,
+                                                                              int* chunk) {
   uint16_t peak = 0;
   *chunk = 0;
   int c = 0;

@@ -150,17 +150,18 @@ __attribute__((always_inline)) inline void splat_row_body(float* __restrict f, f
   }
 }
 
-__attribute__((target_clones("arch=haswell", "default"))) void splat_row_series(
+// Cloned for x86-64-v3 (AVX2, FMA), chosen at load time by the CPU's features. A
+// clone for a named CPU ("arch=haswell") is chosen by the CPU's model instead, and
+// so never runs on later models nor in virtual machines that hide the model.
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void splat_row_series(
     float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx, float dy, float dz,
     float b1, float b2, float c1, float c2, float weight, float r2, float slab2) {
   splat_row_body<false>(f, w, t0, n, zx, zy, zz, dx, dy, dz, b1, b2, c1, c2, weight, r2, slab2);
 }
 
-__attribute__((target_clones("arch=haswell", "default"))) void splat_row_exact(float* __restrict f, float* __restrict w,
-                                                                               int t0, int n, float zx, float zy,
-                                                                               float zz, float dx, float dy, float dz,
-                                                                               float b1, float b2, float c1, float c2,
-                                                                               float weight, float r2, float slab2) {
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void splat_row_exact(
+    float* __restrict f, float* __restrict w, int t0, int n, float zx, float zy, float zz, float dx, float dy, float dz,
+    float b1, float b2, float c1, float c2, float weight, float r2, float slab2) {
   splat_row_body<true>(f, w, t0, n, zx, zy, zz, dx, dy, dz, b1, b2, c1, c2, weight, r2, slab2);
 }
 
