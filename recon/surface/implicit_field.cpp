@@ -193,7 +193,8 @@ long ImplicitField::find_brick(const Eigen::Vector3i& c) const {
 }
 
 size_t ImplicitField::memory_bytes() const {
-  return keys_.capacity() * sizeof(uint64_t) + (values_.capacity() + weights_.capacity()) * sizeof(float);
+  return keys_.capacity() * sizeof(uint64_t) + blocks_.capacity() * sizeof(blocks_[0]) +
+         blocks_.size() * 2 * nodes_per_brick() * sizeof(float);
 }
 
 float ImplicitField::value_at(const Eigen::Vector3i& node) const {
@@ -344,22 +345,15 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
     for (int x = xmin; x <= xmax; ++x)
       if (used[x - xmin]) pencil_bricks[pc].push_back(x);
   });
-  std::vector<size_t> first_brick(np + 1, 0);
-  for (size_t pc = 0; pc < np; ++pc) first_brick[pc + 1] = first_brick[pc] + pencil_bricks[pc].size();
-  const size_t nb = first_brick[np];
+  size_t nb = 0;  // at most; only those some kernel's band reaches are allocated
+  for (const std::vector<int>& xs : pencil_bricks) nb += xs.size();
   if (nb > options.max_bricks) {
     return out_of_range("the surface needs " + std::to_string(nb) + " bricks, more than the limit of " +
                         std::to_string(options.max_bricks) + ": use a larger voxel size");
   }
-  field.keys_.resize(nb);
-  for (size_t pc = 0; pc < np; ++pc) {
-    const uint64_t yz = pairs[starts[pc]].key;  // x bits are 0
-    for (size_t j = 0; j < pencil_bricks[pc].size(); ++j)
-      field.keys_[first_brick[pc] + j] = yz | static_cast<uint64_t>(pencil_bricks[pc][j]);
-  }
   const size_t per = field.nodes_per_brick();
-  field.values_.assign(nb * per, 0.f);
-  field.weights_.assign(nb * per, 0.f);
+  // Each pencil's bricks as its kernels first reach them (x brick coordinate, block).
+  std::vector<std::vector<std::pair<int, std::unique_ptr<float[]>>>> pencil_blocks(np);
 
   // Phase 2: splat.
   std::atomic<size_t> done{0};
@@ -368,15 +362,15 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
   double last_fraction = 0.1;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, np, 4), [&](const tbb::blocked_range<size_t>& range) {
     if (stop.load(std::memory_order_relaxed)) return;
-    std::vector<long> brick_of;  // x brick coordinate - xmin -> brick index, -1 if none
+    std::vector<float*> block_of;  // x brick coordinate - xmin -> block, null until reached
     for (size_t pc = range.begin(); pc != range.end(); ++pc) {
       const uint64_t yz = pairs[starts[pc]].key;
       const int by = static_cast<int>((yz >> kCoordBits) & kMaxCoord);
       const int bz = static_cast<int>(yz >> (2 * kCoordBits));
       const std::vector<int>& xs = pencil_bricks[pc];
       const int xmin = xs.front();
-      brick_of.assign(static_cast<size_t>(xs.back() - xmin + 1), -1);
-      for (size_t j = 0; j < xs.size(); ++j) brick_of[xs[j] - xmin] = static_cast<long>(first_brick[pc] + j);
+      block_of.assign(static_cast<size_t>(xs.back() - xmin + 1), nullptr);
+      auto& blocks = pencil_blocks[pc];
       const int y_first = by * bs, z_first = bz * bs;
       for (size_t pi = starts[pc]; pi < starts[pc + 1]; ++pi) {
         const uint32_t ki = pairs[pi].kernel;
@@ -453,17 +447,21 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
                 first &= ~7;
                 last |= 7;
               }
-              const size_t b = static_cast<size_t>(brick_of[bx - xmin]);
-              const size_t idx = b * per + static_cast<size_t>(row_offset + first);
-              (p.exact ? splat_row_exact : splat_row_series)(field.values_.data() + idx, field.weights_.data() + idx,
-                                                             brick_x + first - node_lo.x(), last - first + 1, z0.x(),
-                                                             z0.y(), z0.z(), dx.x(), dx.y(), dx.z(), p.b1, p.b2, p.c1,
-                                                             p.c2, p.weight, r2, p.slab * p.slab);
+              float*& block = block_of[static_cast<size_t>(bx - xmin)];
+              if (block == nullptr) {
+                blocks.emplace_back(bx, std::make_unique<float[]>(2 * per));  // zeroed
+                block = blocks.back().second.get();
+              }
+              float* const values = block + row_offset + first;
+              (p.exact ? splat_row_exact : splat_row_series)(
+                  values, values + per, brick_x + first - node_lo.x(), last - first + 1, z0.x(), z0.y(), z0.z(), dx.x(),
+                  dx.y(), dx.z(), p.b1, p.b2, p.c1, p.c2, p.weight, r2, p.slab * p.slab);
               gx = seg_end + 1;
             }
           }
         }
       }
+      std::sort(blocks.begin(), blocks.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     }
     const size_t d = done.fetch_add(range.size()) + range.size();
     if (options.progress) {
@@ -475,6 +473,17 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
     }
   });
   if (stop) return cancelled("reconstruction cancelled");
+  size_t allocated = 0;
+  for (const auto& blocks : pencil_blocks) allocated += blocks.size();
+  field.keys_.reserve(allocated);
+  field.blocks_.reserve(allocated);
+  for (size_t pc = 0; pc < np; ++pc) {
+    const uint64_t yz = pairs[starts[pc]].key;  // x bits are 0
+    for (auto& [x, block] : pencil_blocks[pc]) {
+      field.keys_.push_back(yz | static_cast<uint64_t>(x));
+      field.blocks_.push_back(std::move(block));
+    }
+  }
   return field;
 }
 

@@ -33,12 +33,13 @@
 // 3.26-3.27 (D = 2 sigma sqrt(-2 ln epsilon) is that ellipsoid's diameter).
 //
 // Storage follows the surface (thesis fig. 3.28, sub-fields): the grid is cut into
-// cubic bricks of brick_size^3 nodes and only bricks that some support reaches are
-// allocated. Every node's value is the sum of its kernels in increasing point
-// order, so the field is bit-identical whatever the brick size.
+// cubic bricks of brick_size^3 nodes and only bricks that some kernel's visited
+// nodes (its support, cut by its band) reach are allocated. Every node's value is the sum of its kernels in increasing
+// point order, so the field is bit-identical whatever the brick size.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/progress.hpp"
@@ -91,8 +92,8 @@ class ImplicitField {
   long find_brick(const Eigen::Vector3i& c) const;
 
   // Node values of brick b, x fastest: index = x + B (y + B z).
-  const float* values(size_t b) const { return values_.data() + b * nodes_per_brick(); }
-  const float* weights(size_t b) const { return weights_.data() + b * nodes_per_brick(); }
+  const float* values(size_t b) const { return blocks_[b].get(); }
+  const float* weights(size_t b) const { return blocks_[b].get() + nodes_per_brick(); }
 
   // Field and weight at global node (i, j, k); weight 0 when not allocated.
   float value_at(const Eigen::Vector3i& node) const;
@@ -113,8 +114,9 @@ class ImplicitField {
   int brick_shift_ = 3;
   Vec3d origin_ = Vec3d::Zero();
   std::vector<uint64_t> keys_;  // sorted packed brick coordinates
-  std::vector<float> values_;
-  std::vector<float> weights_;
+  // Brick b's values, then its weights: allocated one by one, as kernels first
+  // reach them, so that only bricks some kernel's band touches take memory.
+  std::vector<std::unique_ptr<float[]>> blocks_;
 };
 
 // The median Gaussian weight W at the grid nodes nearest to the given surface

@@ -242,17 +242,20 @@ StatusOr<ReconstructResult> reconstruct_surface(const PointCloud& input, const R
   fo.epsilon = options.epsilon;
   fo.brick_size = options.brick_size;
   fo.progress = options.progress;
-  ASSIGN_OR_RETURN(ImplicitField field, build_implicit_field(kernels, fo));
-  st.bricks = field.num_bricks();
-  st.field_bytes = field.memory_bytes();
-  st.t_field = seconds_since(t0);
+  {
+    // The field is the largest thing held; it goes once its zero set is extracted.
+    ASSIGN_OR_RETURN(ImplicitField field, build_implicit_field(kernels, fo));
+    st.bricks = field.num_bricks();
+    st.field_bytes = field.memory_bytes();
+    st.t_field = seconds_since(t0);
 
-  t0 = Clock::now();
-  MarchingCubesOptions mo;
-  st.min_weight = std::max(1e-6f, options.min_relative_weight * median_surface_weight(field, pts));
-  mo.min_weight = st.min_weight;
-  mo.progress = options.progress;
-  ASSIGN_OR_RETURN(result.mesh, extract_isosurface(field, mo));
+    t0 = Clock::now();
+    MarchingCubesOptions mo;
+    st.min_weight = std::max(1e-6f, options.min_relative_weight * median_surface_weight(field, pts));
+    mo.min_weight = st.min_weight;
+    mo.progress = options.progress;
+    ASSIGN_OR_RETURN(result.mesh, extract_isosurface(field, mo));
+  }
   if (options.close_holes) {
     // The field reaches past its data at creases and thin gaps (its kernels' planes
     // run on beyond them) and stops where the weight runs out, leaving open flaps

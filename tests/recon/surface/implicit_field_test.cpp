@@ -405,6 +405,39 @@ TEST(ImplicitField, MemoryFollowsTheSurface) {
   EXPECT_GE(b.memory_bytes(), b.num_bricks() * b.nodes_per_brick() * 2 * sizeof(float));
 }
 
+TEST(ImplicitField, BandedKernelsAllocateOnlyBricksTheirBandsReach) {
+  // A plane tilted to every grid axis, its kernels cut to a thin band: their
+  // bounding boxes span a slab several bricks thick, their bands about one brick.
+  // Allocated bricks must be those the bands reach, within the rows' rounding.
+  const Vec3f n = Vec3f(1.f, 1.f, 1.f).normalized();
+  const Vec3f t1 = Vec3f(1.f, -1.f, 0.f).normalized();
+  const Vec3f t2 = n.cross(t1);
+  std::vector<Kernel> ks;
+  for (int i = -20; i <= 20; ++i) {
+    for (int j = -20; j <= 20; ++j) {
+      Kernel k;
+      k.center = 0.5f * (static_cast<float>(i) * t1 + static_cast<float>(j) * t2);
+      k.t1 = t1;
+      k.t2 = t2;
+      k.n = n;
+      k.sigma_t1 = k.sigma_t2 = 1.f;
+      k.sigma_n = 0.5f;
+      k.band = 0.15f;
+      ks.push_back(k);
+    }
+  }
+  auto field = build_implicit_field(ks, field_options(0.1f, 8));
+  ASSERT_TRUE(field.ok()) << field.status().message();
+  size_t reached = 0;
+  for (size_t b = 0; b < field->num_bricks(); ++b) {
+    const float* w = field->weights(b);
+    reached += std::any_of(w, w + field->nodes_per_brick(), [](float x) { return x > 0.f; }) ? 1 : 0;
+  }
+  EXPECT_GT(reached, 100u);
+  EXPECT_LE(static_cast<double>(field->num_bricks()), 1.2 * static_cast<double>(reached));
+  EXPECT_GE(field->memory_bytes(), field->num_bricks() * field->nodes_per_brick() * 2 * sizeof(float));
+}
+
 TEST(ImplicitField, ProgressAndCancel) {
   const std::vector<Kernel> ks = sphere_kernels(500, 1.0, Vec3f::Zero(), 0.2f, 0.06f, 0.f);
   std::vector<double> fractions;
