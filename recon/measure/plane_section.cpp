@@ -1,6 +1,7 @@
 #include "recon/measure/plane_section.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace bodyscan {
 
@@ -125,6 +126,26 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
   for (uint32_t s = 0; s < segments.size(); ++s)
     if (!used[s]) walk(s, segments[s].a);
   return loops;
+}
+
+std::vector<std::vector<uint32_t>> triangles_by_plane(const TriangleMesh& mesh, const std::vector<uint32_t>& candidates,
+                                                      const Eigen::Vector3d& origin, const Eigen::Vector3d& normal,
+                                                      const std::vector<double>& offsets) {
+  std::vector<std::vector<uint32_t>> out(offsets.size());
+  // A plane's own distances (plane_section) round differently from these
+  // projections minus its offset by far less than this: a triangle within it of a
+  // plane is listed, and plane_section decides whether it crosses.
+  constexpr double kMarginMm = 1e-6;
+  for (const uint32_t t : candidates) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const uint32_t v : mesh.triangles[t]) {
+      const double d = normal.dot(mesh.vertices[v].cast<double>() - origin);
+      lo = std::min(lo, d), hi = std::max(hi, d);
+    }
+    auto k = static_cast<size_t>(std::lower_bound(offsets.begin(), offsets.end(), lo - kMarginMm) - offsets.begin());
+    for (; k < offsets.size() && offsets[k] <= hi + kMarginMm; ++k) out[k].push_back(t);
+  }
+  return out;
 }
 
 }  // namespace bodyscan

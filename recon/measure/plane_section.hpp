@@ -34,4 +34,13 @@ std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& pl
 std::vector<SectionLoop> plane_section(const TriangleMesh& mesh, const Plane& plane,
                                        const std::vector<uint32_t>* triangles);
 
+// For a sweep of parallel cuts, the planes through origin + offsets[k] * normal
+// (normal unit, offsets ascending): per plane, the triangles of `candidates` whose
+// corners lie on both sides of it or on it, in candidates' order. One pass over the
+// candidates, where cutting each plane through all of them would take one per plane;
+// plane_section over a plane's list finds the same loops as over the candidates.
+std::vector<std::vector<uint32_t>> triangles_by_plane(const TriangleMesh& mesh, const std::vector<uint32_t>& candidates,
+                                                      const Eigen::Vector3d& origin, const Eigen::Vector3d& normal,
+                                                      const std::vector<double>& offsets);
+
 }  // namespace bodyscan

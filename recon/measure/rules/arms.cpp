@@ -206,10 +206,13 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> square_cut_axis(const
                                                                            double length,
                                                                            const std::vector<uint32_t>& triangles) {
   const double reach_limit = 0.05 * cuts.stature();
+  std::vector<double> offsets;
+  for (double t = from; t <= from + length; t += kSquareStepMm) offsets.push_back(t);
+  const std::vector<std::vector<uint32_t>> crossing = triangles_by_plane(cuts.mesh(), triangles, elbow, dir, offsets);
   std::vector<Eigen::Vector3d> centres;
-  for (double t = from; t <= from + length; t += kSquareStepMm) {
-    const Eigen::Vector3d p = elbow + t * dir;
-    StatusOr<Girth> g = mesh_girth(cuts.mesh(), Plane{p, dir}, p, &triangles);
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    const Eigen::Vector3d p = elbow + offsets[k] * dir;
+    StatusOr<Girth> g = mesh_girth(cuts.mesh(), Plane{p, dir}, p, &crossing[k]);
     bool own = g.ok() && !g->loop.empty() && winds_round(g->loop, p, dir);
     if (own) {
       const Eigen::Vector3d centre = loop_centre(g->loop);

@@ -45,6 +45,36 @@ TEST(PlaneSection, AClosedPrismGivesOneClosedLoopAroundIt) {
   }
 }
 
+TEST(PlaneSection, ASweepsPerPlaneTrianglesCutTheSameLoopsAsTheWholeMesh) {
+  // Tilted planes, and level ones through the prism's rims, where corners lie on
+  // the plane: every loop, point for point, as cut through every triangle.
+  const TriangleMesh m = testing::prism(testing::circle(50, {3, -2}, 90), {0, 0}, 0, 100);
+  std::vector<uint32_t> all(m.num_triangles());
+  for (uint32_t t = 0; t < all.size(); ++t) all[t] = t;
+  const std::vector<Eigen::Vector3d> normals = {Eigen::Vector3d(0.3, 1, 0.2).normalized(), Eigen::Vector3d::UnitY()};
+  for (const Eigen::Vector3d& normal : normals) {
+    const Eigen::Vector3d origin(1, 0, 0);
+    std::vector<double> offsets;
+    for (double t = -20; t <= 120; t += 2.5) offsets.push_back(t);
+    const std::vector<std::vector<uint32_t>> lists = triangles_by_plane(m, all, origin, normal, offsets);
+    ASSERT_EQ(lists.size(), offsets.size());
+    size_t cut = 0;
+    for (size_t k = 0; k < offsets.size(); ++k) {
+      const Plane plane{origin + offsets[k] * normal, normal};
+      const std::vector<SectionLoop> want = plane_section(m, plane);
+      const std::vector<SectionLoop> got = plane_section(m, plane, &lists[k]);
+      EXPECT_LT(lists[k].size(), m.num_triangles() / 4) << offsets[k];
+      ASSERT_EQ(got.size(), want.size()) << offsets[k];
+      for (size_t i = 0; i < want.size(); ++i) {
+        EXPECT_EQ(got[i].closed, want[i].closed);
+        EXPECT_EQ(got[i].points, want[i].points) << offsets[k];
+      }
+      cut += want.empty() ? 0 : 1;
+    }
+    EXPECT_GT(cut, 30u);
+  }
+}
+
 TEST(PlaneSection, AnOpenSheetGivesOnePolylineAcrossIt) {
   TriangleMesh m;
   m.vertices.emplace_back(0.f, 0.f, 0.f);
