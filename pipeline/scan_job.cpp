@@ -1,5 +1,6 @@
 #include "pipeline/scan_job.hpp"
 
+#include <tbb/parallel_invoke.h>
 #include <nlohmann/json.hpp>
 
 #include <chrono>
@@ -126,34 +127,67 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
     f.raw[kRawRecordFile] = r.raw_record.dump();
     f.raw[kRawStripesFile] = r.raw_stripes;
   }
-  f.results["points.ply"] = encode_ply(r.cloud, PlyFormat::kBinaryLittleEndian);
-  ASSIGN_OR_RETURN(storage::DracoEncoded drc, storage::encode_drc(r.cloud));
-  f.results["points.drc"] = std::move(drc.bytes);
   nlohmann::json glb;
+  // Two single-threaded halves side by side: the display mesh and its GLB, and the
+  // archived clouds and surface.
+  Status shown_status = Status::Ok(), archived_status = Status::Ok();
+  std::string glb_bytes, points_drc, surface_bytes;
+  tbb::parallel_invoke(
+      [&] {
+        if (r.mesh.triangles.empty()) return;
+        std::optional<SimplifyResult> display;
+        if (r.mesh.num_triangles() > display_triangles) {
+          SimplifyOptions so;
+          so.max_triangles = display_triangles;
+          so.measure_deviation = false;
+          StatusOr<SimplifyResult> s = simplify(r.mesh, so);
+          if (!s.ok()) {
+            shown_status = s.status();
+            return;
+          }
+          display = std::move(*s);
+        }
+        const TriangleMesh& shown = display ? display->mesh : r.mesh;
+        StatusOr<storage::DracoEncoded> e = storage::encode_glb(shown);
+        if (!e.ok()) {
+          shown_status = e.status();
+          return;
+        }
+        glb = {{"bytes", e->bytes.size()},
+               {"position_bits", e->position_bits},
+               {"max_error_mm", e->max_error_mm},
+               {"triangles", shown.num_triangles()},
+               {"surface_triangles", r.mesh.num_triangles()}};
+        glb_bytes = std::move(e->bytes);
+      },
+      [&] {
+        StatusOr<storage::DracoEncoded> drc = storage::encode_drc(r.cloud);
+        if (!drc.ok()) {
+          archived_status = drc.status();
+          return;
+        }
+        points_drc = std::move(drc->bytes);
+        if (r.mesh.triangles.empty()) return;
+        if (surface == SurfaceFile::kPly) {
+          surface_bytes = encode_ply(r.mesh, PlyFormat::kBinaryLittleEndian);
+          return;
+        }
+        storage::DracoOptions keep;
+        keep.max_error_mm = kArchivedMeshErrorMm;
+        StatusOr<storage::DracoEncoded> mesh_drc = storage::encode_mesh_drc(r.mesh, keep);
+        if (!mesh_drc.ok()) {
+          archived_status = mesh_drc.status();
+          return;
+        }
+        surface_bytes = std::move(mesh_drc->bytes);
+      });
+  RETURN_IF_ERROR(archived_status);
+  RETURN_IF_ERROR(shown_status);
+  f.results["points.ply"] = encode_ply(r.cloud, PlyFormat::kBinaryLittleEndian);
+  f.results["points.drc"] = std::move(points_drc);
   if (!r.mesh.triangles.empty()) {
-    if (surface == SurfaceFile::kPly) {
-      f.results["mesh.ply"] = encode_ply(r.mesh, PlyFormat::kBinaryLittleEndian);
-    } else {
-      storage::DracoOptions keep;
-      keep.max_error_mm = kArchivedMeshErrorMm;
-      ASSIGN_OR_RETURN(storage::DracoEncoded mesh_drc, storage::encode_mesh_drc(r.mesh, keep));
-      f.results[kArchivedMeshFile] = std::move(mesh_drc.bytes);
-    }
-    std::optional<SimplifyResult> display;
-    if (r.mesh.num_triangles() > display_triangles) {
-      SimplifyOptions so;
-      so.max_triangles = display_triangles;
-      so.measure_deviation = false;
-      ASSIGN_OR_RETURN(display, simplify(r.mesh, so));
-    }
-    const TriangleMesh& shown = display ? display->mesh : r.mesh;
-    ASSIGN_OR_RETURN(storage::DracoEncoded e, storage::encode_glb(shown));
-    glb = {{"bytes", e.bytes.size()},
-           {"position_bits", e.position_bits},
-           {"max_error_mm", e.max_error_mm},
-           {"triangles", shown.num_triangles()},
-           {"surface_triangles", r.mesh.num_triangles()}};
-    f.results["mesh.glb"] = std::move(e.bytes);
+    f.results[surface == SurfaceFile::kPly ? "mesh.ply" : kArchivedMeshFile] = std::move(surface_bytes);
+    f.results["mesh.glb"] = std::move(glb_bytes);
   }
   if (r.body) {
     nlohmann::json m = measurements_document("mesh.ply", "mesh");
