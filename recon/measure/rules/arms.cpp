@@ -118,12 +118,16 @@ StatusOr<Girth> wrist_girth(const BodyCuts& cuts, const Eigen::Vector3d& forearm
   const std::vector<uint32_t> triangles = cuts.triangles_near(*wrist_c, 0.07 * stature);
   std::vector<double> gs, ts;  // the cuts' tapes and offsets along the forearm from wrist_c
   std::vector<Girth> found;
-  for (double t = -0.03 * stature; t <= 0.03 * stature; t += kForearmStepMm) {
-    StatusOr<Girth> g = limb_cut(cuts, *wrist_c + t * forearm, forearm, triangles);
+  std::vector<double> offsets;
+  for (double t = -0.03 * stature; t <= 0.03 * stature; t += kForearmStepMm) offsets.push_back(t);
+  const std::vector<std::vector<uint32_t>> crossing =
+      triangles_by_plane(cuts.mesh(), triangles, *wrist_c, forearm, offsets);
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    StatusOr<Girth> g = limb_cut(cuts, *wrist_c + offsets[k] * forearm, forearm, crossing[k]);
     if (!g.ok()) continue;
     gs.push_back(g->value_mm);
     found.push_back(std::move(*g));
-    ts.push_back(t);
+    ts.push_back(offsets[k]);
   }
   if (gs.empty()) return not_found("no loop round the wrist");
   // Along the forearm the tape is flat over 10-20 mm at its narrowest, and its
