@@ -278,19 +278,12 @@ int run_reprocess(int argc, char** argv) {
   if (no_surface) options.reconstruct = false;
   if (keep_sway) options.scan.compensate_sway = false;
   if (out.empty()) return cl.fail("--out is required");
-  const auto record = read_whole_file(in + "/raw/" + pipeline::kRawRecordFile);
-  const auto stripes = read_whole_file(in + "/raw/" + pipeline::kRawStripesFile);
-  if (!record.ok() || !stripes.ok()) {
-    std::fprintf(stderr, "bodyscan reprocess: %s/raw/ has no raw record (%s, %s); was it written by bodyscan scan?\n",
-                 in.c_str(), pipeline::kRawRecordFile, pipeline::kRawStripesFile);
+  const StatusOr<pipeline::RawRecord> raw = pipeline::read_raw_record(in);
+  if (!raw.ok()) {
+    std::fprintf(stderr, "bodyscan reprocess: %s\n", raw.status().message().c_str());
     return 1;
   }
-  const nlohmann::json j = parse_json(*record);
-  if (j.is_discarded()) {
-    std::fprintf(stderr, "bodyscan reprocess: %s/raw/%s is not JSON\n", in.c_str(), pipeline::kRawRecordFile);
-    return 1;
-  }
-  auto result = pipeline::reprocess_scan(j, *stripes, options);
+  auto result = pipeline::reprocess_scan(raw->record, raw->stripes, options);
   if (!result.ok()) {
     std::fprintf(stderr, "bodyscan reprocess: %s\n", result.status().message().c_str());
     return 1;

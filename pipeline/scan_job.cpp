@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "core/json_text.hpp"
 #include "pipeline/measurements_json.hpp"
 #include "pipeline/scan_recording.hpp"
 #include "recon/geometry/simplify.hpp"
@@ -117,6 +118,21 @@ StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string
   out.scan = processor.stats();
   out.scan_seconds = seconds_since(t0);
   RETURN_IF_ERROR(surface_and_measure(options, &out));
+  return out;
+}
+
+StatusOr<RawRecord> read_raw_record(const std::string& scan_dir) {
+  const std::string raw = scan_dir + "/raw/";
+  StatusOr<std::string> record = read_whole_file(raw + kRawRecordFile);
+  StatusOr<std::string> stripes = read_whole_file(raw + kRawStripesFile);
+  if (!record.ok() || !stripes.ok()) {
+    return not_found(raw + " has no raw record (" + kRawRecordFile + ", " + kRawStripesFile +
+                     "); was it written by bodyscan scan?");
+  }
+  RawRecord out;
+  out.record = parse_json(*record);
+  if (out.record.is_discarded()) return invalid_argument(raw + kRawRecordFile + " is not JSON");
+  out.stripes = std::move(*stripes);
   return out;
 }
 

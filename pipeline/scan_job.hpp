@@ -102,6 +102,15 @@ StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string
 inline constexpr const char* kRawRecordFile = "record.json";  // in DIR/raw and the archive's raw/
 inline constexpr const char* kRawStripesFile = "stripes.bin";
 
+// The raw record a scan left in SCAN_DIR/raw (`bodyscan scan`, write_scan_results),
+// ready for reprocess_scan. Errors name the directory and say whether the files are
+// missing or the record is not JSON.
+struct RawRecord {
+  nlohmann::json record;
+  std::string stripes;
+};
+StatusOr<RawRecord> read_raw_record(const std::string& scan_dir);
+
 // Every file a scan leaves, as bytes: the results (calibration.json, points.ply,
 // points.drc, the surface, mesh.glb, measurements.json, scan.json, as far as the
 // job got) and the raw record (record.json, stripes.bin). The surface is mesh.ply,
