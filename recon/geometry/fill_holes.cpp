@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <unordered_map>
 #include <unordered_set>
@@ -183,11 +184,14 @@ Vec3f unit_normal(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
 }
 
 // One hole being filled: the patch triangles and what the filling needs to know
-// about the mesh around them.
+// about the mesh around them. The mesh is only read; the patch's own vertices are
+// numbered from first_new_vertex (the mesh's vertex count when they are appended
+// in order) and kept apart until commit(), so that patches of holes with no
+// vertex in common can be made side by side.
 class HolePatch {
  public:
-  HolePatch(TriangleMesh& mesh, const HalfEdges& he, const AddedEdges& added_edges)
-      : mesh_(mesh), he_(he), added_(added_edges), first_new_vertex_(static_cast<uint32_t>(mesh.vertices.size())) {}
+  HolePatch(const TriangleMesh& mesh, const HalfEdges& he, const AddedEdges& added_edges, uint32_t first_new_vertex)
+      : mesh_(mesh), he_(he), added_(added_edges), first_new_vertex_(first_new_vertex) {}
 
   // Triangulates the polygon (fill winding: consecutive vertices are the new
   // triangles' edges). `edge_normal[k]` is the unit normal of the mesh triangle on
@@ -235,8 +239,8 @@ class HolePatch {
           big = big && d > sc && d > scale_[v];
         }
         if (!big) continue;
-        const uint32_t m = static_cast<uint32_t>(mesh_.vertices.size());
-        mesh_.vertices.push_back(c);
+        const uint32_t m = next_vertex();
+        new_vertices_.push_back(c);
         scale_[m] = sc;
         remove_edges(i);
         tris_[i] = {t[0], t[1], m};
@@ -264,7 +268,7 @@ class HolePatch {
   // and the loop's vertices (thin plate: the loop's rings pull the patch along the
   // surrounding curvature).
   void fair(const std::vector<uint32_t>& loop, bool thin_plate) {
-    const uint32_t nv = static_cast<uint32_t>(mesh_.vertices.size());
+    const uint32_t nv = next_vertex();
     const uint32_t k = nv - first_new_vertex_;
     if (k == 0) return;
     std::unordered_map<uint32_t, std::vector<uint32_t>> ring;
@@ -296,7 +300,7 @@ class HolePatch {
         if (u >= first_new_vertex_) {
           triplets.emplace_back(static_cast<int>(row), static_cast<int>(u - first_new_vertex_), c);
         } else {
-          b -= c * mesh_.vertices[u].cast<double>();
+          b -= c * pos(u).cast<double>();
         }
       };
       for (uint32_t u : r) put(u, w);
@@ -316,8 +320,7 @@ class HolePatch {
     if (solver.info() != Eigen::Success) return;
     const Eigen::MatrixXd x = solver.solve(a.transpose() * b);
     if (solver.info() != Eigen::Success || !x.allFinite()) return;
-    for (uint32_t i = 0; i < k; ++i)
-      mesh_.vertices[first_new_vertex_ + i] = x.row(static_cast<int>(i)).transpose().cast<float>();
+    for (uint32_t i = 0; i < k; ++i) new_vertices_[i] = x.row(static_cast<int>(i)).transpose().cast<float>();
   }
 
   const std::vector<Triangle>& triangles() const { return tris_; }
@@ -332,11 +335,15 @@ class HolePatch {
     tris_.clear();
     edges_.clear();
     diagonals_.clear();
-    mesh_.vertices.resize(first_new_vertex_);
+    new_vertices_.clear();
   }
+  const std::vector<Vec3f>& new_vertices() const { return new_vertices_; }
 
  private:
-  const Vec3f& pos(uint32_t v) const { return mesh_.vertices[v]; }
+  const Vec3f& pos(uint32_t v) const {
+    return v < first_new_vertex_ ? mesh_.vertices[v] : new_vertices_[v - first_new_vertex_];
+  }
+  uint32_t next_vertex() const { return first_new_vertex_ + static_cast<uint32_t>(new_vertices_.size()); }
 
   // An edge the patch may not create: it exists in the mesh, in another patch, or
   // in this one.
@@ -565,15 +572,16 @@ class HolePatch {
     Vec3f c = Vec3f::Zero();
     for (uint32_t v : poly) c += pos(v);
     c /= static_cast<float>(poly.size());
-    const uint32_t m = static_cast<uint32_t>(mesh_.vertices.size());
-    mesh_.vertices.push_back(c);
+    const uint32_t m = next_vertex();
+    new_vertices_.push_back(c);
     for (size_t k = 0; k < poly.size(); ++k) add({poly[k], poly[(k + 1) % poly.size()], m});
   }
 
-  TriangleMesh& mesh_;
+  const TriangleMesh& mesh_;
   const HalfEdges& he_;
   const AddedEdges& added_;
   const uint32_t first_new_vertex_;
+  std::vector<Vec3f> new_vertices_;  // vertex first_new_vertex_ + i
   std::vector<Triangle> tris_;
   tsl::robin_map<uint64_t, uint32_t, EdgeHash> edges_;  // directed patch edge -> patch triangle
   std::unordered_set<uint64_t> diagonals_;              // the splits' diagonals (undirected)
@@ -590,36 +598,88 @@ HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
   const std::vector<std::vector<uint32_t>> loops = boundary_loops(boundary_edges(he));
   stats.holes = loops.size();
   if (loops.empty()) return stats;
-  std::vector<Triangle> added_triangles;
-  AddedEdges added_edges;
-  for (const std::vector<uint32_t>& loop : loops) {
+  for (const std::vector<uint32_t>& loop : loops)
     stats.largest_hole_edges = std::max(stats.largest_hole_edges, loop.size());
-    if (options.max_hole_edges && loop.size() > options.max_hole_edges) continue;
-    // The fill walks the loop backwards: each patch triangle uses a loop edge in
-    // the direction opposite to the mesh triangle beside it.
-    const std::vector<uint32_t> poly(loop.rbegin(), loop.rend());
-    std::vector<Vec3f> edge_normal(poly.size());
-    for (size_t k = 0; k < poly.size(); ++k) {
-      const long t = he.find(poly[(k + 1) % poly.size()], poly[k]);
-      edge_normal[k] = Vec3f::Zero();
-      if (t >= 0) {
-        const Triangle& tri = mesh.triangles[static_cast<size_t>(t)];
-        edge_normal[k] = unit_normal(mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]);
+
+  // A patch may not create an edge another patch made, so holes that share a
+  // vertex are filled one after the other, in loop order: each such group is a
+  // union of holes joined through shared vertices. Groups touch nothing in common,
+  // so they are filled side by side, each numbering its patches' new vertices from
+  // the mesh's vertex count on; the patches are then appended in loop order, their
+  // vertices renumbered: the same mesh, vertex for vertex, as filling every hole in
+  // turn. (A patch's triangles use its loop's vertices and its own new ones only.)
+  std::vector<uint32_t> group(loops.size());
+  for (uint32_t i = 0; i < group.size(); ++i) group[i] = i;
+  const auto root = [&](uint32_t i) {
+    while (group[i] != i) i = group[i] = group[group[i]];
+    return i;
+  };
+  {
+    std::unordered_map<uint32_t, uint32_t> hole_at;  // vertex -> the first hole through it
+    for (uint32_t i = 0; i < loops.size(); ++i)
+      for (uint32_t v : loops[i]) {
+        const auto [it, first] = hole_at.emplace(v, i);
+        if (!first) {
+          const uint32_t a = root(it->second), b = root(i);
+          group[std::max(a, b)] = std::min(a, b);
+        }
       }
+  }
+  std::vector<std::vector<uint32_t>> groups;  // holes in loop order, groups by their first hole
+  {
+    std::unordered_map<uint32_t, size_t> slot;
+    for (uint32_t i = 0; i < loops.size(); ++i) {
+      const auto [it, fresh] = slot.emplace(root(i), groups.size());
+      if (fresh) groups.emplace_back();
+      groups[it->second].push_back(i);
     }
-    HolePatch patch(mesh, he, added_edges);
-    patch.triangulate(poly, edge_normal, std::max<size_t>(options.max_dp_edges, 4));
-    if (options.max_hole_area > 0.0 && patch.area() > options.max_hole_area) {
-      patch.discard();
-      continue;
+  }
+  const auto first_apart = static_cast<uint32_t>(original_vertices);
+  std::vector<std::unique_ptr<HolePatch>> patches(loops.size());  // null: skipped
+  std::vector<uint32_t> first_of(loops.size(), first_apart);      // where each patch numbered from
+  tbb::parallel_for(size_t{0}, groups.size(), [&](size_t g) {
+    AddedEdges added_edges;
+    uint32_t next = first_apart;
+    for (const uint32_t i : groups[g]) {
+      const std::vector<uint32_t>& loop = loops[i];
+      if (options.max_hole_edges && loop.size() > options.max_hole_edges) continue;
+      // The fill walks the loop backwards: each patch triangle uses a loop edge in
+      // the direction opposite to the mesh triangle beside it.
+      const std::vector<uint32_t> poly(loop.rbegin(), loop.rend());
+      std::vector<Vec3f> edge_normal(poly.size());
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const long t = he.find(poly[(k + 1) % poly.size()], poly[k]);
+        edge_normal[k] = Vec3f::Zero();
+        if (t >= 0) {
+          const Triangle& tri = mesh.triangles[static_cast<size_t>(t)];
+          edge_normal[k] = unit_normal(mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]);
+        }
+      }
+      auto patch = std::make_unique<HolePatch>(mesh, he, added_edges, next);
+      patch->triangulate(poly, edge_normal, std::max<size_t>(options.max_dp_edges, 4));
+      if (options.max_hole_area > 0.0 && patch->area() > options.max_hole_area) continue;
+      if (options.refine) patch->refine();
+      if (options.fairing != HoleFairing::kNone) patch->fair(loop, options.fairing == HoleFairing::kThinPlate);
+      for (const Triangle& t : patch->triangles())
+        for (int k = 0; k < 3; ++k) added_edges.insert(t[k], t[(k + 1) % 3]);
+      first_of[i] = next;
+      next += static_cast<uint32_t>(patch->new_vertices().size());
+      patches[i] = std::move(patch);
     }
-    if (options.refine) patch.refine();
-    if (options.fairing != HoleFairing::kNone) patch.fair(loop, options.fairing == HoleFairing::kThinPlate);
+  });
+
+  std::vector<Triangle> added_triangles;
+  for (size_t i = 0; i < loops.size(); ++i) {
+    if (!patches[i]) continue;
+    const HolePatch& patch = *patches[i];
+    const auto first = static_cast<uint32_t>(mesh.vertices.size());
     stats.area_added += patch.area();
-    for (const Triangle& t : patch.triangles()) {
+    for (Triangle t : patch.triangles()) {
+      for (uint32_t& v : t)
+        if (v >= first_apart) v = v - first_of[i] + first;
       added_triangles.push_back(t);
-      for (int k = 0; k < 3; ++k) added_edges.insert(t[k], t[(k + 1) % 3]);
     }
+    mesh.vertices.insert(mesh.vertices.end(), patch.new_vertices().begin(), patch.new_vertices().end());
     ++stats.holes_filled;
   }
   stats.triangles_added = added_triangles.size();

@@ -1,6 +1,7 @@
 #include "recon/geometry/fill_holes.hpp"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -216,6 +217,52 @@ TEST(FillHoles, HolesMeetingAtAVertexAndSeveralHolesAllClose) {
   EXPECT_EQ(s.holes_filled, 3u);
   expect_closed(m, "touching holes");
   EXPECT_EQ(analyze_topology(m).euler_characteristic, 2);
+}
+
+TEST(FillHoles, HolesFilledSideBySideGiveTheMeshOfFillingThemOneByOne) {
+  // Caps cut from a sphere, two of them touching at a vertex: the patches are made
+  // side by side and appended in loop order, so the mesh is the same, vertex for
+  // vertex, with one thread as with all of them.
+  TriangleMesh m = icosphere(4, 1.0);
+  const std::vector<Vec3f> centres = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0.6f, 0.6f, -0.53f}};
+  m = without(m, [&](const Vec3f& v) {
+    for (const Vec3f& c : centres)
+      if ((v - c.normalized()).norm() < 0.3f) return true;
+    return false;
+  });
+  const size_t nt = m.triangles.size();
+  // And two triangles touching at one vertex, away from the caps.
+  size_t f = 0;
+  for (bool clear = false; !clear; ++f) {
+    clear = true;
+    for (const Vec3f& c : centres) clear = clear && (m.vertices[m.triangles[f][0]] - c.normalized()).norm() > 0.7f;
+  }
+  --f;
+  const Triangle first = m.triangles[f];
+  for (size_t i = 0; i < nt; ++i) {
+    int shared = 0;
+    for (uint32_t a : m.triangles[i])
+      for (uint32_t b : first) shared += a == b;
+    if (shared != 1) continue;
+    m.triangles.erase(m.triangles.begin() + static_cast<long>(std::max(i, f)));
+    m.triangles.erase(m.triangles.begin() + static_cast<long>(std::min(i, f)));
+    break;
+  }
+  ASSERT_EQ(m.triangles.size(), nt - 2);
+  TriangleMesh one = m, all = m;
+  HoleFillStats s_one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    s_one = fill_holes(one);
+  }
+  const HoleFillStats s_all = fill_holes(all);
+  EXPECT_EQ(s_all.holes_filled, centres.size() + 2);
+  EXPECT_EQ(s_one.holes_filled, s_all.holes_filled);
+  EXPECT_GT(s_all.vertices_added, 20u);
+  expect_closed(all, "caps and touching holes");
+  EXPECT_EQ(one.vertices, all.vertices);
+  EXPECT_EQ(one.triangles, all.triangles);
+  EXPECT_EQ(one.confidence, all.confidence);
 }
 
 TEST(FillHoles, OpeningsLargerThanTheAreaLimitStayOpen) {
