@@ -18,7 +18,7 @@ size_t drop_redundant_points(PointCloud& cloud, float radius, float ratio, float
     const float c = cloud.confidence[i];
     const float need = c < weak ? std::nextafter(c, 2.f) : ratio * c;
     if (need > 1.f) return;  // nothing can be that much better
-    for (const auto& [j, d2] : index.within_radius(cloud.positions[i], radius)) {
+    for (const auto& [j, d2] : index.within_radius(cloud.positions[i], radius, false)) {  // any one will do
       if (j == i || cloud.confidence[j] < need) continue;
       const bool other =
           (frames && cloud.frame[j] != cloud.frame[i]) || (cameras && cloud.camera[j] != cloud.camera[i]);

@@ -199,7 +199,7 @@ std::vector<Pair> find_pairs(const PointCloud& cloud, const std::vector<Vec3f>& 
   tbb::parallel_for(size_t{0}, anchors.size(), [&](size_t a) {
     const size_t i = anchors[a];
     const int fi = cloud.frame[i];
-    auto near = index.within_radius(moved[i], radius);
+    auto near = index.within_radius(moved[i], radius, false);  // sorted by laser and point below
     // Group the other moments' points by laser (one laser sweeps once, so its points
     // near here were seen at nearly one moment).
     std::vector<std::pair<int32_t, uint32_t>> other;

@@ -45,10 +45,11 @@ size_t KnnIndex::knn(const Vec3f& q, size_t k, uint32_t* indices, float* sq_dist
   return rs.size();
 }
 
-std::vector<std::pair<uint32_t, float>> KnnIndex::within_radius(const Vec3f& q, float radius) const {
+std::vector<std::pair<uint32_t, float>> KnnIndex::within_radius(const Vec3f& q, float radius,
+                                                                bool nearest_first) const {
   std::vector<std::pair<uint32_t, float>> out;
   nanoflann::SearchParams params;
-  params.sorted = true;
+  params.sorted = nearest_first;
   impl_->tree.radiusSearch(q.data(), radius * radius, out, params);
   return out;
 }

@@ -23,8 +23,9 @@ class KnnIndex {
   // distances[0..n), returns n = min(k, size()). Includes a point equal to q.
   size_t knn(const Vec3f& q, size_t k, uint32_t* indices, float* sq_distances) const;
 
-  // All points within `radius` of q as (index, squared distance), nearest first.
-  std::vector<std::pair<uint32_t, float>> within_radius(const Vec3f& q, float radius) const;
+  // All points within `radius` of q as (index, squared distance), nearest first;
+  // in no particular order when nearest_first is false (faster: nothing is sorted).
+  std::vector<std::pair<uint32_t, float>> within_radius(const Vec3f& q, float radius, bool nearest_first = true) const;
 
   size_t size() const;
 
