@@ -278,12 +278,13 @@ int run_reprocess(int argc, char** argv) {
   if (no_surface) options.reconstruct = false;
   if (keep_sway) options.scan.compensate_sway = false;
   if (out.empty()) return cl.fail("--out is required");
-  const StatusOr<pipeline::RawRecord> raw = pipeline::read_raw_record(in);
-  if (!raw.ok()) {
-    std::fprintf(stderr, "bodyscan reprocess: %s\n", raw.status().message().c_str());
+  nlohmann::json record;
+  std::string stripes;
+  if (const Status raw = pipeline::read_raw_record(in, &record, &stripes); !raw.ok()) {
+    std::fprintf(stderr, "bodyscan reprocess: %s\n", raw.message().c_str());
     return 1;
   }
-  auto result = pipeline::reprocess_scan(raw->record, raw->stripes, options);
+  auto result = pipeline::reprocess_scan(record, stripes, options);
   if (!result.ok()) {
     std::fprintf(stderr, "bodyscan reprocess: %s\n", result.status().message().c_str());
     return 1;

@@ -58,15 +58,16 @@ int main(int argc, char** argv) {
   std::printf("%-28s %9s %8s %8s %9s %8s %8s | %12s %9s %9s\n", "scan", "points", "replay", "cloud", "surface",
               "measure", "files", "measurements", "mesh.glb", "triangles");
   for (const std::string& dir : dirs) {
-    const StatusOr<pipeline::RawRecord> raw = pipeline::read_raw_record(dir);
-    if (!raw.ok()) {
-      std::fprintf(stderr, "latency_benchmark: %s\n", raw.status().message().c_str());
+    nlohmann::json record;
+    std::string stripes;
+    if (const Status raw = pipeline::read_raw_record(dir, &record, &stripes); !raw.ok()) {
+      std::fprintf(stderr, "latency_benchmark: %s\n", raw.message().c_str());
       return 1;
     }
     Stages best;
     size_t points = 0, triangles = 0;
     for (int i = 0; i < repeat; ++i) {
-      auto r = pipeline::reprocess_scan(raw->record, raw->stripes);
+      auto r = pipeline::reprocess_scan(record, stripes);
       if (!r.ok()) {
         std::fprintf(stderr, "latency_benchmark: %s: %s\n", dir.c_str(), r.status().message().c_str());
         return 1;

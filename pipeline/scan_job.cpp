@@ -121,19 +121,64 @@ StatusOr<ScanJobResult> reprocess_scan(const nlohmann::json& record, std::string
   return out;
 }
 
-StatusOr<RawRecord> read_raw_record(const std::string& scan_dir) {
+namespace {
+
+// mesh.glb: the surface, decimated first when it exceeds display_triangles, and
+// what scan.json says of it (the encoding and the two triangle counts). Nothing
+// for no surface.
+struct DisplayFile {
+  storage::DracoEncoded glb;
+  size_t surface_triangles = 0;
+};
+StatusOr<DisplayFile> display_file(const TriangleMesh& mesh, size_t display_triangles) {
+  DisplayFile out;
+  if (mesh.triangles.empty()) return out;
+  out.surface_triangles = mesh.num_triangles();
+  std::optional<SimplifyResult> display;
+  if (mesh.num_triangles() > display_triangles) {
+    SimplifyOptions so;
+    so.max_triangles = display_triangles;
+    so.measure_deviation = false;
+    ASSIGN_OR_RETURN(display, simplify(mesh, so));
+  }
+  ASSIGN_OR_RETURN(out.glb, storage::encode_glb(display ? display->mesh : mesh));
+  return out;
+}
+
+// points.drc and the surface as `surface` asks (empty for no surface).
+struct ArchivedFiles {
+  std::string points_drc, surface;
+};
+StatusOr<ArchivedFiles> archived_files(const ScanJobResult& r, SurfaceFile surface) {
+  ArchivedFiles out;
+  ASSIGN_OR_RETURN(storage::DracoEncoded drc, storage::encode_drc(r.cloud));
+  out.points_drc = std::move(drc.bytes);
+  if (r.mesh.triangles.empty()) return out;
+  if (surface == SurfaceFile::kPly) {
+    out.surface = encode_ply(r.mesh, PlyFormat::kBinaryLittleEndian);
+    return out;
+  }
+  storage::DracoOptions keep;
+  keep.max_error_mm = kArchivedMeshErrorMm;
+  ASSIGN_OR_RETURN(storage::DracoEncoded mesh_drc, storage::encode_mesh_drc(r.mesh, keep));
+  out.surface = std::move(mesh_drc.bytes);
+  return out;
+}
+
+}  // namespace
+
+Status read_raw_record(const std::string& scan_dir, nlohmann::json* record, std::string* stripes) {
   const std::string raw = scan_dir + "/raw/";
-  StatusOr<std::string> record = read_whole_file(raw + kRawRecordFile);
-  StatusOr<std::string> stripes = read_whole_file(raw + kRawStripesFile);
-  if (!record.ok() || !stripes.ok()) {
+  StatusOr<std::string> text = read_whole_file(raw + kRawRecordFile);
+  StatusOr<std::string> bytes = read_whole_file(raw + kRawStripesFile);
+  if (!text.ok() || !bytes.ok()) {
     return not_found(raw + " has no raw record (" + kRawRecordFile + ", " + kRawStripesFile +
                      "); was it written by bodyscan scan?");
   }
-  RawRecord out;
-  out.record = parse_json(*record);
-  if (out.record.is_discarded()) return invalid_argument(raw + kRawRecordFile + " is not JSON");
-  out.stripes = std::move(*stripes);
-  return out;
+  *record = parse_json(*text);
+  if (record->is_discarded()) return invalid_argument(raw + kRawRecordFile + " is not JSON");
+  *stripes = std::move(*bytes);
+  return Status::Ok();
 }
 
 StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surface, size_t display_triangles) {
@@ -143,67 +188,26 @@ StatusOr<ScanFiles> scan_result_files(const ScanJobResult& r, SurfaceFile surfac
     f.raw[kRawRecordFile] = r.raw_record.dump();
     f.raw[kRawStripesFile] = r.raw_stripes;
   }
-  nlohmann::json glb;
   // Two single-threaded halves side by side: the display mesh and its GLB, and the
   // archived clouds and surface.
-  Status shown_status = Status::Ok(), archived_status = Status::Ok();
-  std::string glb_bytes, points_drc, surface_bytes;
-  tbb::parallel_invoke(
-      [&] {
-        if (r.mesh.triangles.empty()) return;
-        std::optional<SimplifyResult> display;
-        if (r.mesh.num_triangles() > display_triangles) {
-          SimplifyOptions so;
-          so.max_triangles = display_triangles;
-          so.measure_deviation = false;
-          StatusOr<SimplifyResult> s = simplify(r.mesh, so);
-          if (!s.ok()) {
-            shown_status = s.status();
-            return;
-          }
-          display = std::move(*s);
-        }
-        const TriangleMesh& shown = display ? display->mesh : r.mesh;
-        StatusOr<storage::DracoEncoded> e = storage::encode_glb(shown);
-        if (!e.ok()) {
-          shown_status = e.status();
-          return;
-        }
-        glb = {{"bytes", e->bytes.size()},
-               {"position_bits", e->position_bits},
-               {"max_error_mm", e->max_error_mm},
-               {"triangles", shown.num_triangles()},
-               {"surface_triangles", r.mesh.num_triangles()}};
-        glb_bytes = std::move(e->bytes);
-      },
-      [&] {
-        StatusOr<storage::DracoEncoded> drc = storage::encode_drc(r.cloud);
-        if (!drc.ok()) {
-          archived_status = drc.status();
-          return;
-        }
-        points_drc = std::move(drc->bytes);
-        if (r.mesh.triangles.empty()) return;
-        if (surface == SurfaceFile::kPly) {
-          surface_bytes = encode_ply(r.mesh, PlyFormat::kBinaryLittleEndian);
-          return;
-        }
-        storage::DracoOptions keep;
-        keep.max_error_mm = kArchivedMeshErrorMm;
-        StatusOr<storage::DracoEncoded> mesh_drc = storage::encode_mesh_drc(r.mesh, keep);
-        if (!mesh_drc.ok()) {
-          archived_status = mesh_drc.status();
-          return;
-        }
-        surface_bytes = std::move(mesh_drc->bytes);
-      });
-  RETURN_IF_ERROR(archived_status);
-  RETURN_IF_ERROR(shown_status);
+  StatusOr<DisplayFile> shown = DisplayFile{};
+  StatusOr<ArchivedFiles> archived = ArchivedFiles{};
+  tbb::parallel_invoke([&] { shown = display_file(r.mesh, display_triangles); },
+                       [&] { archived = archived_files(r, surface); });
+  if (!archived.ok()) return archived.status();
+  if (!shown.ok()) return shown.status();
   f.results["points.ply"] = encode_ply(r.cloud, PlyFormat::kBinaryLittleEndian);
-  f.results["points.drc"] = std::move(points_drc);
+  f.results["points.drc"] = std::move(archived->points_drc);
+  nlohmann::json glb;
   if (!r.mesh.triangles.empty()) {
-    f.results[surface == SurfaceFile::kPly ? "mesh.ply" : kArchivedMeshFile] = std::move(surface_bytes);
-    f.results["mesh.glb"] = std::move(glb_bytes);
+    const storage::DracoEncoded& e = shown->glb;
+    glb = {{"bytes", e.bytes.size()},
+           {"position_bits", e.position_bits},
+           {"max_error_mm", e.max_error_mm},
+           {"triangles", e.triangles},
+           {"surface_triangles", shown->surface_triangles}};
+    f.results[surface == SurfaceFile::kPly ? "mesh.ply" : kArchivedMeshFile] = std::move(archived->surface);
+    f.results["mesh.glb"] = std::move(shown->glb.bytes);
   }
   if (r.body) {
     nlohmann::json m = measurements_document("mesh.ply", "mesh");

@@ -105,11 +105,7 @@ inline constexpr const char* kRawStripesFile = "stripes.bin";
 // The raw record a scan left in SCAN_DIR/raw (`bodyscan scan`, write_scan_results),
 // ready for reprocess_scan. Errors name the directory and say whether the files are
 // missing or the record is not JSON.
-struct RawRecord {
-  nlohmann::json record;
-  std::string stripes;
-};
-StatusOr<RawRecord> read_raw_record(const std::string& scan_dir);
+Status read_raw_record(const std::string& scan_dir, nlohmann::json* record, std::string* stripes);
 
 // Every file a scan leaves, as bytes: the results (calibration.json, points.ply,
 // points.drc, the surface, mesh.glb, measurements.json, scan.json, as far as the

@@ -588,6 +588,77 @@ class HolePatch {
   std::unordered_map<uint32_t, float> scale_;           // local edge length per vertex
 };
 
+// Holes joined through shared vertices, each group in loop order, the groups in
+// the order of their first holes.
+std::vector<std::vector<uint32_t>> hole_groups(const std::vector<std::vector<uint32_t>>& loops) {
+  std::vector<uint32_t> group(loops.size());
+  for (uint32_t i = 0; i < group.size(); ++i) group[i] = i;
+  const auto root = [&](uint32_t i) {
+    while (group[i] != i) i = group[i] = group[group[i]];
+    return i;
+  };
+  std::unordered_map<uint32_t, uint32_t> hole_at;  // vertex -> the first hole through it
+  for (uint32_t i = 0; i < loops.size(); ++i)
+    for (uint32_t v : loops[i]) {
+      const auto [it, first] = hole_at.emplace(v, i);
+      if (first) continue;
+      const uint32_t a = root(it->second), b = root(i);
+      group[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<std::vector<uint32_t>> groups;
+  std::unordered_map<uint32_t, size_t> slot;  // root -> its group
+  for (uint32_t i = 0; i < loops.size(); ++i) {
+    const auto [it, fresh] = slot.emplace(root(i), groups.size());
+    if (fresh) groups.emplace_back();
+    groups[it->second].push_back(i);
+  }
+  return groups;
+}
+
+// The patch of one loop, its new vertices numbered from `first`; null when the hole
+// is skipped (too many edges, or a fill larger than the limit).
+std::unique_ptr<HolePatch> make_patch(const TriangleMesh& mesh, const HalfEdges& he, const std::vector<uint32_t>& loop,
+                                      const AddedEdges& added_edges, uint32_t first, const HoleFillOptions& options) {
+  if (options.max_hole_edges && loop.size() > options.max_hole_edges) return nullptr;
+  // The fill walks the loop backwards: each patch triangle uses a loop edge in the
+  // direction opposite to the mesh triangle beside it.
+  const std::vector<uint32_t> poly(loop.rbegin(), loop.rend());
+  std::vector<Vec3f> edge_normal(poly.size());
+  for (size_t k = 0; k < poly.size(); ++k) {
+    const long t = he.find(poly[(k + 1) % poly.size()], poly[k]);
+    edge_normal[k] = Vec3f::Zero();
+    if (t >= 0) {
+      const Triangle& tri = mesh.triangles[static_cast<size_t>(t)];
+      edge_normal[k] = unit_normal(mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]);
+    }
+  }
+  auto patch = std::make_unique<HolePatch>(mesh, he, added_edges, first);
+  patch->triangulate(poly, edge_normal, std::max<size_t>(options.max_dp_edges, 4));
+  if (options.max_hole_area > 0.0 && patch->area() > options.max_hole_area) return nullptr;
+  if (options.refine) patch->refine();
+  if (options.fairing != HoleFairing::kNone) patch->fair(loop, options.fairing == HoleFairing::kThinPlate);
+  return patch;
+}
+
+// The patches of one group's holes, one after the other (each may not create an
+// edge an earlier one made), their new vertices numbered on from `first`:
+// (*patches)[i] for hole i, numbered from (*first_of)[i].
+void fill_group(const TriangleMesh& mesh, const HalfEdges& he, const std::vector<std::vector<uint32_t>>& loops,
+                const std::vector<uint32_t>& group, uint32_t first, const HoleFillOptions& options,
+                std::vector<std::unique_ptr<HolePatch>>* patches, std::vector<uint32_t>* first_of) {
+  AddedEdges added_edges;
+  uint32_t next = first;
+  for (const uint32_t i : group) {
+    std::unique_ptr<HolePatch> patch = make_patch(mesh, he, loops[i], added_edges, next, options);
+    if (!patch) continue;
+    for (const Triangle& t : patch->triangles())
+      for (int k = 0; k < 3; ++k) added_edges.insert(t[k], t[(k + 1) % 3]);
+    (*first_of)[i] = next;
+    next += static_cast<uint32_t>(patch->new_vertices().size());
+    (*patches)[i] = std::move(patch);
+  }
+}
+
 }  // namespace
 
 HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
@@ -602,70 +673,18 @@ HoleFillStats fill_holes(TriangleMesh& mesh, const HoleFillOptions& options) {
     stats.largest_hole_edges = std::max(stats.largest_hole_edges, loop.size());
 
   // A patch may not create an edge another patch made, so holes that share a
-  // vertex are filled one after the other, in loop order: each such group is a
-  // union of holes joined through shared vertices. Groups touch nothing in common,
-  // so they are filled side by side, each numbering its patches' new vertices from
-  // the mesh's vertex count on; the patches are then appended in loop order, their
-  // vertices renumbered: the same mesh, vertex for vertex, as filling every hole in
-  // turn. (A patch's triangles use its loop's vertices and its own new ones only.)
-  std::vector<uint32_t> group(loops.size());
-  for (uint32_t i = 0; i < group.size(); ++i) group[i] = i;
-  const auto root = [&](uint32_t i) {
-    while (group[i] != i) i = group[i] = group[group[i]];
-    return i;
-  };
-  {
-    std::unordered_map<uint32_t, uint32_t> hole_at;  // vertex -> the first hole through it
-    for (uint32_t i = 0; i < loops.size(); ++i)
-      for (uint32_t v : loops[i]) {
-        const auto [it, first] = hole_at.emplace(v, i);
-        if (!first) {
-          const uint32_t a = root(it->second), b = root(i);
-          group[std::max(a, b)] = std::min(a, b);
-        }
-      }
-  }
-  std::vector<std::vector<uint32_t>> groups;  // holes in loop order, groups by their first hole
-  {
-    std::unordered_map<uint32_t, size_t> slot;
-    for (uint32_t i = 0; i < loops.size(); ++i) {
-      const auto [it, fresh] = slot.emplace(root(i), groups.size());
-      if (fresh) groups.emplace_back();
-      groups[it->second].push_back(i);
-    }
-  }
+  // vertex are filled one after the other, in loop order (hole_groups). Groups
+  // touch nothing in common, so they are filled side by side, each numbering its
+  // patches' new vertices from the mesh's vertex count on; the patches are then
+  // appended in loop order, their vertices renumbered: the same mesh, vertex for
+  // vertex, as filling every hole in turn. (A patch's triangles use its loop's
+  // vertices and its own new ones only.)
+  const std::vector<std::vector<uint32_t>> groups = hole_groups(loops);
   const auto first_apart = static_cast<uint32_t>(original_vertices);
   std::vector<std::unique_ptr<HolePatch>> patches(loops.size());  // null: skipped
   std::vector<uint32_t> first_of(loops.size(), first_apart);      // where each patch numbered from
   tbb::parallel_for(size_t{0}, groups.size(), [&](size_t g) {
-    AddedEdges added_edges;
-    uint32_t next = first_apart;
-    for (const uint32_t i : groups[g]) {
-      const std::vector<uint32_t>& loop = loops[i];
-      if (options.max_hole_edges && loop.size() > options.max_hole_edges) continue;
-      // The fill walks the loop backwards: each patch triangle uses a loop edge in
-      // the direction opposite to the mesh triangle beside it.
-      const std::vector<uint32_t> poly(loop.rbegin(), loop.rend());
-      std::vector<Vec3f> edge_normal(poly.size());
-      for (size_t k = 0; k < poly.size(); ++k) {
-        const long t = he.find(poly[(k + 1) % poly.size()], poly[k]);
-        edge_normal[k] = Vec3f::Zero();
-        if (t >= 0) {
-          const Triangle& tri = mesh.triangles[static_cast<size_t>(t)];
-          edge_normal[k] = unit_normal(mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]);
-        }
-      }
-      auto patch = std::make_unique<HolePatch>(mesh, he, added_edges, next);
-      patch->triangulate(poly, edge_normal, std::max<size_t>(options.max_dp_edges, 4));
-      if (options.max_hole_area > 0.0 && patch->area() > options.max_hole_area) continue;
-      if (options.refine) patch->refine();
-      if (options.fairing != HoleFairing::kNone) patch->fair(loop, options.fairing == HoleFairing::kThinPlate);
-      for (const Triangle& t : patch->triangles())
-        for (int k = 0; k < 3; ++k) added_edges.insert(t[k], t[(k + 1) % 3]);
-      first_of[i] = next;
-      next += static_cast<uint32_t>(patch->new_vertices().size());
-      patches[i] = std::move(patch);
-    }
+    fill_group(mesh, he, loops, groups[g], first_apart, options, &patches, &first_of);
   });
 
   std::vector<Triangle> added_triangles;

@@ -98,18 +98,20 @@ TEST(ScanResults, TheRawRecordReadsBackOrSaysWhatIsWrong) {
   r.raw_stripes = std::string("\x01\x00\x02stripes", 10);
   const std::string dir = testing::temp_dir() + "/scan";
   ASSERT_TRUE(write_scan_results(r, dir).ok());
-  StatusOr<RawRecord> back = read_raw_record(dir);
-  ASSERT_TRUE(back.ok()) << back.status().message();
-  EXPECT_EQ(back->record, r.raw_record);
-  EXPECT_EQ(back->stripes, r.raw_stripes);
+  nlohmann::json record;
+  std::string stripes;
+  const Status back = read_raw_record(dir, &record, &stripes);
+  ASSERT_TRUE(back.ok()) << back.message();
+  EXPECT_EQ(record, r.raw_record);
+  EXPECT_EQ(stripes, r.raw_stripes);
 
-  StatusOr<RawRecord> none = read_raw_record(testing::temp_dir() + "/nowhere");
-  EXPECT_EQ(none.status().code(), StatusCode::kNotFound);
-  EXPECT_NE(none.status().message().find("no raw record"), std::string::npos);
+  const Status none = read_raw_record(testing::temp_dir() + "/nowhere", &record, &stripes);
+  EXPECT_EQ(none.code(), StatusCode::kNotFound);
+  EXPECT_NE(none.message().find("no raw record"), std::string::npos);
   std::ofstream(dir + "/raw/" + kRawRecordFile, std::ios::trunc) << "{\"rig\": ";
-  StatusOr<RawRecord> torn = read_raw_record(dir);
-  EXPECT_EQ(torn.status().code(), StatusCode::kInvalidArgument);
-  EXPECT_NE(torn.status().message().find("not JSON"), std::string::npos);
+  const Status torn = read_raw_record(dir, &record, &stripes);
+  EXPECT_EQ(torn.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(torn.message().find("not JSON"), std::string::npos);
 }
 
 }  // namespace
