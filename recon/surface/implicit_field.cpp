@@ -328,8 +328,9 @@ StatusOr<ImplicitField> build_implicit_field(const std::vector<Kernel>& kernels,
   starts.push_back(pairs.size());
   const size_t np = starts.size() - 1;
 
-  // Phase 1: each pencil's bricks (the union of its kernels' x ranges), so that
-  // brick indices and the sorted key list are known before any value is written.
+  // Phase 1: each pencil's x extent and the bricks its kernels' boxes overlap (the
+  // union of their x ranges): the bound that max_bricks is checked against before
+  // anything is allocated.
   std::vector<std::vector<int>> pencil_bricks(np);
   tbb::parallel_for(size_t{0}, np, [&](size_t pc) {
     int xmin = INT32_MAX, xmax = INT32_MIN;
